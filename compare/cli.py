@@ -1,0 +1,189 @@
+"""``spindle-verify``: the command line.
+
+Every user error (a malformed spec or cycle, a singular problem) prints one message per
+problem naming the file, the field and the fix, and exits with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from spindle.errors import InputError, SpindleVerifyError
+
+KELVIN = 273.15
+
+
+def _cmd_specs(args: argparse.Namespace) -> int:
+    from spindle.spec import load_spec, shipped_specs
+
+    for name, path in sorted(shipped_specs().items()):
+        spec = load_spec(path)
+        print(f"{name:12s} {spec.description}")
+        print(f"{'':12s} {path}")
+    return 0
+
+
+def _cmd_mesh(args: argparse.Namespace) -> int:
+    from meshes import build_mesh
+    from meshes.io import mesh_png, save_mesh_vtu
+    from spindle.outputs import output_dir
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)
+    rows = []
+    print(f"{'level':>5} {'elements':>9} {'nodes':>8} {'dofs_P1':>8} {'dofs_P2':>8} {'h_max_mm':>9}")
+    for level in range(args.level + 1):
+        sm = build_mesh(spec, level)
+        c1, c2 = sm.counts(1), sm.counts(2)
+        rows.append({**c2, "dofs_P1": c1["dofs_P1"], "h_max_m": sm.h_max_m})
+        print(f"{level:5d} {c2['elements']:9d} {c2['nodes']:8d} {c1['dofs_P1']:8d} "
+              f"{c2['dofs_P2']:8d} {sm.h_max_m * 1e3:9.3f}")
+    out = Path(args.out or f"results/{spec.name}/mesh")
+    with output_dir(out, inputs=[spec.path]) as tmp:
+        save_mesh_vtu(sm, tmp / f"mesh_level{args.level}.vtu")
+        (tmp / "mesh.json").write_text(json.dumps(
+            {"spec": spec.name, "parts": sm.part_names, "levels": rows,
+             "surfaces": {k: int(len(v)) for k, v in sm.surfaces.items()}}, indent=2) + "\n")
+        if not args.no_pictures:
+            mesh_png(sm, tmp / f"mesh_level{args.level}.png")
+    print(f"wrote {out}/mesh_level{args.level}.vtu, mesh.json"
+          + ("" if args.no_pictures else f", mesh_level{args.level}.png"))
+    return 0
+
+
+def _print_sensor_table(table: dict, title: str) -> None:
+    print(title)
+    print(f"  {'sensor':<16} {'z_mm':>7} {'r_mm':>7} {'T_C':>9} {'rise_K':>8}")
+    for i, name in enumerate(table["sensor"]):
+        print(f"  {name:<16} {table['z_m'][i] * 1e3:7.1f} {table['r_m'][i] * 1e3:7.2f} "
+              f"{table['T_C'][i]:9.3f} {table['rise_K'][i]:8.3f}")
+
+
+def _cmd_solve(args: argparse.Namespace) -> int:
+    from compare.progress import Progress
+    from meshes import build_mesh
+    from reference import ThermalModel
+    from spindle.loads import TimeSeries, read_cycle_csv
+    from spindle.outputs import output_dir
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)
+    t0 = time.perf_counter()
+    model = ThermalModel(build_mesh(spec, args.level), args.order)
+    t_asm = time.perf_counter() - t0
+    case = spec.default_load_case()
+    if args.speed is not None:
+        case = type(case)(**{**case.__dict__, "speed_rpm": TimeSeries.constant(args.speed)})
+    inputs = [spec.path]
+    quiet = args.quiet
+    if args.cycle:
+        case = read_cycle_csv(args.cycle, [h.name for h in spec.heat_sources], case)
+        inputs.append(args.cycle)
+        result = model.solve_transient(case, args.dt, theta=args.theta,
+                                       save_every=max(1, int(round(args.save_every / args.dt))),
+                                       progress=Progress("transient", not quiet))
+    else:
+        result = model.solve_steady(case)
+    t_solve = time.perf_counter() - t0 - t_asm
+    out = Path(args.out or f"results/{spec.name}")
+    with output_dir(out, inputs=inputs) as tmp:
+        files = result.save(tmp, pictures=not args.no_pictures)
+    c = model.smesh.counts(args.order)
+    print(f"{spec.name}: FEM P{args.order}, level {args.level}, {c['elements']} elements, "
+          f"{model.basis.N} DOFs; assembly {t_asm:.2f} s, solve {t_solve:.2f} s")
+    if args.cycle:
+        s = result.summary()
+        print(f"transient '{case.name}': {s['steps']} steps over {s['duration_s'] / 3600:.2f} h, "
+              f"theta = {args.theta:g}")
+        print(f"  {'sensor':<16} {'peak_C':>9} {'final_C':>9}")
+        for n in result.names:
+            print(f"  {n:<16} {s['peak_C'][n]:9.3f} {s['final_C'][n]:9.3f}")
+        e = result.energy
+        print(f"energy: in {e['energy_in_J'] / 3.6e6:.4f} kWh, out {e['energy_out_J'] / 3.6e6:.4f}"
+              f" kWh, stored {e['energy_stored_J'] / 3.6e6:.4f} kWh, relative imbalance "
+              f"{e['relative_imbalance']:.1e}")
+    else:
+        _print_sensor_table(result.sensor_table(),
+                            f"steady state at {result.speed_rpm:g} rpm, ambient "
+                            f"{case.T_ambient_K(0) - KELVIN:.2f} degC:")
+        e = result.energy
+        print(f"energy: in {e['heat_in_W']:.3f} W, out {e['heat_out_W']:.3f} W, relative "
+              f"imbalance {e['relative_imbalance']:.1e}; relative residual {result.residual:.1e}")
+    print("wrote " + ", ".join(str(out / f.name) for f in files))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="spindle-verify",
+        description="How far can you trust a thermal model of a motor spindle? FEM reference, "
+                    "lumped models and the harness that compares them. SPEC is a shipped spec "
+                    "name (see 'spindle-verify specs') or a path to a .toml file.")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    sp = sub.add_parser("specs", help="list the shipped spindle descriptions")
+    sp.set_defaults(func=_cmd_specs)
+
+    mp = sub.add_parser("mesh", help="mesh a spec at refinement levels 0..N; VTU and PNG")
+    mp.add_argument("spec", metavar="SPEC")
+    mp.add_argument("--level", type=int, default=2, help="finest level (default 2)")
+    mp.add_argument("--out", help="output folder (default results/<spec>/mesh)")
+    mp.add_argument("--no-pictures", action="store_true", help="skip the PNG")
+    mp.set_defaults(func=_cmd_mesh)
+
+    so = sub.add_parser("solve", help="FEM reference: steady state or a transient cycle")
+    so.add_argument("spec", metavar="SPEC")
+    so.add_argument("--level", type=int, default=2, help="mesh level (default 2)")
+    so.add_argument("--order", type=int, choices=(1, 2), default=2,
+                    help="element order (default 2)")
+    mode = so.add_mutually_exclusive_group()
+    mode.add_argument("--steady", action="store_true", help="steady state (the default)")
+    mode.add_argument("--cycle", metavar="FILE",
+                      help="transient cycle CSV: time_s, speed_rpm, T_env_C, T_coolant_C, "
+                           "<heat source>_W")
+    so.add_argument("--speed", type=float, help="spindle speed for a steady solve [rpm]")
+    so.add_argument("--dt", type=float, default=60.0, help="time step [s] (default 60)")
+    so.add_argument("--theta", type=float, default=1.0,
+                    help="1 = backward Euler (default), 0.5 = Crank-Nicolson")
+    so.add_argument("--save-every", type=float, default=1800.0,
+                    help="keep a field for ParaView every this many seconds (default 1800)")
+    so.add_argument("--out", help="output folder (default results/<spec>)")
+    so.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
+    so.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    so.set_defaults(func=_cmd_solve)
+    return p
+
+
+def _check_args(args: argparse.Namespace) -> None:
+    if not 0 <= getattr(args, "level", 0) <= 6:
+        raise InputError("command line", "--level", f"{args.level} is out of range",
+                         "give a level between 0 and 6")
+    if getattr(args, "dt", 1.0) <= 0:
+        raise InputError("command line", "--dt", "must be > 0 s", "give a positive time step")
+    if not 0.0 <= getattr(args, "theta", 1.0) <= 1.0:
+        raise InputError("command line", "--theta", "must be within [0, 1]",
+                         "use 1 (backward Euler) or 0.5 (Crank-Nicolson)")
+    if (getattr(args, "speed", None) or 0) < 0:
+        raise InputError("command line", "--speed", "is negative", "give |n| in rpm")
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        _check_args(args)
+        return args.func(args)
+    except SpindleVerifyError as exc:
+        for line in str(exc).splitlines():
+            print(f"spindle-verify: error: {line}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("spindle-verify: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

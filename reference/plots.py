@@ -1,0 +1,113 @@
+"""Pictures of FEM results (computing stays in reference.thermal; this module only draws)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from meshes.io import quiet_vtk
+from reference.fields import field_grid, revolved
+from spindle.outputs import atomic_write
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_section(model, T: np.ndarray, ax=None, title: str = "", sensors: bool = True):
+    """Temperature [degC] on the half-section, with the sensor points; returns the axes."""
+    import matplotlib.tri as mtri
+
+    plt = _pyplot()
+    if ax is None:
+        _, ax = plt.subplots(figsize=(12, 4.2), layout="constrained")
+    grid = field_grid(model, T)
+    tri = grid.cells.reshape(-1, 4)[:, 1:]
+    pts = grid.points
+    tc = ax.tripcolor(mtri.Triangulation(pts[:, 0] * 1e3, pts[:, 1] * 1e3, tri),
+                      grid.point_data["T_C"], shading="gouraud", cmap="inferno")
+    ax.figure.colorbar(tc, ax=ax, label="temperature [°C]", shrink=0.9)
+    if sensors:
+        for s in model.spec.temperature_sensors():
+            marker = "." if s.array else "o"
+            ax.plot(s.z * 1e3, s.r * 1e3, marker, color="cyan", ms=4 if s.array else 6,
+                    mec="black", mew=0.5)
+            if not s.array:
+                ax.annotate(s.name, (s.z * 1e3, s.r * 1e3), xytext=(3, 3),
+                            textcoords="offset points", fontsize=7, color="cyan")
+    ax.set_aspect("equal")
+    ax.set_xlabel("z [mm] (rear → tool)")
+    ax.set_ylabel("r [mm]")
+    ax.set_title(title)
+    return ax
+
+
+def section_png(model, T: np.ndarray, path: Path, title: str = "") -> None:
+    plt = _pyplot()
+    ax = plot_section(model, T, title=title)
+    atomic_write(Path(path), lambda tmp: ax.figure.savefig(tmp, dpi=130))
+    plt.close(ax.figure)
+
+
+def revolved_png(model, T: np.ndarray, path: Path, title: str = "",
+                 window: tuple[int, int] = (1400, 800)) -> None:
+    """The field revolved to 3-D as a 270 degree cut-away (off-screen pyvista)."""
+    import pyvista as pv
+
+    quiet_vtk()
+    solid = revolved(field_grid(model, T))
+    pl = pv.Plotter(off_screen=True, window_size=list(window))
+    pl.set_background("white")
+    pl.add_mesh(solid, scalars="T_C", cmap="inferno", smooth_shading=False,
+                scalar_bar_args={"title": "T [°C]", "color": "black", "vertical": True})
+    pl.add_text(title, font_size=10, color="black")
+    b = solid.bounds
+    focal = (0.5 * (b[0] + b[1]), 0.0, 0.0)
+    size = b[1] - b[0]
+    pl.camera_position = [(focal[0] - 0.35 * size, 0.9 * size, 0.7 * size), focal, (0, 0, 1)]
+    pl.reset_camera()
+    pl.camera.zoom(1.4)
+    atomic_write(Path(path), lambda tmp: pl.screenshot(str(tmp)))
+    pl.close()
+
+
+def sensor_profile_png(table, path: Path, title: str = "") -> None:
+    """Array sensors (shaft, housing) along z, from a sensor DataFrame-like table."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4), layout="constrained")
+    for arr in sorted({a for a in table["array"] if a}):
+        rows = [i for i, a in enumerate(table["array"]) if a == arr]
+        ax.plot([table["z_m"][i] * 1e3 for i in rows], [table["T_C"][i] for i in rows],
+                "o-", label=f"{arr} sensors")
+    ax.set_xlabel("z [mm]")
+    ax.set_ylabel("temperature [°C]")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=130))
+    plt.close(fig)
+
+
+def timeseries_png(times_s: np.ndarray, names: list[str], values_C: np.ndarray, path: Path,
+                   title: str = "") -> None:
+    """Point sensors over time [h]; array sensors are drawn thin and grey."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
+    for j, n in enumerate(names):
+        if "_" in n and n.rsplit("_", 1)[1].isdigit():
+            ax.plot(times_s / 3600, values_C[:, j], color="0.8", lw=0.6)
+        else:
+            ax.plot(times_s / 3600, values_C[:, j], lw=1.6, label=n)
+    ax.set_xlabel("time [h]")
+    ax.set_ylabel("temperature [°C]")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=130))
+    plt.close(fig)

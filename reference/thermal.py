@@ -1,0 +1,301 @@
+"""The FEM thermal reference: assembly from a meshed spec, steady and transient solves.
+
+The conductance matrix at speed n is an affine combination of matrices assembled once::
+
+    K(n) = K_solid + sum_links g_l(n) K_l + sum_surfaces h_s(n) R_s + sum_contacts h_c C_c
+
+and the load is ``F(t) = sum_s h_s T_ref,s(t) b_s + sum_j P_j(t) f_j``. A change of speed
+or of time therefore never reassembles, and one sparse LU is reused for every time step
+of the same length at the same speed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+from scipy.spatial import cKDTree
+from skfem import Basis, ElementTriP0, ElementTriP1, ElementTriP2, FacetBasis, asm
+
+from meshes import SpindleMesh
+from reference.forms import capacity, conduction, film, surface_flux, volume_source
+from spindle.errors import SolverError
+from spindle.loads import LoadCase
+from spindle.spec import BearingLink, ContactLink
+
+TWO_PI = 2.0 * math.pi
+
+
+def factorize(A: sp.spmatrix):
+    """Sparse LU of a symmetric positive definite matrix (conductance, or M/dt + theta K).
+
+    SuperLU in symmetric mode: minimum-degree ordering on A^T + A and no pivoting (SPD
+    matrices need none), which halves the fill of the default COLAMD ordering here.
+    """
+    return splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True})
+ELEMENTS = {1: ElementTriP1, 2: ElementTriP2}
+
+
+def layer_conductivity_factor(region_shape, kind: str) -> float:
+    """Conductivity [W/m/K] of a link layer per unit link value (W/K or W/m2/K).
+
+    Bearing: a radial annulus of length L between r_i and r_o has the conductance
+    G = 2 pi k L / ln(r_o / r_i), so k = G ln(r_o / r_i) / (2 pi L).
+    Air gap: the film coefficient h acts on the rotor surface 2 pi r_i L, so
+    k = h r_i ln(r_o / r_i). Radii are the section's means (exact for cylinders).
+    """
+    ri = 0.5 * (region_shape.r_inner[0] + region_shape.r_inner[1])
+    ro = 0.5 * (region_shape.r_outer[0] + region_shape.r_outer[1])
+    if kind == "bearing":
+        return math.log(ro / ri) / (TWO_PI * region_shape.length)
+    return ri * math.log(ro / ri)
+
+
+@dataclass
+class Operator:
+    """The matrices of one mesh and element order, and how to combine them."""
+
+    K_solid: sp.csr_matrix
+    M: sp.csr_matrix
+    links: list[tuple[object, sp.csr_matrix]]  # (link, unit matrix)
+    films: list[tuple[object, sp.csr_matrix, np.ndarray]]  # (surface, R_s, b_s)
+    contacts: list[tuple[object, sp.csr_matrix]]  # (link, C_c at h = 1)
+    sources: list[tuple[object, np.ndarray]]  # (heat source, load per W)
+
+    def K(self, speed_rpm: float) -> sp.csr_matrix:
+        K = self.K_solid.copy()
+        for lk, A in self.links:
+            value = lk.G_W_K(speed_rpm) if isinstance(lk, BearingLink) else lk.h_W_m2K(speed_rpm)
+            K = K + value * A
+        for s, R, _ in self.films:
+            K = K + s.h_W_m2K(speed_rpm) * R
+        for lk, C in self.contacts:
+            K = K + lk.h_W_m2K * C
+        return K.tocsr()
+
+    def F(self, case: LoadCase, t: float, speed_rpm: float) -> np.ndarray:
+        F = np.zeros(self.M.shape[0])
+        T_ref = {"ambient": float(case.T_ambient_K(t)), "coolant": float(case.T_coolant_K(t))}
+        for s, _, b in self.films:
+            F += s.h_W_m2K(speed_rpm) * T_ref[s.T_ref] * b
+        for src, f in self.sources:
+            F += float(case.sources.get(src.name, src.power_W)(t)) * f
+        return F
+
+    def heat_in_W(self, case: LoadCase, t: float) -> float:
+        return float(sum(case.sources.get(src.name, src.power_W)(t) for src, _ in self.sources))
+
+    def heat_out_W(self, T: np.ndarray, case: LoadCase, t: float, speed_rpm: float
+                   ) -> dict[str, float]:
+        """Heat leaving through each convective surface [W]."""
+        T_ref = {"ambient": float(case.T_ambient_K(t)), "coolant": float(case.T_coolant_K(t))}
+        # 1^T R_s T = int_s T r ds and 1^T b_s = int_s r ds (partition of unity)
+        return {s.name: TWO_PI * s.h_W_m2K(speed_rpm) * (float(b @ T) - T_ref[s.T_ref] * b.sum())
+                for s, _, b in self.films}
+
+    def stored_J(self, T: np.ndarray, T0: np.ndarray) -> float:
+        """Heat stored since T0 [J]: 2 pi 1^T M (T - T0)."""
+        return TWO_PI * float(np.asarray(self.M.sum(axis=0)).ravel() @ (T - T0))
+
+
+class ThermalModel:
+    """FEM heat conduction on a :class:`~meshes.SpindleMesh` with P1 or P2 elements."""
+
+    def __init__(self, smesh: SpindleMesh, order: int = 2):
+        if order not in ELEMENTS:
+            raise ValueError(f"order must be 1 or 2, not {order}")
+        self.smesh, self.order, self.spec = smesh, order, smesh.spec
+        mesh = smesh.mesh
+        self.basis = Basis(mesh, ELEMENTS[order](), intorder=2 * order + 1)
+        self.op = self._assemble()
+        self._lu: dict[tuple, object] = {}
+
+    # ------------------------------------------------------------------ assembly
+    def _element_fields(self):
+        regions, er = self.smesh.regions, self.smesh.element_region
+        kr = np.array([r.material.k_r_W_mK if r.kind == "solid" else 0.0 for r in regions])[er]
+        kz = np.array([r.material.k_z_W_mK if r.kind == "solid" else 0.0 for r in regions])[er]
+        rhoc = np.array([r.material.rho_kg_m3 * r.material.c_J_kgK for r in regions])[er]
+        return kr, kz, rhoc
+
+    def _cell(self, values: np.ndarray):
+        """A per-element constant as a field at the quadrature points."""
+        b0 = self.basis.with_element(ElementTriP0())
+        return b0.interpolate(values)
+
+    def _assemble(self) -> Operator:
+        sm, spec, basis = self.smesh, self.spec, self.basis
+        kr, kz, rhoc = self._element_fields()
+        K_solid = asm(conduction, basis, kr=self._cell(kr), kz=self._cell(kz)).tocsr()
+        M = asm(capacity, basis, rhoc=self._cell(rhoc)).tocsr()
+        links = []
+        for li, lk in enumerate(spec.links):
+            if isinstance(lk, ContactLink):
+                continue
+            factor = np.zeros(len(sm.regions))
+            for ri, reg in enumerate(sm.regions):
+                if reg.link == li:
+                    factor[ri] = layer_conductivity_factor(reg.shape, reg.kind)
+            els = np.nonzero(factor[sm.element_region] > 0)[0]
+            cb = Basis(sm.mesh, basis.elem, elements=els, intorder=2 * self.order + 1)
+            g = cb.with_element(ElementTriP0()).interpolate(
+                np.zeros(sm.mesh.nelements) + factor[sm.element_region])
+            links.append((lk, asm(conduction, cb, kr=g, kz=g).tocsr()))
+        films = []
+        for s in spec.surfaces:
+            if s.h_W_m2K is None:
+                continue
+            fb = FacetBasis(sm.mesh, basis.elem, facets=sm.surfaces[s.name],
+                            intorder=2 * self.order + 1)
+            films.append((s, asm(film, fb, h=1.0).tocsr(), asm(surface_flux, fb, qs=1.0)))
+        contacts = [(spec.links[li], self._contact_matrix(fa, fb))
+                    for li, fa, fb in sm.contacts if len(fa)]
+        sources = []
+        for src in spec.heat_sources:
+            if src.surface is not None:
+                fb = FacetBasis(sm.mesh, basis.elem, facets=sm.surfaces[src.surface],
+                                intorder=2 * self.order + 1)
+                area = TWO_PI * asm(surface_flux, fb, qs=1.0).sum()
+                sources.append((src, asm(surface_flux, fb, qs=1.0 / area)))
+            else:
+                els = sm.elements_of(src.part, src.section)
+                cb = Basis(sm.mesh, basis.elem, elements=els, intorder=2 * self.order + 1)
+                vol = TWO_PI * asm(volume_source, cb, q=1.0).sum()
+                sources.append((src, asm(volume_source, cb, q=1.0 / vol)))
+        return Operator(K_solid, M, links, films, contacts, sources)
+
+    def _contact_matrix(self, fa: np.ndarray, fb: np.ndarray) -> sp.csr_matrix:
+        """Interface term of int h_c [T][v] r ds at h_c = 1 as D^T M_a D.
+
+        M_a is the facet mass on side A; D maps a vector to its jump across the interface,
+        (D U)_i = U_i - U_phi(i), phi pairing each A-side DOF with the B-side DOF at the
+        same place (the two sides' Lagrange traces coincide, so this is exact).
+        """
+        basis, n = self.basis, self.basis.N
+        fbasis = FacetBasis(self.smesh.mesh, basis.elem, facets=fa, intorder=2 * self.order + 1)
+        Ma = asm(film, fbasis, h=1.0).tocsr()
+        da = np.unique(basis.get_dofs(facets=fa).flatten())
+        db = np.unique(basis.get_dofs(facets=fb).flatten())
+        dist, j = cKDTree(basis.doflocs[:, db].T).query(basis.doflocs[:, da].T)
+        if np.max(dist, initial=0.0) > 1e-9:
+            raise SolverError("contact interface DOFs do not match pairwise (mesh bug)")
+        D = sp.csr_matrix((np.r_[np.ones(len(da)), -np.ones(len(da))],
+                           (np.r_[da, da], np.r_[da, db[j]])), shape=(n, n))
+        return (D.T @ Ma @ D).tocsr()
+
+    # ------------------------------------------------------------------ sensors
+    def probe_matrix(self, points: np.ndarray) -> sp.csr_matrix:
+        """Interpolation (not nearest node) of the field at points (2 x n, z and r in m)."""
+        return self.basis.probes(np.asarray(points, dtype=float)).tocsr()
+
+    def sensor_points(self) -> tuple[list[str], np.ndarray]:
+        sensors = self.spec.temperature_sensors()
+        return [s.name for s in sensors], np.array([[s.z for s in sensors],
+                                                    [s.r for s in sensors]])
+
+    # ------------------------------------------------------------------ solves
+    def _factor(self, build: Callable[[], sp.spmatrix], key: tuple):
+        """LU of ``build()``, cached by ``key`` so equal steps reuse one factorisation."""
+        if key not in self._lu:
+            if len(self._lu) > 16:
+                self._lu.clear()
+            try:
+                self._lu[key] = factorize(build())
+            except RuntimeError as exc:
+                raise SolverError(f"{self.spec.path}: the thermal problem is singular ({exc}); "
+                                  "fix: give every part a heat path to a fixed temperature "
+                                  "([[surfaces]] with h_W_m2K > 0)") from None
+        return self._lu[key]
+
+    def solve_steady(self, case: LoadCase | None = None, t: float = 0.0):
+        """Steady state for the inputs of ``case`` at time ``t`` [s]."""
+        from reference.results import SteadyResult
+
+        case = case or self.spec.default_load_case()
+        n = float(case.speed_rpm(t))
+        K, F = self.op.K(n), self.op.F(case, t, n)
+        T = self._factor(lambda: K, ("steady", n)).solve(F)
+        if not np.all(np.isfinite(T)):
+            raise SolverError(f"{self.spec.path}: the steady solution is not finite; "
+                              "fix: check film coefficients and conductances for zeros")
+        residual = float(np.linalg.norm(K @ T - F) / max(np.linalg.norm(F), 1e-300))
+        q_in = self.op.heat_in_W(case, t)
+        q_out = self.op.heat_out_W(T, case, t, n)
+        return SteadyResult(self, case, t, n, T, q_in, q_out, residual)
+
+    def solve_transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
+                        T0: np.ndarray | float | None = None, save_every: int = 0,
+                        progress: Callable[[float], None] | None = None):
+        """Theta-method time integration over ``case.duration_s`` [s].
+
+        theta = 1 is backward Euler (first order), theta = 0.5 Crank-Nicolson (second order).
+        Steps of ``dt_s`` land on every sample time of the inputs. ``T0`` is the initial
+        field (K), a uniform temperature, or None for the spec's initial temperature.
+        Fields are kept every ``save_every`` steps (0: first and last only).
+        """
+        from reference.results import TransientResult
+
+        if not 0.0 <= theta <= 1.0:
+            raise ValueError("theta must be within [0, 1]")
+        if dt_s <= 0 or case.duration_s <= 0:
+            raise SolverError("a transient run needs dt_s > 0 and a duration > 0")
+        grid = np.unique(np.concatenate([np.arange(0.0, case.duration_s, dt_s),
+                                         case.breakpoints(), [case.duration_s]]))
+        grid = grid[np.concatenate([[True], np.diff(grid) > 1e-9 * dt_s])]
+        op = self.op
+        N = op.M.shape[0]
+        if T0 is None:
+            T = np.full(N, self.spec.T_initial_K)
+        elif np.isscalar(T0):
+            T = np.full(N, float(T0))
+        else:
+            T = np.asarray(T0, dtype=float).copy()
+        T_start = T.copy()
+        names, pts = self.sensor_points()
+        P = self.probe_matrix(pts)
+        sensors = np.empty((len(grid), len(names)))
+        sensors[0] = P @ T
+        fields_t, fields = [0.0], [T.copy()]
+        n0 = float(case.speed_rpm(0.0))
+        K0, F0 = op.K(n0), op.F(case, 0.0, n0)
+        q_in0 = op.heat_in_W(case, 0.0)
+        q_out0 = sum(op.heat_out_W(T, case, 0.0, n0).values())
+        E_in = E_out = 0.0
+        heat_in, heat_out = np.empty(len(grid)), np.empty(len(grid))
+        heat_in[0], heat_out[0] = q_in0, q_out0
+        K_cache: dict[float, sp.csr_matrix] = {n0: K0}
+        for k in range(1, len(grid)):
+            t0, t1 = grid[k - 1], grid[k]
+            dt = t1 - t0
+            # speed is held over a step at its value at the step's start (zero-order hold)
+            n1 = float(case.speed_rpm(t0 + 0.5 * dt))
+            if n1 not in K_cache:
+                K_cache[n1] = op.K(n1)
+            K1 = K_cache[n1]
+            F1 = op.F(case, t1, n1)
+            lu = self._factor(lambda dt=dt, K1=K1: op.M / dt + theta * K1,
+                              ("step", round(dt, 9), n1, theta))
+            rhs = op.M @ T / dt + theta * F1 + (1 - theta) * (F0 - K0 @ T)
+            T_new = lu.solve(rhs)
+            q_in1 = op.heat_in_W(case, t1)
+            q_out1 = sum(op.heat_out_W(T_new, case, t1, n1).values())
+            # heat flows of the same theta-weighting as the scheme: the balance is exact
+            E_in += dt * (theta * q_in1 + (1 - theta) * q_in0)
+            # the explicit part acts with the previous step's operator, hence q_out0
+            E_out += dt * (theta * q_out1 + (1 - theta) * q_out0)
+            T, K0, F0, q_in0, q_out0, n0 = T_new, K1, op.F(case, t1, n1), q_in1, q_out1, n1
+            sensors[k] = P @ T
+            heat_in[k], heat_out[k] = q_in1, q_out1
+            if (save_every and k % save_every == 0) or k == len(grid) - 1:
+                fields_t.append(float(t1))
+                fields.append(T.copy())
+            if progress is not None:
+                progress(t1 / case.duration_s)
+        E_stored = op.stored_J(T, T_start)
+        return TransientResult(self, case, theta, grid, names, sensors, np.array(fields_t),
+                               np.array(fields), heat_in, heat_out, E_in, E_out, E_stored)

@@ -1,0 +1,186 @@
+"""Time series and load cases: what drives a solve (speed, heat sources, ambient, coolant).
+
+A :class:`LoadCase` holds, for one run, the spindle speed [rpm], the ambient and coolant
+temperatures [K] and the power of each named heat source [W], each as a time series.
+A steady solve evaluates them at one instant; a transient solve follows them.
+"""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from spindle.errors import InputError
+
+Interpolation = Literal["linear", "previous"]
+
+
+@dataclass(frozen=True)
+class TimeSeries:
+    """A scalar signal of time: samples ``values`` at ``time_s`` [s].
+
+    ``linear`` interpolates between samples; ``previous`` holds each value until the next
+    sample (a step signal, as spindle speeds in a test cycle are). Outside the samples the
+    first or last value is held. A single sample is a constant.
+    """
+
+    time_s: tuple[float, ...]
+    values: tuple[float, ...]
+    interpolation: Interpolation = "linear"
+
+    @classmethod
+    def constant(cls, value: float) -> TimeSeries:
+        return cls((0.0,), (float(value),))
+
+    @property
+    def is_constant(self) -> bool:
+        return len(set(self.values)) <= 1
+
+    def __call__(self, t: float | np.ndarray) -> float | np.ndarray:
+        times = np.asarray(self.time_s)
+        vals = np.asarray(self.values)
+        if len(vals) == 1:
+            return np.full_like(np.asarray(t, dtype=float), vals[0])[()]
+        if self.interpolation == "previous":
+            idx = np.searchsorted(times, t, side="right") - 1
+            return vals[np.clip(idx, 0, len(vals) - 1)][()]
+        return np.interp(t, times, vals)[()]
+
+    def breakpoints(self) -> np.ndarray:
+        """The sample times [s]: a time stepper should land on them."""
+        return np.asarray(self.time_s) if len(self.values) > 1 else np.zeros(0)
+
+
+@dataclass(frozen=True)
+class SpeedTable:
+    """A coefficient that depends on spindle speed, linear between table points.
+
+    ``speed_rpm`` ascending; a single point is a constant. Units are those of the field
+    the table stands for (W/m2/K for film coefficients, W/K for conductances).
+    """
+
+    speed_rpm: tuple[float, ...]
+    values: tuple[float, ...]
+
+    @classmethod
+    def constant(cls, value: float) -> SpeedTable:
+        return cls((0.0,), (float(value),))
+
+    def __call__(self, speed_rpm: float) -> float:
+        if len(self.values) == 1:
+            return float(self.values[0])
+        return float(np.interp(speed_rpm, self.speed_rpm, self.values))
+
+    @property
+    def max(self) -> float:
+        return float(max(self.values))
+
+    @property
+    def min(self) -> float:
+        return float(min(self.values))
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """Inputs of one run. Temperatures in K, speed in rpm, source powers in W.
+
+    ``sources`` maps each heat source of the spec by name to its power series; sources not
+    named keep the spec's own value. ``duration_s`` is the length of a transient run.
+    """
+
+    name: str
+    speed_rpm: TimeSeries
+    T_ambient_K: TimeSeries
+    T_coolant_K: TimeSeries
+    sources: Mapping[str, TimeSeries] = field(default_factory=dict)
+    duration_s: float = 0.0
+
+    def breakpoints(self) -> np.ndarray:
+        """All sample times of all inputs [s], sorted and unique."""
+        series = [self.speed_rpm, self.T_ambient_K, self.T_coolant_K, *self.sources.values()]
+        pts = np.concatenate([s.breakpoints() for s in series] + [np.zeros(1)])
+        return np.unique(pts[(pts >= 0) & (pts <= self.duration_s)])
+
+    def with_sources(self, sources: Mapping[str, TimeSeries]) -> LoadCase:
+        return replace(self, sources={**self.sources, **sources})
+
+
+_KNOWN_CYCLE_COLUMNS = {"time_s", "speed_rpm", "T_env_C", "T_coolant_C"}
+
+
+def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) -> LoadCase:
+    """Read a transient load cycle from CSV (comment lines start with ``#``).
+
+    Columns: ``time_s`` (required, strictly increasing), and any of ``speed_rpm`` (held
+    between samples), ``T_env_C`` and ``T_coolant_C`` (linear), and ``<source>_W`` for each
+    heat source of the spec (linear). Columns not given keep the values of ``base``.
+    """
+    path = Path(path)
+    name = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise InputError(name, "file", f"cannot be read ({exc.strerror})",
+                         "check the path given to --cycle") from None
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InputError(name, "header", "the file has no header row",
+                         "add a header such as 'time_s,speed_rpm,T_env_C'")
+    rows = list(csv.reader(lines))
+    header = [h.strip() for h in rows[0]]
+    if "time_s" not in header:
+        raise InputError(name, "time_s", "required column is missing",
+                         "add a 'time_s' column with the time since the start [s]")
+    allowed = _KNOWN_CYCLE_COLUMNS | {f"{s}_W" for s in source_names}
+    unknown = [h for h in header if h not in allowed]
+    if unknown:
+        raise InputError(name, unknown[0], "is not a cycle column",
+                         f"use one of {sorted(allowed)}")
+    data: dict[str, list[float]] = {h: [] for h in header}
+    for lineno, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise InputError(name, f"row {lineno}", f"has {len(row)} cells, header has "
+                             f"{len(header)}", "give every row one cell per column")
+        for h, cell in zip(header, row, strict=True):
+            try:
+                v = float(cell)
+            except ValueError:
+                raise InputError(name, f"{h} (row {lineno})", f"'{cell}' is not a number",
+                                 "write a decimal number with '.' as the separator") from None
+            if not np.isfinite(v):
+                raise InputError(name, f"{h} (row {lineno})", "is not finite",
+                                 "write a finite number")
+            data[h].append(v)
+    t = np.asarray(data["time_s"])
+    if len(t) < 2:
+        raise InputError(name, "time_s", "a cycle needs at least two rows",
+                         "add rows up to the end time of the run")
+    bad = np.nonzero(np.diff(t) <= 0)[0]
+    if len(bad):
+        raise InputError(name, f"time_s (row {bad[0] + 3})", "time does not increase",
+                         "sort the rows by time and remove duplicates")
+    if t[0] < 0:
+        raise InputError(name, "time_s (row 2)", "is negative", "start the cycle at 0 s")
+    times = tuple(float(x) for x in t - t[0])
+
+    def series(col: str, offset: float = 0.0, interp: Interpolation = "linear") -> TimeSeries:
+        return TimeSeries(times, tuple(v + offset for v in data[col]), interp)
+
+    case = replace(base, name=path.stem, duration_s=times[-1])
+    if "speed_rpm" in data:
+        if min(data["speed_rpm"]) < 0:
+            raise InputError(name, "speed_rpm", "is negative", "give the speed as |n| [rpm]")
+        case = replace(case, speed_rpm=series("speed_rpm", interp="previous"))
+    for col, attr in (("T_env_C", "T_ambient_K"), ("T_coolant_C", "T_coolant_K")):
+        if col in data:
+            if min(data[col]) < -60 or max(data[col]) > 200:
+                raise InputError(name, col, "is outside -60..200 degC",
+                                 "give temperatures in degrees Celsius")
+            case = replace(case, **{attr: series(col, 273.15)})
+    sources = {s: series(f"{s}_W") for s in source_names if f"{s}_W" in data}
+    return case.with_sources(sources)

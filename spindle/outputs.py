@@ -1,0 +1,57 @@
+"""Atomic outputs: a run writes into a hidden temporary folder and moves each finished file
+into the output folder only when everything succeeded, so a failed run leaves no
+half-written output; an output never replaces one of the run's inputs."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+
+from spindle.errors import InputError
+
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
+
+def atomic_write(path: Path, write) -> None:
+    """Call ``write(tmp_path)`` and move the result into ``path`` in one step."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; outputs are ordinary files
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+@contextmanager
+def output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[Path]:
+    """Yield a temporary folder to write into; on success move its files into ``path``."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(str(path), "--out", "is a file, not a folder",
+                         "give a folder for the outputs")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.tmp-", dir=path.parent))
+    try:
+        yield tmp
+        files = [f for f in tmp.rglob("*") if f.is_file()]
+        protected = {Path(p).resolve() for p in inputs}
+        for f in files:
+            dest = (path / f.relative_to(tmp)).resolve()
+            if dest in protected:
+                raise InputError(str(dest), "--out", "an output would overwrite this input",
+                                 "choose another output folder")
+        for f in files:
+            dest = path / f.relative_to(tmp)
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(f, dest)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)

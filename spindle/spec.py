@@ -1,0 +1,729 @@
+"""The spindle description (spec): a TOML file of CAD dimensions, materials, links, boundary
+conditions, heat sources and sensors, in SI units. See docs/spec.md for every field.
+
+:func:`load_spec` reads and validates a file; every problem found is reported at once, each
+naming the file, the field and the fix (:class:`~spindle.errors.SpecError`).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from spindle.errors import Problem, SpecError
+from spindle.geometry import TOL_M, Trapezoid, contact_length, overlap
+from spindle.loads import LoadCase, SpeedTable, TimeSeries
+
+ROLES = ("shaft", "tool", "rotor", "stator", "housing", "cooling_sleeve",
+         "front_bearing", "rear_bearing")
+BEARING_ROLES = ("front_bearing", "rear_bearing")
+SIDES = ("outer", "inner", "front", "rear", "any")
+T_REFS = ("ambient", "coolant")
+LINK_TYPES = ("bearing", "air_gap", "contact")
+#: A rotor-stator gap wider than this is not an air gap of a built-in motor [m].
+MAX_AIR_GAP_M = 5e-3
+
+
+@dataclass(frozen=True)
+class Material:
+    """Thermal and elastic properties, SI. ``k_r``/``k_z``: radial/axial conductivity [W/m/K]."""
+
+    name: str
+    k_r_W_mK: float
+    k_z_W_mK: float
+    rho_kg_m3: float
+    c_J_kgK: float
+    E_Pa: float
+    nu: float
+    alpha_1_K: float
+    source: str = ""
+
+    @property
+    def isotropic(self) -> bool:
+        return self.k_r_W_mK == self.k_z_W_mK
+
+
+@dataclass(frozen=True)
+class Section(Trapezoid):
+    """One axisymmetric section of a part: geometry [m], its material and optional name."""
+
+    material: str = ""
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class Part:
+    name: str
+    role: str
+    sections: tuple[Section, ...]
+
+
+@dataclass(frozen=True)
+class BearingLink:
+    """Rolling-contact conductance between the raceways [W/K]; its ``section`` of the bearing
+    ``part`` is meshed with the conductivity that gives this conductance radially."""
+
+    part: str
+    section: str
+    G_W_K: SpeedTable
+
+
+@dataclass(frozen=True)
+class AirGapLink:
+    """Effective rotor-stator air-gap coefficient [W/m2/K] on the rotor surface; the gap
+    between ``inner`` and ``outer`` is meshed as a layer with the matching conductivity."""
+
+    inner: str
+    outer: str
+    h_W_m2K: SpeedTable
+
+
+@dataclass(frozen=True)
+class ContactLink:
+    """Fitted-joint contact conductance [W/m2/K] on the interface of two touching parts."""
+
+    parts: tuple[str, str]
+    h_W_m2K: float
+
+
+Link = BearingLink | AirGapLink | ContactLink
+
+
+@dataclass(frozen=True)
+class Surface:
+    """Named exposed surface: the boundary of ``parts`` facing ``side``, within z limits [m].
+
+    With ``h_W_m2K`` it is a convective boundary towards ``T_ref`` (ambient or coolant);
+    without, it only names the place for a surface heat source.
+    """
+
+    name: str
+    parts: tuple[str, ...]
+    side: str
+    z_min: float
+    z_max: float
+    h_W_m2K: SpeedTable | None
+    T_ref: str | None
+
+
+@dataclass(frozen=True)
+class HeatSource:
+    """Heat [W] into a part (or one named section of it) by volume, or into a surface."""
+
+    name: str
+    power_W: TimeSeries
+    part: str | None = None
+    section: str | None = None
+    surface: str | None = None
+
+
+@dataclass(frozen=True)
+class Sensor:
+    """A virtual sensor at (z, r) [m]. ``axial_displacement`` sensors also have a reference
+    point (z_ref, r_ref) and read the axial displacement of (z, r) relative to it."""
+
+    name: str
+    kind: str
+    z: float
+    r: float
+    z_ref: float | None = None
+    r_ref: float | None = None
+    array: str | None = None
+
+
+@dataclass(frozen=True)
+class SensorArray:
+    """``count`` temperature sensors spaced evenly over the axial length of ``part``."""
+
+    name: str
+    part: str
+    count: int
+    radius: str | float
+
+
+@dataclass(frozen=True)
+class Spec:
+    """A validated spindle description (SI units)."""
+
+    name: str
+    path: str
+    description: str
+    source: str
+    speed_rpm: float
+    T_ambient_K: float
+    T_coolant_K: float
+    T_initial_K: float
+    h0_m: float
+    materials: dict[str, Material]
+    parts: tuple[Part, ...]
+    links: tuple[Link, ...]
+    surfaces: tuple[Surface, ...]
+    heat_sources: tuple[HeatSource, ...]
+    sensors: tuple[Sensor, ...]
+    sensor_arrays: tuple[SensorArray, ...] = field(default_factory=tuple)
+
+    def part(self, name: str) -> Part:
+        return next(p for p in self.parts if p.name == name)
+
+    def sections(self) -> Iterator[tuple[Part, Section]]:
+        for p in self.parts:
+            for s in p.sections:
+                yield p, s
+
+    def parts_with_role(self, role: str) -> list[Part]:
+        return [p for p in self.parts if p.role == role]
+
+    def mass_kg(self, part: str, section: str | None = None) -> float:
+        return float(sum(self.materials[s.material].rho_kg_m3 * s.volume_m3
+                         for s in self.part(part).sections
+                         if section is None or s.name == section))
+
+    def temperature_sensors(self) -> list[Sensor]:
+        return [s for s in self.sensors if s.kind == "temperature"]
+
+    def default_load_case(self) -> LoadCase:
+        """Constant inputs from the spec's [operating] table and heat sources."""
+        return LoadCase(
+            name="steady",
+            speed_rpm=TimeSeries.constant(self.speed_rpm),
+            T_ambient_K=TimeSeries.constant(self.T_ambient_K),
+            T_coolant_K=TimeSeries.constant(self.T_coolant_K),
+            sources={h.name: h.power_W for h in self.heat_sources},
+        )
+
+
+# --------------------------------------------------------------------------- reading
+
+
+class _Reader:
+    """Collects problems while reading nested TOML tables; never stops at the first."""
+
+    def __init__(self, file: str):
+        self.file = file
+        self.problems: list[Problem] = []
+
+    def add(self, fld: str, message: str, fix: str) -> None:
+        self.problems.append(Problem(self.file, fld, message, fix))
+
+    def table(self, data: dict, key: str, path: str, required: bool = True) -> dict | None:
+        v = data.get(key)
+        if v is None:
+            if required:
+                self.add(f"{path}{key}", "required table is missing", f"add a [{path}{key}] table")
+            return None
+        if not isinstance(v, dict):
+            self.add(f"{path}{key}", "must be a table", f"write it as [{path}{key}]")
+            return None
+        return v
+
+    def array(self, data: dict, key: str, path: str, required: bool = True) -> list[dict]:
+        v = data.get(key)
+        if v is None:
+            if required:
+                self.add(key, "required list is missing", f"add at least one [[{key}]] entry")
+            return []
+        if not isinstance(v, list) or not all(isinstance(x, dict) for x in v):
+            self.add(f"{path}{key}", "must be a list of tables", f"write entries as [[{key}]]")
+            return []
+        return v
+
+    def string(self, data: dict, key: str, path: str, required: bool = True,
+               choices: tuple[str, ...] | None = None, default: str | None = None) -> str | None:
+        v = data.get(key)
+        if v is None:
+            if required:
+                self.add(f"{path}.{key}", "required field is missing", f"add {key} = \"...\"")
+            return default
+        if not isinstance(v, str) or not v:
+            self.add(f"{path}.{key}", f"must be a text, not {v!r}", f"write {key} = \"...\"")
+            return default
+        if choices is not None and v not in choices:
+            self.add(f"{path}.{key}", f"'{v}' is not one of {', '.join(choices)}",
+                     f"use one of {', '.join(choices)}")
+            return default
+        return v
+
+    def number(self, data: dict, key: str, path: str, unit: str, required: bool = True,
+               default: float | None = None, lo: float | None = None, lo_open: bool = False,
+               hi: float | None = None) -> float | None:
+        v = data.get(key)
+        if v is None:
+            if required:
+                self.add(f"{path}.{key}", "required field is missing",
+                         f"add {key} = <number in {unit}>")
+            return default
+        if isinstance(v, bool) or not isinstance(v, int | float) or not np.isfinite(v):
+            self.add(f"{path}.{key}", f"must be a finite number in {unit}, not {v!r}",
+                     f"write {key} = <number in {unit}>")
+            return default
+        v = float(v)
+        if lo is not None and (v <= lo if lo_open else v < lo):
+            rel = ">" if lo_open else ">="
+            self.add(f"{path}.{key}", f"{v:g} {unit} is not physical (must be {rel} {lo:g})",
+                     f"give {key} {rel} {lo:g} {unit}")
+            return default
+        if hi is not None and v > hi:
+            self.add(f"{path}.{key}", f"{v:g} {unit} is out of range (must be <= {hi:g})",
+                     f"give {key} <= {hi:g} {unit}")
+            return default
+        return v
+
+    def radius(self, data: dict, key: str, path: str) -> tuple[float, float] | None:
+        v = data.get(key)
+        if isinstance(v, list) and len(v) == 2 and all(
+                isinstance(x, int | float) and not isinstance(x, bool) for x in v):
+            pair = (float(v[0]), float(v[1]))
+        elif isinstance(v, int | float) and not isinstance(v, bool):
+            pair = (float(v), float(v))
+        elif v is None:
+            self.add(f"{path}.{key}", "required field is missing",
+                     f"add {key} = <radius in m> (or [start, end] for a cone)")
+            return None
+        else:
+            self.add(f"{path}.{key}", f"must be a radius in m or [start, end], not {v!r}",
+                     f"write {key} = 0.04 or {key} = [0.04, 0.05]")
+            return None
+        if min(pair) < 0:
+            self.add(f"{path}.{key}", "a radius cannot be negative", "give radii >= 0 m")
+            return None
+        return pair
+
+    def speed_table(self, data: dict, key: str, path: str, unit: str,
+                    required: bool = True) -> SpeedTable | None:
+        """A constant, or {speed_rpm = [...], value = [...]} interpolated in speed."""
+        v = data.get(key)
+        if v is None:
+            if required:
+                self.add(f"{path}.{key}", "required field is missing",
+                         f"add {key} = <number in {unit}>")
+            return None
+        if isinstance(v, dict):
+            n, vals = v.get("speed_rpm"), v.get("value")
+            ok = (isinstance(n, list) and isinstance(vals, list) and len(n) == len(vals) >= 1
+                  and all(isinstance(x, int | float) and not isinstance(x, bool)
+                          for x in [*n, *vals]))
+            if not ok:
+                self.add(f"{path}.{key}", "a speed table needs lists speed_rpm and value of "
+                         "equal length", f"write {key} = {{speed_rpm = [0, 4300], value = [10, 60]}}")
+                return None
+            if any(b <= a for a, b in zip(n, n[1:], strict=False)):
+                self.add(f"{path}.{key}.speed_rpm", "must increase", "sort the table by speed")
+                return None
+            if min(vals) < 0:
+                self.add(f"{path}.{key}.value", f"negative {unit} is not physical",
+                         "give values >= 0")
+                return None
+            return SpeedTable(tuple(float(x) for x in n), tuple(float(x) for x in vals))
+        num = self.number(data, key, path, unit, lo=0.0)
+        return None if num is None else SpeedTable.constant(num)
+
+    def power(self, data: dict, path: str) -> TimeSeries | None:
+        """A constant power [W] or {time_s = [...], value = [...]} (linear in time)."""
+        v = data.get("power_W")
+        if isinstance(v, dict):
+            t, vals = v.get("time_s"), v.get("value")
+            ok = (isinstance(t, list) and isinstance(vals, list) and len(t) == len(vals) >= 1
+                  and all(isinstance(x, int | float) and not isinstance(x, bool)
+                          for x in [*t, *vals]))
+            if not ok or any(b <= a for a, b in zip(t or [], (t or [])[1:], strict=False)):
+                self.add(f"{path}.power_W", "a power series needs increasing time_s and value "
+                         "lists of equal length",
+                         "write power_W = {time_s = [0, 3600], value = [40, 60]}")
+                return None
+            return TimeSeries(tuple(map(float, t)), tuple(map(float, vals)))
+        num = self.number(data, "power_W", path, "W")
+        return None if num is None else TimeSeries.constant(num)
+
+
+def _read_material(r: _Reader, name: str, d: dict, path: str) -> Material | None:
+    n0 = len(r.problems)
+    if "k_W_mK" in d:
+        kr = kz = r.number(d, "k_W_mK", path, "W/m/K", lo=0.0, lo_open=True)
+    else:
+        kr = r.number(d, "k_r_W_mK", path, "W/m/K", lo=0.0, lo_open=True)
+        kz = r.number(d, "k_z_W_mK", path, "W/m/K", lo=0.0, lo_open=True)
+    rho = r.number(d, "rho_kg_m3", path, "kg/m3", lo=0.0, lo_open=True)
+    c = r.number(d, "c_J_kgK", path, "J/kg/K", lo=0.0, lo_open=True)
+    E = r.number(d, "E_Pa", path, "Pa", lo=0.0, lo_open=True)
+    nu = r.number(d, "nu", path, "-", lo=-1.0, lo_open=True, hi=0.4999)
+    alpha = r.number(d, "alpha_1_K", path, "1/K", lo=0.0)
+    if len(r.problems) > n0:
+        return None
+    return Material(name, kr, kz, rho, c, E, nu, alpha, str(d.get("source", "")))
+
+
+def shipped_materials() -> dict[str, Material]:
+    """The shipped material table (spindle/data/materials.toml), each with its source."""
+    text = resources.files("spindle").joinpath("data/materials.toml").read_text("utf-8")
+    r = _Reader("spindle/data/materials.toml")
+    out = {}
+    for name, d in tomllib.loads(text).items():
+        m = _read_material(r, name, d, f"{name}")
+        if m is not None:
+            out[name] = m
+    if r.problems:  # a broken shipped table is a bug, but say where
+        raise SpecError(r.problems)
+    return out
+
+
+def shipped_specs() -> dict[str, Path]:
+    """Shipped specs by name (``spindle-verify specs`` lists them)."""
+    root = resources.files("spindle").joinpath("data/specs")
+    return {Path(str(p)).stem: Path(str(p)) for p in root.iterdir() if str(p).endswith(".toml")}
+
+
+def resolve_spec_path(name_or_path: str | Path) -> Path:
+    """A path to a TOML file, or the name of a shipped spec."""
+    p = Path(name_or_path)
+    if p.is_file():
+        return p
+    shipped = shipped_specs()
+    if str(name_or_path) in shipped:
+        return shipped[str(name_or_path)]
+    raise SpecError([Problem(str(name_or_path), "file", "is neither a file nor a shipped spec",
+                             f"give a path to a .toml spec or one of: {', '.join(sorted(shipped))}")])
+
+
+def load_spec(name_or_path: str | Path) -> Spec:
+    """Read and validate a spec (a file path or a shipped name). Raises SpecError."""
+    path = resolve_spec_path(name_or_path)
+    file = str(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError([Problem(file, "syntax", str(exc), "fix the TOML syntax at that line")]) \
+            from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SpecError([Problem(file, "file", f"cannot be read ({exc})",
+                                 "check the path and that the file is UTF-8 text")]) from None
+    return _build(_Reader(file), data)
+
+
+def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass over the schema
+    head = r.table(data, "spindle", "") or {}
+    name = r.string(head, "name", "spindle") or "?"
+    op = r.table(data, "operating", "") or {}
+    speed = r.number(op, "speed_rpm", "operating", "rpm", required=False, default=0.0, lo=0.0, hi=1e5)
+    T_amb = r.number(op, "T_ambient_K", "operating", "K", lo=150.0, hi=500.0)
+    T_cool = r.number(op, "T_coolant_K", "operating", "K", required=False, default=T_amb, lo=150.0, hi=500.0)
+    T_init = r.number(op, "T_initial_K", "operating", "K", required=False, default=T_amb, lo=150.0, hi=500.0)
+    mesh = r.table(data, "mesh", "", required=False) or {}
+    h0 = r.number(mesh, "h0_m", "mesh", "m", required=False, default=0.01, lo=0.0, lo_open=True)
+
+    materials = dict(shipped_materials())
+    for mname, md in (r.table(data, "materials", "", required=False) or {}).items():
+        if not isinstance(md, dict):
+            r.add(f"materials.{mname}", "must be a table", f"write it as [materials.{mname}]")
+            continue
+        m = _read_material(r, mname, md, f"materials.{mname}")
+        if m is not None:
+            materials[mname] = m
+
+    # parts and sections
+    parts: list[Part] = []
+    for i, pd in enumerate(r.array(data, "parts", "")):
+        path = f"parts[{i}]"
+        pname = r.string(pd, "name", path)
+        role = r.string(pd, "role", path, choices=ROLES)
+        pmat = pd.get("material")
+        if pname is not None and any(p.name == pname for p in parts):
+            r.add(f"{path}.name", f"part '{pname}' is defined twice", "give each part its own name")
+        secs = pd.get("sections")
+        if not isinstance(secs, list) or not secs or not all(isinstance(s, dict) for s in secs):
+            r.add(f"{path}.sections", "required list of sections is missing or empty",
+                  "add sections = [{z_start = 0.0, z_end = 0.1, r_inner = 0.0, r_outer = 0.04}]")
+            secs = []
+        sections = []
+        for j, sd in enumerate(secs):
+            sp = f"{path}.sections[{j}]"
+            z0 = r.number(sd, "z_start", sp, "m")
+            z1 = r.number(sd, "z_end", sp, "m")
+            ri = r.radius(sd, "r_inner", sp)
+            ro = r.radius(sd, "r_outer", sp)
+            mat = sd.get("material", pmat)
+            if mat is None:
+                r.add(f"{sp}.material", "no material for this section or its part",
+                      f"add material = \"...\" to {path} (one of: {', '.join(sorted(materials))})")
+            elif mat not in materials:
+                r.add(f"{sp}.material" if "material" in sd else f"{path}.material",
+                      f"unknown material '{mat}'",
+                      f"use one of: {', '.join(sorted(materials))}, or define [materials.{mat}]")
+                mat = None
+            if None in (z0, z1, ri, ro, mat):
+                continue
+            if z1 - z0 <= TOL_M:
+                r.add(f"{sp}.z_end", f"z_end = {z1:g} m is not after z_start = {z0:g} m",
+                      "give z_end > z_start (z grows from the rear towards the tool)")
+                continue
+            if ri[0] >= ro[0] - TOL_M or ri[1] >= ro[1] - TOL_M:
+                r.add(f"{sp}.r_inner", f"r_inner {list(ri)} m is not below r_outer {list(ro)} m",
+                      "give r_inner < r_outer at both ends (r_inner = 0 for a solid section)")
+                continue
+            sections.append(Section(z0, z1, ri, ro, material=mat, name=str(sd.get("name", ""))))
+        if pname is not None and role is not None and sections:
+            parts.append(Part(pname, role, tuple(sections)))
+    part_names = {p.name for p in parts}
+
+    # links
+    links: list[Link] = []
+    for i, ld in enumerate(r.array(data, "links", "", required=False)):
+        path = f"links[{i}]"
+        kind = r.string(ld, "type", path, choices=LINK_TYPES)
+        if kind == "bearing":
+            pn = r.string(ld, "part", path)
+            sn = r.string(ld, "section", path)
+            G = r.speed_table(ld, "G_W_K", path, "W/K")
+            if pn is not None and pn not in part_names:
+                r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+            elif pn is not None and sn is not None and not any(
+                    s.name == sn for s in next(p for p in parts if p.name == pn).sections):
+                r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
+                      f"add name = \"{sn}\" to the rolling-element section of part '{pn}'")
+            elif G is not None and G.min <= 0:
+                r.add(f"{path}.G_W_K", "a bearing conductance must be > 0 W/K",
+                      "give G_W_K > 0 (typ. 5-50 W/K per bearing pair)")
+            elif None not in (pn, sn, G):
+                links.append(BearingLink(pn, sn, G))
+        elif kind == "air_gap":
+            a = r.string(ld, "inner", path)
+            b = r.string(ld, "outer", path)
+            h = r.speed_table(ld, "h_W_m2K", path, "W/m2/K")
+            for key, v in (("inner", a), ("outer", b)):
+                if v is not None and v not in part_names:
+                    r.add(f"{path}.{key}", f"unknown part '{v}'", f"use one of: {sorted(part_names)}")
+            if h is not None and h.min <= 0:
+                r.add(f"{path}.h_W_m2K", "an air-gap coefficient must be > 0 W/m2/K",
+                      "give h_W_m2K > 0")
+            elif a in part_names and b in part_names and h is not None:
+                links.append(AirGapLink(a, b, h))
+        elif kind == "contact":
+            pl = ld.get("parts")
+            h = r.number(ld, "h_W_m2K", path, "W/m2/K", lo=0.0, lo_open=True)
+            if not (isinstance(pl, list) and len(pl) == 2 and all(isinstance(x, str) for x in pl)):
+                r.add(f"{path}.parts", "must name two parts", "write parts = [\"shaft\", \"rotor\"]")
+            elif any(x not in part_names for x in pl):
+                bad = next(x for x in pl if x not in part_names)
+                r.add(f"{path}.parts", f"unknown part '{bad}'", f"use one of: {sorted(part_names)}")
+            elif h is not None:
+                links.append(ContactLink((pl[0], pl[1]), h))
+
+    # surfaces
+    surfaces: list[Surface] = []
+    for i, sd in enumerate(r.array(data, "surfaces", "", required=False)):
+        path = f"surfaces[{i}]"
+        sname = r.string(sd, "name", path)
+        pl = sd.get("parts", sd.get("part"))
+        pl = [pl] if isinstance(pl, str) else pl
+        if not (isinstance(pl, list) and pl and all(isinstance(x, str) for x in pl)):
+            r.add(f"{path}.parts", "must name one or more parts", "write parts = [\"housing\"]")
+            pl = []
+        for x in pl:
+            if x not in part_names:
+                r.add(f"{path}.parts", f"unknown part '{x}'", f"use one of: {sorted(part_names)}")
+        side = r.string(sd, "side", path, required=False, choices=SIDES, default="any")
+        zmin = r.number(sd, "z_min", path, "m", required=False, default=-np.inf)
+        zmax = r.number(sd, "z_max", path, "m", required=False, default=np.inf)
+        h = r.speed_table(sd, "h_W_m2K", path, "W/m2/K", required=False)
+        tref = r.string(sd, "T_ref", path, required=h is not None, choices=T_REFS)
+        if sname is not None and any(s.name == sname for s in surfaces):
+            r.add(f"{path}.name", f"surface '{sname}' is defined twice", "give each its own name")
+        elif sname is not None and all(x in part_names for x in pl) and pl:
+            surfaces.append(Surface(sname, tuple(pl), side, zmin, zmax, h, tref))
+    surface_names = {s.name for s in surfaces}
+
+    # heat sources
+    sources: list[HeatSource] = []
+    for i, hd in enumerate(r.array(data, "heat_sources", "", required=False)):
+        path = f"heat_sources[{i}]"
+        hname = r.string(hd, "name", path)
+        pw = r.power(hd, path)
+        pn, sn, surf = hd.get("part"), hd.get("section"), hd.get("surface")
+        if (pn is None) == (surf is None):
+            r.add(path, "a heat source goes into either a part or a surface",
+                  "give exactly one of part = \"...\" or surface = \"...\"")
+            continue
+        if pn is not None and pn not in part_names:
+            r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+            continue
+        if sn is not None and not any(s.name == sn for s in
+                                      next(p for p in parts if p.name == pn).sections):
+            r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
+                  f"name one of its sections '{sn}' or drop the section field")
+            continue
+        if surf is not None and surf not in surface_names:
+            r.add(f"{path}.surface", f"unknown surface '{surf}'",
+                  f"define it under [[surfaces]] (known: {sorted(surface_names)})")
+            continue
+        if hname is not None and any(h.name == hname for h in sources):
+            r.add(f"{path}.name", f"heat source '{hname}' is defined twice",
+                  "give each its own name")
+            continue
+        if hname is not None and pw is not None:
+            sources.append(HeatSource(hname, pw, pn, sn, surf))
+
+    # sensors
+    sensors: list[Sensor] = []
+    for i, sd in enumerate(r.array(data, "sensors", "", required=False)):
+        path = f"sensors[{i}]"
+        sname = r.string(sd, "name", path)
+        kind = r.string(sd, "kind", path, required=False, default="temperature",
+                        choices=("temperature", "axial_displacement"))
+        z = r.number(sd, "z", path, "m")
+        rr = r.number(sd, "r", path, "m", lo=0.0)
+        zr = rr_ref = None
+        if kind == "axial_displacement":
+            zr = r.number(sd, "z_ref", path, "m")
+            rr_ref = r.number(sd, "r_ref", path, "m", lo=0.0)
+        if None in (sname, z, rr) or (kind == "axial_displacement" and None in (zr, rr_ref)):
+            continue
+        sensors.append(Sensor(sname, kind, z, rr, zr, rr_ref))
+    arrays: list[SensorArray] = []
+    for i, ad in enumerate(r.array(data, "sensor_arrays", "", required=False)):
+        path = f"sensor_arrays[{i}]"
+        aname = r.string(ad, "name", path)
+        pn = r.string(ad, "part", path)
+        cnt = ad.get("count", 11)
+        rad = ad.get("radius", "mid")
+        if not isinstance(cnt, int) or isinstance(cnt, bool) or cnt < 2:
+            r.add(f"{path}.count", f"must be an integer >= 2, not {cnt!r}", "write count = 11")
+            continue
+        if not (rad in ("mid", "inner", "outer") or (isinstance(rad, int | float)
+                                                      and not isinstance(rad, bool))):
+            r.add(f"{path}.radius", f"{rad!r} is not a radius", "write \"mid\", \"inner\", "
+                  "\"outer\" or a radius in m")
+            continue
+        if pn is not None and pn not in part_names:
+            r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+            continue
+        if aname is not None and pn is not None:
+            arrays.append(SensorArray(aname, pn, cnt, rad))
+            sensors.extend(_array_sensors(arrays[-1], next(p for p in parts if p.name == pn)))
+    seen: set[str] = set()
+    for s in sensors:
+        if s.name in seen:
+            r.add(f"sensors.{s.name}", "sensor name is used twice", "give each sensor its own name")
+        seen.add(s.name)
+
+    if not r.problems:
+        _check_geometry(r, parts, links, surfaces, sensors)
+    if r.problems:
+        raise SpecError(r.problems)
+    return Spec(
+        name=name, path=r.file, description=str(head.get("description", "")),
+        source=str(head.get("source", "")), speed_rpm=speed, T_ambient_K=T_amb,
+        T_coolant_K=T_cool, T_initial_K=T_init, h0_m=h0,
+        materials={m: materials[m] for m in {s.material for p in parts for s in p.sections}},
+        parts=tuple(parts), links=tuple(links), surfaces=tuple(surfaces),
+        heat_sources=tuple(sources), sensors=tuple(sensors), sensor_arrays=tuple(arrays))
+
+
+def _array_sensors(arr: SensorArray, part: Part) -> list[Sensor]:
+    z0 = min(s.z_start for s in part.sections)
+    z1 = max(s.z_end for s in part.sections)
+    out = []
+    for i, z in enumerate(np.linspace(z0, z1, arr.count)):
+        sec = next((s for s in part.sections if s.z_start - TOL_M <= z <= s.z_end + TOL_M
+                    and s.z_start < z1), part.sections[0])
+        # at a joint between sections prefer the one the point is strictly inside of
+        inside = [s for s in part.sections if s.z_start < z < s.z_end]
+        sec = inside[0] if inside else sec
+        zc = min(max(z, sec.z_start), sec.z_end)
+        ri, ro = float(sec.r_in(zc)), float(sec.r_out(zc))
+        rad = {"mid": 0.5 * (ri + ro), "inner": ri, "outer": ro}.get(arr.radius, arr.radius)
+        out.append(Sensor(f"{arr.name}_{i:02d}", "temperature", float(z), float(rad),
+                          array=arr.name))
+    return out
+
+
+def _check_geometry(r: _Reader, parts: list[Part], links: list[Link],
+                    surfaces: list[Surface], sensors: list[Sensor]) -> None:
+    """Overlaps, gaps where a link is required, sensors outside, and heat paths."""
+    secs = [(p, j, s) for p in parts for j, s in enumerate(p.sections)]
+    touching: dict[str, set[str]] = {p.name: set() for p in parts}
+    for a in range(len(secs)):
+        pa, ja, sa = secs[a]
+        for b in range(a + 1, len(secs)):
+            pb, jb, sb = secs[b]
+            if overlap(sa, sb):
+                r.add(f"parts[{parts.index(pb)}].sections[{jb}]",
+                      f"part '{pb.name}' overlaps part '{pa.name}' (section {ja}) "
+                      f"near z = {max(sa.z_start, sb.z_start):.4g} m",
+                      "change the radii or z limits so the sections only touch")
+            elif pa.name != pb.name and contact_length(sa, sb) > 0:
+                touching[pa.name].add(pb.name)
+                touching[pb.name].add(pa.name)
+    if r.problems:
+        return
+    joined = {k: set(v) for k, v in touching.items()}
+    roles = {p.name: p.role for p in parts}
+    for i, link in enumerate(links):
+        if isinstance(link, AirGapLink):
+            gaps = [float(so.r_in(z) - si.r_out(z))
+                    for si in next(p for p in parts if p.name == link.inner).sections
+                    for so in next(p for p in parts if p.name == link.outer).sections
+                    for z in (max(si.z_start, so.z_start), min(si.z_end, so.z_end))
+                    if min(si.z_end, so.z_end) - max(si.z_start, so.z_start) > TOL_M]
+            if not gaps:
+                r.add(f"links[{i}]", f"'{link.inner}' and '{link.outer}' do not face each "
+                      "other over any axial length", "make their z ranges overlap")
+            elif min(gaps) <= TOL_M or max(gaps) > MAX_AIR_GAP_M:
+                r.add(f"links[{i}]", f"the gap between '{link.inner}' and '{link.outer}' is "
+                      f"{min(gaps) * 1e3:.3g}..{max(gaps) * 1e3:.3g} mm",
+                      f"give the outer part's r_inner above the inner part's r_outer by "
+                      f"0 < gap <= {MAX_AIR_GAP_M * 1e3:g} mm")
+            else:
+                joined[link.inner].add(link.outer)
+                joined[link.outer].add(link.inner)
+        elif isinstance(link, ContactLink):
+            a, b = link.parts
+            if b not in touching[a]:
+                r.add(f"links[{i}].parts", f"'{a}' and '{b}' do not touch",
+                      "a contact link needs parts that share a boundary: fix the radii")
+    for p in parts:
+        if len(parts) > 1 and not joined[p.name]:
+            r.add(f"parts[{parts.index(p)}]", f"part '{p.name}' is separated from every other "
+                  "part by a gap", "close the gap in its sections or add a [[links]] entry "
+                  "(air_gap) that bridges it")
+        if p.role in BEARING_ROLES:
+            others = {roles[q] for q in touching[p.name]}
+            if not others & {"shaft", "rotor"} or not others & {"housing", "cooling_sleeve"}:
+                r.add(f"parts[{parts.index(p)}]", f"bearing '{p.name}' must touch the shaft "
+                      "(inner ring) and the housing (outer ring)",
+                      "set its r_inner to the shaft seat radius and r_outer to the housing bore")
+    has_rotor = [p.name for p in parts if p.role == "rotor"]
+    has_stator = [p.name for p in parts if p.role == "stator"]
+    if has_rotor and has_stator and not any(isinstance(x, AirGapLink) for x in links):
+        r.add("links", f"rotor '{has_rotor[0]}' and stator '{has_stator[0]}' have no air-gap "
+              "link", "add [[links]] type = \"air_gap\" with inner/outer and h_W_m2K")
+    for s in sensors:
+        pts = [(s.z, s.r)] + ([(s.z_ref, s.r_ref)] if s.kind == "axial_displacement" else [])
+        for z, rr in pts:
+            if not any(sec.contains(z, rr) for _, _, sec in secs):
+                r.add(f"sensors.{s.name}", f"point (z = {z:g} m, r = {rr:g} m) is outside every "
+                      "part", "move it into a part's section (z along the axis, r radius)")
+    if r.problems:
+        return
+    # every group of joined parts needs a path to a fixed temperature
+    anchored = {x for s in surfaces if s.h_W_m2K is not None and s.h_W_m2K.max > 0
+                for x in s.parts}
+    seen: set[str] = set()
+    for p in parts:
+        if p.name in seen:
+            continue
+        group, stack = set(), [p.name]
+        while stack:
+            q = stack.pop()
+            if q not in group:
+                group.add(q)
+                stack.extend(joined[q] - group)
+        seen |= group
+        if not group & anchored:
+            r.add("surfaces", f"parts {sorted(group)} have no heat path to a fixed temperature "
+                  "(the problem would be singular)", "add a [[surfaces]] entry with h_W_m2K > 0 "
+                  "and T_ref = \"ambient\" or \"coolant\" on one of them")

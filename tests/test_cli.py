@@ -1,0 +1,108 @@
+"""The command line: outputs, messages and exit status 2 for bad input."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from compare.cli import main
+
+
+def run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "compare", *args], capture_output=True,
+                          text=True, timeout=300)
+
+
+def test_help():
+    r = run("--help")
+    assert r.returncode == 0 and "solve" in r.stdout and "mesh" in r.stdout
+
+
+def test_specs_lists_shipped(capsys):
+    assert main(["specs"]) == 0
+    out = capsys.readouterr().out
+    assert "spl2782" in out and "fin-shaft" in out
+
+
+def test_mesh_command(tmp_path, capsys):
+    assert main(["mesh", "fin-shaft", "--level", "1", "--out", str(tmp_path / "m")]) == 0
+    info = json.loads((tmp_path / "m" / "mesh.json").read_text())
+    assert [row["level"] for row in info["levels"]] == [0, 1]
+    assert (tmp_path / "m" / "mesh_level1.png").exists()
+    assert (tmp_path / "m" / "mesh_level1.vtu").exists()
+
+
+def test_solve_steady_writes_everything(tmp_path, capsys):
+    out = tmp_path / "s"
+    assert main(["solve", "spl2782", "--level", "0", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "T1" in text and "relative imbalance" in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["energy"]["relative_imbalance"] < 1e-10
+    assert summary["relative_residual"] <= 1e-8
+    for f in ("sensors.csv", "temperature.vtu", "temperature_section.png",
+              "temperature_3d.png", "sensor_profile.png"):
+        assert (out / f).stat().st_size > 0
+    assert not list(tmp_path.glob(".*tmp*"))
+
+
+def test_solve_cycle(tmp_path, capsys):
+    cycle = tmp_path / "c.csv"
+    cycle.write_text("# warm-up and stop\ntime_s,speed_rpm,T_env_C,stator_W\n"
+                     "0,4300,20,2000\n3600,0,21,0\n7200,0,21,0\n")
+    out = tmp_path / "t"
+    assert main(["solve", "spl2782", "--level", "0", "--cycle", str(cycle), "--dt", "600",
+                 "--out", str(out), "--quiet"]) == 0
+    assert (out / "temperature.pvd").exists()
+    rows = (out / "sensors_timeseries.csv").read_text().splitlines()
+    assert rows[0].startswith("time_s,T1_C")
+    assert len(rows) == 1 + 13
+    assert "peak_C" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("content, words", [
+    ("time_s,speed_rpm\n0,100\n0,200\n", "time does not increase"),
+    ("time_s,speed_rpm\n0,abc\n10,1\n", "'abc' is not a number"),
+    ("speed_rpm\n0\n", "time_s: required column is missing"),
+    ("time_s,torque_Nm\n0,1\n10,1\n", "torque_Nm: is not a cycle column"),
+    ("time_s,T_env_C\n0,293\n10,293\n", "outside -60..200 degC"),
+])
+def test_bad_cycle_exits_2(tmp_path, content, words):
+    cycle = tmp_path / "bad.csv"
+    cycle.write_text(content)
+    r = run("solve", "fin-shaft", "--level", "0", "--cycle", str(cycle), "--out",
+            str(tmp_path / "o"))
+    assert r.returncode == 2
+    assert words in r.stderr and "Traceback" not in r.stderr
+    assert "bad.csv" in r.stderr and "fix:" in r.stderr
+    assert not (tmp_path / "o").exists()
+
+
+def test_bad_spec_exits_2_without_output(tmp_path):
+    spec = tmp_path / "broken.toml"
+    spec.write_text('[spindle]\nname = "x"\n[operating]\nT_ambient_K = 293.15\n'
+                    '[[parts]]\nname = "s"\nrole = "shaft"\nmaterial = "steel_42CrMo4"\n'
+                    'sections = [{ z_start = 0.0, z_end = 0.1, r_inner = 0.05, r_outer = 0.04 }]\n')
+    r = run("solve", str(spec), "--out", str(tmp_path / "o"))
+    assert r.returncode == 2
+    assert "broken.toml: parts[0].sections[0].r_inner" in r.stderr
+    assert "Traceback" not in r.stderr
+    assert not (tmp_path / "o").exists()
+
+
+def test_bad_option_exits_2(tmp_path):
+    r = run("solve", "fin-shaft", "--level", "9", "--out", str(tmp_path / "o"))
+    assert r.returncode == 2 and "--level" in r.stderr
+
+
+def test_output_never_overwrites_input(tmp_path):
+    spec = tmp_path / "sensors.csv"  # an input named like an output
+    from spindle.spec import load_spec
+
+    spec.write_text(open(load_spec("fin-shaft").path).read())
+    before = spec.read_text()
+    # a .csv spec is still TOML; the output folder is the spec's own folder
+    r = run("solve", str(spec), "--level", "0", "--out", str(tmp_path), "--no-pictures")
+    assert r.returncode == 2 and "overwrite" in r.stderr
+    assert spec.read_text() == before

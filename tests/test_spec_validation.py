@@ -1,0 +1,146 @@
+"""Bad specs: one clear problem per fault, naming the file, the field and the fix."""
+
+import pytest
+
+from spindle.errors import SpecError
+from spindle.spec import load_spec, shipped_specs
+from tests.conftest import write_spec
+
+GOOD = """
+[[parts]]
+name = "shaft"
+role = "shaft"
+material = "mat_a"
+sections = [{ z_start = 0.0, z_end = 0.2, r_inner = 0.0, r_outer = 0.02 }]
+
+[[parts]]
+name = "sleeve"
+role = "housing"
+material = "mat_b"
+sections = [{ z_start = 0.05, z_end = 0.15, r_inner = 0.02, r_outer = 0.04 }]
+
+[[surfaces]]
+name = "out"
+parts = ["sleeve"]
+side = "outer"
+h_W_m2K = 10.0
+T_ref = "ambient"
+
+[[sensors]]
+name = "T1"
+z = 0.1
+r = 0.03
+"""
+
+
+def problems(tmp_path, body: str) -> list:
+    with pytest.raises(SpecError) as exc:
+        load_spec(write_spec(tmp_path, body))
+    for p in exc.value.problems:
+        assert p.file.endswith("case.toml") and p.field and p.message and p.fix
+    return exc.value.problems
+
+
+def test_good_spec_loads(tmp_path):
+    spec = load_spec(write_spec(tmp_path, GOOD))
+    assert [p.name for p in spec.parts] == ["shaft", "sleeve"]
+
+
+@pytest.mark.parametrize("old, new, field, words", [
+    ("r_outer = 0.04", "r_outer = 0.045 }, { z_start = 0.1, z_end = 0.12, r_inner = 0.0, "
+     "r_outer = 0.03", "parts[1].sections[1]", "overlaps"),
+    ("r_inner = 0.02, r_outer = 0.04", "r_inner = 0.025, r_outer = 0.04", "parts[1]",
+     "separated from every other part by a gap"),
+    ("r_inner = 0.0, r_outer = 0.02", "r_inner = 0.02, r_outer = 0.02",
+     "parts[0].sections[0].r_inner", "not below r_outer"),
+    ('material = "mat_a"', 'material = "unobtainium"', "parts[0].material", "unknown material"),
+    ('role = "shaft"', 'role = "spoke"', "parts[0].role", "not one of"),
+    ("r = 0.03", "r = 0.09", "sensors.T1", "outside every part"),
+    ("z_end = 0.2,", "", "parts[0].sections[0].z_end", "required field is missing"),
+    ("h_W_m2K = 10.0", "h_W_m2K = 0.0", "surfaces", "no heat path"),
+    ('T_ref = "ambient"', "", "surfaces[0].T_ref", "required field is missing"),
+    ("z_end = 0.2", "z_end = -0.2", "parts[0].sections[0].z_end", "not after z_start"),
+])
+def test_each_fault_is_named(tmp_path, old, new, field, words):
+    assert old in GOOD
+    found = problems(tmp_path, GOOD.replace(old, new, 1))
+    assert any(p.field == field and words in p.message for p in found), found
+
+
+def test_negative_conductivity_and_zero_heat_capacity(tmp_path):
+    bad = GOOD + """
+[materials.weird]
+k_W_mK = -1.0
+rho_kg_m3 = 1000.0
+c_J_kgK = 0.0
+E_Pa = 1e9
+nu = 0.3
+alpha_1_K = 1e-5
+"""
+    found = problems(tmp_path, bad)
+    fields = {p.field for p in found}
+    assert {"materials.weird.k_W_mK", "materials.weird.c_J_kgK"} <= fields
+    assert all("not physical" in p.message for p in found)
+
+
+def test_isolated_group_without_fixed_temperature(tmp_path):
+    """Two parts that touch each other but not the rest, and have no film: singular."""
+    body = GOOD + """
+[[parts]]
+name = "island"
+role = "tool"
+material = "mat_a"
+sections = [{ z_start = 0.3, z_end = 0.4, r_inner = 0.0, r_outer = 0.02 }]
+"""
+    found = problems(tmp_path, body)
+    assert any("separated from every other part" in p.message for p in found)
+
+
+def test_rotor_and_stator_need_an_air_gap_link(tmp_path):
+    body = """
+[[parts]]
+name = "rotor"
+role = "rotor"
+material = "mat_a"
+sections = [{ z_start = 0.0, z_end = 0.1, r_inner = 0.0, r_outer = 0.02 }]
+
+[[parts]]
+name = "stator"
+role = "stator"
+material = "mat_b"
+sections = [{ z_start = 0.0, z_end = 0.1, r_inner = 0.0205, r_outer = 0.04 }]
+
+[[surfaces]]
+name = "out"
+parts = ["stator", "rotor"]
+side = "outer"
+h_W_m2K = 10.0
+T_ref = "ambient"
+"""
+    found = problems(tmp_path, body)
+    assert any(p.field == "links" and "air-gap" in p.message for p in found)
+    ok = body + '\n[[links]]\ntype = "air_gap"\ninner = "rotor"\nouter = "stator"\nh_W_m2K = 50.0\n'
+    spec = load_spec(write_spec(tmp_path, ok, "ok"))
+    assert spec.links[0].h_W_m2K(0) == 50.0
+
+
+def test_toml_syntax_error(tmp_path):
+    found = problems(tmp_path, GOOD + "\n[[parts]\n")
+    assert found[0].field == "syntax"
+
+
+def test_all_problems_reported_at_once(tmp_path):
+    bad = GOOD.replace('material = "mat_a"', 'material = "nope"').replace(
+        'role = "housing"', 'role = "hat"')
+    assert len(problems(tmp_path, bad)) >= 2
+
+
+def test_unknown_spec_name():
+    with pytest.raises(SpecError, match="neither a file nor a shipped spec"):
+        load_spec("no-such-spindle")
+
+
+def test_shipped_specs_load():
+    assert {"spl2782", "fin-shaft"} <= set(shipped_specs())
+    for path in shipped_specs().values():
+        load_spec(path)
