@@ -246,6 +246,9 @@ def build_mesh(spec: Spec, level: int = 0) -> SpindleMesh:
     element_region = np.tile(tags, 4 ** level)
     sm = SpindleMesh(spec, level, mesh, regions, element_region)
     _classify_facets(sm)
+    # the same names on the scikit-fem mesh, for users who assemble their own forms
+    sm.mesh = mesh.with_subdomains({n: sm.elements_of(n) for n in sm.part_names}) \
+        .with_boundaries(dict(sm.surfaces))
     return sm
 
 

@@ -95,15 +95,27 @@ def sensor_profile_png(table, path: Path, title: str = "") -> None:
 
 
 def timeseries_png(times_s: np.ndarray, names: list[str], values_C: np.ndarray, path: Path,
-                   title: str = "") -> None:
-    """Point sensors over time [h]; array sensors are drawn thin and grey."""
+                   title: str = "", arrays: dict[str, str] | None = None) -> None:
+    """Sensors over time [h]: point sensors bold, each array as a shaded family of lines
+    (``arrays`` maps sensor name to its array name)."""
+    from matplotlib import colormaps
+
     plt = _pyplot()
+    arrays = arrays or {}
     fig, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
+    families: dict[str, list[int]] = {}
     for j, n in enumerate(names):
-        if "_" in n and n.rsplit("_", 1)[1].isdigit():
-            ax.plot(times_s / 3600, values_C[:, j], color="0.8", lw=0.6)
+        if n in arrays:
+            families.setdefault(arrays[n], []).append(j)
         else:
-            ax.plot(times_s / 3600, values_C[:, j], lw=1.6, label=n)
+            ax.plot(times_s / 3600, values_C[:, j], lw=1.8, label=n)
+    for (fam, cols), cmap in zip(families.items(), ("Greys", "Blues", "Greens", "Oranges"),
+                                 strict=False):
+        shades = colormaps[cmap](np.linspace(0.35, 0.9, len(cols)))
+        for k, (j, color) in enumerate(zip(cols, shades, strict=True)):
+            ax.plot(times_s / 3600, values_C[:, j], color=color, lw=0.8,
+                    label=f"{fam} sensors ({names[cols[0]]} light .. {names[cols[-1]]} dark)"
+                    if k == len(cols) - 1 else None)
     ax.set_xlabel("time [h]")
     ax.set_ylabel("temperature [°C]")
     ax.set_title(title)

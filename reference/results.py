@@ -208,8 +208,9 @@ class TransientResult:
         files = ["summary.json", "sensors_timeseries.csv", "temperature.pvd"]
         if pictures:
             title = f"{self.model.spec.name}: {self.case.name}"
+            arrays = {s.name: s.array for s in self.model.spec.temperature_sensors() if s.array}
             plots.timeseries_png(self.times_s, self.names, self.sensor_K - KELVIN,
-                                 out / "sensors_timeseries.png", title)
+                                 out / "sensors_timeseries.png", title, arrays)
             plots.section_png(self.model, self.fields_K[-1], out / "temperature_section.png",
                               f"{title}, t = {self.field_times_s[-1] / 3600:.2f} h")
             plots.revolved_png(self.model, self.fields_K[-1], out / "temperature_3d.png", title)

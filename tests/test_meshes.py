@@ -91,3 +91,9 @@ def test_vtu_and_png(tmp_path):
     assert set(np.unique(grid.cell_data["part_id"])) == set(range(len(sm.part_names)))
     mesh_png(sm, tmp_path / "m.png")
     assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_names_on_the_skfem_mesh():
+    sm = build_mesh(load_spec("spl2782"), 1)
+    assert set(sm.mesh.subdomains) == set(sm.part_names)
+    np.testing.assert_array_equal(sm.mesh.boundaries["housing_outer"], sm.surfaces["housing_outer"])

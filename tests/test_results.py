@@ -1,0 +1,50 @@
+"""Result objects: tables, pictures and files, computed apart from plotting."""
+
+import json
+
+import numpy as np
+import pytest
+
+from meshes import build_mesh
+from reference import ThermalModel
+from spindle.loads import LoadCase, TimeSeries
+from spindle.spec import load_spec
+
+
+@pytest.fixture(scope="module")
+def fin_model():
+    return ThermalModel(build_mesh(load_spec("fin-shaft"), 0), 2)
+
+
+def test_steady_to_pandas_and_plot(fin_model):
+    pd = pytest.importorskip("pandas")
+    res = fin_model.solve_steady()
+    df = res.to_pandas()
+    assert isinstance(df, pd.DataFrame)
+    assert list(df.columns) == ["sensor", "array", "z_m", "r_m", "T_C", "rise_K"]
+    assert len(df) == 11
+    np.testing.assert_allclose(df["T_C"] + 273.15 - 293.15, df["rise_K"])
+    ax = res.plot()
+    assert ax.get_xlabel().startswith("z [mm]")
+
+
+def test_transient_to_pandas_and_save(fin_model, tmp_path):
+    pytest.importorskip("pandas")
+    case = LoadCase("ramp", TimeSeries.constant(0.0), TimeSeries.constant(293.15),
+                    TimeSeries.constant(293.15),
+                    {"Q2_front_bearing_B": TimeSeries((0.0, 3600.0), (0.0, 90.0))},
+                    duration_s=7200.0)
+    res = fin_model.solve_transient(case, 600.0, save_every=6)
+    df = res.to_pandas()
+    assert df["time_s"].iloc[-1] == 7200.0 and "shaft_10_C" in df
+    # heat enters at B (x = l): the sensor there warms first and most
+    assert df["shaft_10_C"].iloc[-1] > df["shaft_00_C"].iloc[-1] > 20.0
+    res.save(tmp_path)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["energy"]["relative_imbalance"] < 1e-10
+    pvd = (tmp_path / "temperature.pvd").read_text()
+    assert pvd.count("<DataSet") == len(res.field_times_s) == 3
+    import pyvista as pv
+
+    grid = pv.read(tmp_path / "fields" / "temperature_0002.vtu")
+    assert grid.point_data["T_C"].max() == pytest.approx(res.fields_K[-1].max() - 273.15)
