@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from spindle.errors import InputError, SpindleVerifyError
@@ -77,7 +79,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     t_asm = time.perf_counter() - t0
     case = spec.default_load_case()
     if args.speed is not None:
-        case = type(case)(**{**case.__dict__, "speed_rpm": TimeSeries.constant(args.speed)})
+        case = replace(case, speed_rpm=TimeSeries.constant(args.speed))
     inputs = [spec.path]
     quiet = args.quiet
     if args.cycle:
@@ -183,6 +185,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("spindle-verify: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into e.g. `head`, which closed early
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":

@@ -218,7 +218,7 @@ def _split_contacts(spec: Spec, regions: list[Region], p: np.ndarray, t: np.ndar
             continue
         remap = np.arange(n + len(shared))
         remap[shared] = n + np.arange(len(shared))
-        new_p.append(np.hstack(new_p)[:, shared] if len(new_p) > 1 else p[:, shared])
+        new_p.append(np.hstack(new_p)[:, shared])  # shared may include earlier copies
         t[:, in_b] = remap[t[:, in_b]]
         n += len(shared)
     return np.hstack(new_p)

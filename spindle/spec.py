@@ -628,11 +628,10 @@ def _array_sensors(arr: SensorArray, part: Part) -> list[Sensor]:
     z1 = max(s.z_end for s in part.sections)
     out = []
     for i, z in enumerate(np.linspace(z0, z1, arr.count)):
-        sec = next((s for s in part.sections if s.z_start - TOL_M <= z <= s.z_end + TOL_M
-                    and s.z_start < z1), part.sections[0])
-        # at a joint between sections prefer the one the point is strictly inside of
-        inside = [s for s in part.sections if s.z_start < z < s.z_end]
-        sec = inside[0] if inside else sec
+        # a point strictly inside a section takes that section; at a joint or an end, the
+        # first section that reaches it
+        sec = next((s for s in part.sections if s.z_start < z < s.z_end),
+                   next(s for s in part.sections if s.z_start - TOL_M <= z <= s.z_end + TOL_M))
         zc = min(max(z, sec.z_start), sec.z_end)
         ri, ro = float(sec.r_in(zc)), float(sec.r_out(zc))
         rad = {"mid": 0.5 * (ri + ro), "inner": ri, "outer": ro}.get(arr.radius, arr.radius)
