@@ -67,15 +67,16 @@ def _print_sensor_table(table: dict, title: str) -> None:
 
 def _cmd_solve(args: argparse.Namespace) -> int:
     from compare.progress import Progress
-    from meshes import build_mesh
-    from reference import ThermalModel
+    from reference import ReferenceModel
     from spindle.loads import TimeSeries, read_cycle_csv
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
     t0 = time.perf_counter()
-    model = ThermalModel(build_mesh(spec, args.level), args.order)
+    ref = ReferenceModel(spec, args.level, args.order, centrifugal=args.centrifugal,
+                         elastic=not args.thermal_only)
+    model = ref.thermal
     t_asm = time.perf_counter() - t0
     case = spec.default_load_case()
     if args.speed is not None:
@@ -85,11 +86,11 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     if args.cycle:
         case = read_cycle_csv(args.cycle, [h.name for h in spec.heat_sources], case)
         inputs.append(args.cycle)
-        result = model.solve_transient(case, args.dt, theta=args.theta,
-                                       save_every=max(1, int(round(args.save_every / args.dt))),
-                                       progress=Progress("transient", not quiet))
+        result = ref.transient(case, args.dt, theta=args.theta,
+                               save_every=max(1, int(round(args.save_every / args.dt))),
+                               progress=Progress("transient", not quiet))
     else:
-        result = model.solve_steady(case)
+        result = ref.steady(case)
     t_solve = time.perf_counter() - t0 - t_asm
     out = Path(args.out or f"results/{spec.name}")
     with output_dir(out, inputs=inputs) as tmp:
@@ -104,6 +105,9 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         print(f"  {'sensor':<16} {'peak_C':>9} {'final_C':>9}")
         for n in result.names:
             print(f"  {n:<16} {s['peak_C'][n]:9.3f} {s['final_C'][n]:9.3f}")
+        print(f"  {'growth':<16} {'peak_um':>9} {'final_um':>9}")
+        for n in result.growth_m:
+            print(f"  {n:<16} {s['peak_growth_um'][n]:9.3f} {s['final_growth_um'][n]:9.3f}")
         e = result.energy
         print(f"energy: in {e['energy_in_J'] / 3.6e6:.4f} kWh, out {e['energy_out_J'] / 3.6e6:.4f}"
               f" kWh, stored {e['energy_stored_J'] / 3.6e6:.4f} kWh, relative imbalance "
@@ -112,6 +116,9 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         _print_sensor_table(result.sensor_table(),
                             f"steady state at {result.speed_rpm:g} rpm, ambient "
                             f"{case.T_ambient_K(0) - KELVIN:.2f} degC:")
+        for n, v in result.growth_m.items():
+            print(f"  {n + '_um':<16} {v * 1e6:9.3f}  axial growth relative to the housing "
+                  "fixation below the front bearing")
         e = result.energy
         print(f"energy: in {e['heat_in_W']:.3f} W, out {e['heat_out_W']:.3f} W, relative "
               f"imbalance {e['relative_imbalance']:.1e}; relative residual {result.residual:.1e}")
@@ -137,7 +144,8 @@ def build_parser() -> argparse.ArgumentParser:
     mp.add_argument("--no-pictures", action="store_true", help="skip the PNG")
     mp.set_defaults(func=_cmd_mesh)
 
-    so = sub.add_parser("solve", help="FEM reference: steady state or a transient cycle")
+    so = sub.add_parser("solve", help="FEM reference: temperatures and axial growth (P1), steady "
+                        "or over a transient cycle")
     so.add_argument("spec", metavar="SPEC")
     so.add_argument("--level", type=int, default=2, help="mesh level (default 2)")
     so.add_argument("--order", type=int, choices=(1, 2), default=2,
@@ -153,6 +161,10 @@ def build_parser() -> argparse.ArgumentParser:
                     help="1 = backward Euler (default), 0.5 = Crank-Nicolson")
     so.add_argument("--save-every", type=float, default=1800.0,
                     help="keep a field for ParaView every this many seconds (default 1800)")
+    so.add_argument("--centrifugal", action="store_true",
+                    help="add the centrifugal load of the rotating parts (off by default)")
+    so.add_argument("--thermal-only", action="store_true",
+                    help="skip the thermoelastic growth (P1, TCP)")
     so.add_argument("--out", help="output folder (default results/<spec>)")
     so.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
     so.add_argument("--quiet", action="store_true", help="no progress on stderr")

@@ -29,6 +29,18 @@ def field_grid(model, T: np.ndarray, name: str = "T_C", offset: float = -273.15)
     return grid
 
 
+def add_displacement(grid, elastic, U: np.ndarray) -> None:
+    """Add point data u_z_um, u_r_um and the 3-D vector 'displacement' [m] to a field grid
+    made by :func:`field_grid` (the vector DOFs sit at the same places as the scalar ones)."""
+    uz, ur = U[elastic.iz], U[elastic.ir]
+    if elastic.thermal.order == 1:
+        n = elastic.smesh.mesh.nvertices
+        uz, ur = uz[:n], ur[:n]
+    grid.point_data["u_z_um"] = uz * 1e6
+    grid.point_data["u_r_um"] = ur * 1e6
+    grid.point_data["displacement"] = np.column_stack([uz, ur, np.zeros_like(uz)])
+
+
 def revolved(grid, angle_deg: float = -270.0, resolution: int = 90):
     """Sweep the half-section about the z axis: a cut-away solid showing the section.
 

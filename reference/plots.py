@@ -123,3 +123,59 @@ def timeseries_png(times_s: np.ndarray, names: list[str], values_C: np.ndarray, 
     ax.legend(fontsize=8)
     atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=130))
     plt.close(fig)
+
+
+def deformed_png(model, T: np.ndarray, elastic, U: np.ndarray, path: Path, title: str = "",
+                 growth_m: dict | None = None) -> None:
+    """Half-section deformed by the displacement, exaggerated so that the largest
+    displacement shows as 3 % of the spindle length; colour: axial displacement [µm]."""
+    import matplotlib.tri as mtri
+
+    from reference.fields import add_displacement
+
+    plt = _pyplot()
+    grid = field_grid(model, T)
+    add_displacement(grid, elastic, U)
+    tri = grid.cells.reshape(-1, 4)[:, 1:]
+    pts, d = grid.points[:, :2], grid.point_data["displacement"][:, :2]
+    length = np.ptp(pts[:, 0])
+    scale = 0.03 * length / max(np.abs(d).max(), 1e-30)
+    fig, ax = plt.subplots(figsize=(12, 4.2), layout="constrained")
+    ax.triplot(mtri.Triangulation(pts[:, 0] * 1e3, pts[:, 1] * 1e3, tri), color="0.85", lw=0.2)
+    moved = pts + scale * d
+    tc = ax.tripcolor(mtri.Triangulation(moved[:, 0] * 1e3, moved[:, 1] * 1e3, tri),
+                      grid.point_data["u_z_um"], shading="gouraud", cmap="coolwarm")
+    fig.colorbar(tc, ax=ax, label="axial displacement u_z [µm]", shrink=0.9)
+    text = ", ".join(f"{k} = {v * 1e6:.2f} µm" for k, v in (growth_m or {}).items())
+    ax.set_title(f"{title}\ndeformed x{scale:.0f} (grey: undeformed); {text}", fontsize=10)
+    ax.set_aspect("equal")
+    ax.set_xlabel("z [mm]")
+    ax.set_ylabel("r [mm]")
+    atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=130))
+    plt.close(fig)
+
+
+def growth_band_png(times_s: np.ndarray, T1_C: np.ndarray, P1_um: np.ndarray, path: Path,
+                    title: str = "", band_um: float = 1.5,
+                    measured: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+    """T1 and P1 over the cycle, P1 with the paper's ±1.5 µm tolerance band around the
+    prediction (paper Fig. 11-13); ``measured`` = (times_s, P1_um) adds a test run."""
+    plt = _pyplot()
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True, layout="constrained")
+    h = times_s / 3600
+    a1.plot(h, T1_C, color="tab:red", label="T1 prediction (front bearing outer ring)")
+    a1.set_ylabel("T1 [°C]")
+    a1.grid(alpha=0.3)
+    a1.legend(fontsize=8)
+    a1.set_title(title)
+    a2.fill_between(h, P1_um - band_um, P1_um + band_um, color="tab:blue", alpha=0.2,
+                    label=f"±{band_um:g} µm tolerance")
+    a2.plot(h, P1_um, color="tab:blue", ls="--", label="P1 prediction")
+    if measured is not None:
+        a2.plot(measured[0] / 3600, measured[1], color="black", lw=1, label="P1 test")
+    a2.set_xlabel("time [h]")
+    a2.set_ylabel("P1 axial growth [µm]")
+    a2.grid(alpha=0.3)
+    a2.legend(fontsize=8)
+    atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=130))
+    plt.close(fig)

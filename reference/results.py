@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +49,9 @@ class SteadyResult:
     heat_in_W: float
     heat_out_W: dict[str, float]
     residual: float  # ||K T - F|| / ||F||
+    growth_m: dict[str, float] = field(default_factory=dict)  # axial growth readings [m]
+    U: np.ndarray | None = None  # displacement DOFs [m] (thermoelastic runs)
+    elastic: object = None
 
     @property
     def sensors(self) -> dict[str, float]:
@@ -88,7 +91,8 @@ class SteadyResult:
                 "T_coolant_C": float(self.case.T_coolant_K(self.time_s)) - KELVIN,
                 "relative_residual": self.residual, "energy": self.energy,
                 "T_max_C": float(self.T.max() - KELVIN),
-                "sensors_C": dict(zip(table["sensor"], table["T_C"], strict=True))}
+                "sensors_C": dict(zip(table["sensor"], table["T_C"], strict=True)),
+                "growth_um": {k: v * 1e6 for k, v in self.growth_m.items()}}
 
     def plot(self, ax=None):
         from reference.plots import plot_section
@@ -103,7 +107,7 @@ class SteadyResult:
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         """JSON summary, sensor CSV, VTU field, PNG half-section and 3-D cut-away."""
         from reference import plots
-        from reference.fields import field_grid
+        from reference.fields import add_displacement, field_grid
 
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
@@ -111,8 +115,14 @@ class SteadyResult:
         _write_json(out / "summary.json", self.summary())
         _write_csv(out / "sensors.csv", list(table), zip(*table.values(), strict=True))
         grid = field_grid(self.model, self.T)
+        if self.U is not None:
+            add_displacement(grid, self.elastic, self.U)
         atomic_write(out / "temperature.vtu", lambda tmp: grid.save(str(tmp)))
         files = ["summary.json", "sensors.csv", "temperature.vtu"]
+        if self.U is not None and pictures:
+            plots.deformed_png(self.model, self.T, self.elastic, self.U,
+                               out / "deformation_section.png", self._title(), self.growth_m)
+            files.append("deformation_section.png")
         if pictures:
             plots.section_png(self.model, self.T, out / "temperature_section.png", self._title())
             plots.revolved_png(self.model, self.T, out / "temperature_3d.png", self._title())
@@ -138,6 +148,8 @@ class TransientResult:
     energy_in_J: float
     energy_out_J: float
     energy_stored_J: float
+    functionals: dict[str, np.ndarray] = field(default_factory=dict)
+    growth_m: dict[str, np.ndarray] = field(default_factory=dict)  # per reading, per time [m]
 
     @property
     def energy(self) -> dict[str, float]:
@@ -158,6 +170,8 @@ class TransientResult:
 
         df = pd.DataFrame(self.sensor_K - KELVIN, columns=[f"{n}_C" for n in self.names])
         df.insert(0, "time_s", self.times_s)
+        for k, v in self.growth_m.items():
+            df[f"{k}_um"] = v * 1e6
         return df
 
     def summary(self) -> dict:
@@ -168,7 +182,9 @@ class TransientResult:
                 "energy": self.energy,
                 "peak_C": dict(zip(self.names, peak.tolist(), strict=True)),
                 "final_C": dict(zip(self.names, (self.sensor_K[-1] - KELVIN).tolist(),
-                                    strict=True))}
+                                    strict=True)),
+                "peak_growth_um": {k: float(v.max() * 1e6) for k, v in self.growth_m.items()},
+                "final_growth_um": {k: float(v[-1] * 1e6) for k, v in self.growth_m.items()}}
 
     def plot(self, ax=None):
         import matplotlib
@@ -192,9 +208,12 @@ class TransientResult:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         _write_json(out / "summary.json", self.summary())
-        _write_csv(out / "sensors_timeseries.csv", ["time_s"] + [f"{n}_C" for n in self.names],
-                   ([t, *row] for t, row in zip(self.times_s, self.sensor_K - KELVIN,
-                                                strict=True)))
+        growth = np.array(list(self.growth_m.values())).T * 1e6 if self.growth_m else \
+            np.zeros((len(self.times_s), 0))
+        _write_csv(out / "sensors_timeseries.csv",
+                   ["time_s"] + [f"{n}_C" for n in self.names] + [f"{k}_um" for k in self.growth_m],
+                   ([t, *row, *g] for t, row, g in zip(self.times_s, self.sensor_K - KELVIN,
+                                                        growth, strict=True)))
         (out / "fields").mkdir(exist_ok=True)
         entries = []
         for i, (t, T) in enumerate(zip(self.field_times_s, self.fields_K, strict=True)):
@@ -215,4 +234,9 @@ class TransientResult:
                               f"{title}, t = {self.field_times_s[-1] / 3600:.2f} h")
             plots.revolved_png(self.model, self.fields_K[-1], out / "temperature_3d.png", title)
             files += ["sensors_timeseries.png", "temperature_section.png", "temperature_3d.png"]
+            if "P1" in self.growth_m and "T1" in self.names:
+                plots.growth_band_png(self.times_s, self.sensor("T1") - KELVIN,
+                                      self.growth_m["P1"] * 1e6, out / "T1_P1_tolerance.png",
+                                      title)
+                files.append("T1_P1_tolerance.png")
         return [out / f for f in files]

@@ -230,13 +230,16 @@ class ThermalModel:
 
     def solve_transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
                         T0: np.ndarray | float | None = None, save_every: int = 0,
-                        progress: Callable[[float], None] | None = None):
+                        progress: Callable[[float], None] | None = None,
+                        functionals: dict[str, np.ndarray] | None = None):
         """Theta-method time integration over ``case.duration_s`` [s].
 
         theta = 1 is backward Euler (first order), theta = 0.5 Crank-Nicolson (second order).
         Steps of ``dt_s`` land on every sample time of the inputs. ``T0`` is the initial
         field (K), a uniform temperature, or None for the spec's initial temperature.
         Fields are kept every ``save_every`` steps (0: first and last only).
+        ``functionals`` maps names to vectors g whose values g . T are recorded every step
+        (the thermoelastic sensors are such functionals).
         """
         from reference.results import TransientResult
 
@@ -260,6 +263,10 @@ class ThermalModel:
         P = self.probe_matrix(pts)
         sensors = np.empty((len(grid), len(names)))
         sensors[0] = P @ T
+        functionals = functionals or {}
+        G = np.array(list(functionals.values())) if functionals else np.zeros((0, N))
+        fvals = np.empty((len(grid), len(functionals)))
+        fvals[0] = G @ T
         fields_t, fields = [0.0], [T.copy()]
         n0 = float(case.speed_rpm(0.0))
         K0, F0 = op.K(n0), op.F(case, 0.0, n0)
@@ -290,6 +297,7 @@ class ThermalModel:
             E_out += dt * (theta * q_out1 + (1 - theta) * q_out0)
             T, K0, F0, q_in0, q_out0, n0 = T_new, K1, op.F(case, t1, n1), q_in1, q_out1, n1
             sensors[k] = P @ T
+            fvals[k] = G @ T
             heat_in[k], heat_out[k] = q_in1, q_out1
             if (save_every and k % save_every == 0) or k == len(grid) - 1:
                 fields_t.append(float(t1))
@@ -298,4 +306,5 @@ class ThermalModel:
                 progress(t1 / case.duration_s)
         E_stored = op.stored_J(T, T_start)
         return TransientResult(self, case, theta, grid, names, sensors, np.array(fields_t),
-                               np.array(fields), heat_in, heat_out, E_in, E_out, E_stored)
+                               np.array(fields), heat_in, heat_out, E_in, E_out, E_stored,
+                               {k: fvals[:, j] for j, k in enumerate(functionals)})

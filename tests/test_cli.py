@@ -41,8 +41,10 @@ def test_solve_steady_writes_everything(tmp_path, capsys):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["energy"]["relative_imbalance"] < 1e-10
     assert summary["relative_residual"] <= 1e-8
+    assert "P1_um" in text and "TCP_um" in text
+    assert summary["growth_um"]["P1"] > 0
     for f in ("sensors.csv", "temperature.vtu", "temperature_section.png",
-              "temperature_3d.png", "sensor_profile.png"):
+              "temperature_3d.png", "sensor_profile.png", "deformation_section.png"):
         assert (out / f).stat().st_size > 0
     assert not list(tmp_path.glob(".*tmp*"))
 
@@ -56,8 +58,9 @@ def test_solve_cycle(tmp_path, capsys):
                  "--out", str(out), "--quiet"]) == 0
     assert (out / "temperature.pvd").exists()
     rows = (out / "sensors_timeseries.csv").read_text().splitlines()
-    assert rows[0].startswith("time_s,T1_C")
+    assert rows[0].startswith("time_s,T1_C") and rows[0].endswith("P1_um,TCP_um")
     assert len(rows) == 1 + 13
+    assert (out / "T1_P1_tolerance.png").exists()
     assert "peak_C" in capsys.readouterr().out
 
 
