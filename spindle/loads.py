@@ -33,6 +33,14 @@ class TimeSeries:
     values: tuple[float, ...]
     interpolation: Interpolation = "linear"
 
+    def __post_init__(self) -> None:
+        if len(self.time_s) != len(self.values) or not self.values:
+            raise ValueError("TimeSeries needs as many times as values, at least one")
+        if any(b <= a for a, b in zip(self.time_s, self.time_s[1:], strict=False)):
+            raise ValueError("TimeSeries times must increase strictly")
+        if self.interpolation not in ("linear", "previous"):
+            raise ValueError(f"unknown interpolation {self.interpolation!r}")
+
     @classmethod
     def constant(cls, value: float) -> TimeSeries:
         return cls((0.0,), (float(value),))
@@ -127,11 +135,13 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
     except OSError as exc:
         raise InputError(name, "file", f"cannot be read ({exc.strerror})",
                          "check the path given to --cycle") from None
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    if not lines:
+    numbered = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1)
+                if ln.strip() and not ln.lstrip().startswith("#")]
+    if not numbered:
         raise InputError(name, "header", "the file has no header row",
                          "add a header such as 'time_s,speed_rpm,T_env_C'")
-    rows = list(csv.reader(lines))
+    line_no = [i for i, _ in numbered]  # file line of each row, comments counted
+    rows = list(csv.reader([ln for _, ln in numbered]))
     header = [h.strip() for h in rows[0]]
     if "time_s" not in header:
         raise InputError(name, "time_s", "required column is missing",
@@ -142,18 +152,19 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
         raise InputError(name, unknown[0], "is not a cycle column",
                          f"use one of {sorted(allowed)}")
     data: dict[str, list[float]] = {h: [] for h in header}
-    for lineno, row in enumerate(rows[1:], start=2):
+    for k, row in enumerate(rows[1:], start=1):
+        lineno = line_no[k]
         if len(row) != len(header):
-            raise InputError(name, f"row {lineno}", f"has {len(row)} cells, header has "
+            raise InputError(name, f"line {lineno}", f"has {len(row)} cells, header has "
                              f"{len(header)}", "give every row one cell per column")
         for h, cell in zip(header, row, strict=True):
             try:
                 v = float(cell)
             except ValueError:
-                raise InputError(name, f"{h} (row {lineno})", f"'{cell}' is not a number",
+                raise InputError(name, f"{h} (line {lineno})", f"'{cell}' is not a number",
                                  "write a decimal number with '.' as the separator") from None
             if not np.isfinite(v):
-                raise InputError(name, f"{h} (row {lineno})", "is not finite",
+                raise InputError(name, f"{h} (line {lineno})", "is not finite",
                                  "write a finite number")
             data[h].append(v)
     t = np.asarray(data["time_s"])
@@ -162,10 +173,11 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
                          "add rows up to the end time of the run")
     bad = np.nonzero(np.diff(t) <= 0)[0]
     if len(bad):
-        raise InputError(name, f"time_s (row {bad[0] + 3})", "time does not increase",
+        raise InputError(name, f"time_s (line {line_no[bad[0] + 2]})", "time does not increase",
                          "sort the rows by time and remove duplicates")
     if t[0] < 0:
-        raise InputError(name, "time_s (row 2)", "is negative", "start the cycle at 0 s")
+        raise InputError(name, f"time_s (line {line_no[1]})", "is negative",
+                         "start the cycle at 0 s")
     times = tuple(float(x) for x in t - t[0])
 
     def series(col: str, offset: float = 0.0, interp: Interpolation = "linear") -> TimeSeries:
@@ -178,9 +190,11 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
         case = replace(case, speed_rpm=series("speed_rpm", interp="previous"))
     for col, attr in (("T_env_C", "T_ambient_K"), ("T_coolant_C", "T_coolant_K")):
         if col in data:
-            if min(data[col]) < -60 or max(data[col]) > 200:
-                raise InputError(name, col, "is outside -60..200 degC",
-                                 "give temperatures in degrees Celsius")
+            out = [k for k, v in enumerate(data[col]) if not -60 <= v <= 200]
+            if out:
+                raise InputError(name, f"{col} (line {line_no[out[0] + 1]})",
+                                 f"{data[col][out[0]]:g} is outside -60..200 degC",
+                                 "give temperatures in degrees Celsius (not kelvin)")
             case = replace(case, **{attr: series(col, 273.15)})
     sources = {s: series(f"{s}_W") for s in source_names if f"{s}_W" in data}
     return case.with_sources(sources)

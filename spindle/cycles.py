@@ -1,0 +1,596 @@
+"""Load cycles: a table of speed steps plus the ambient and coolant temperatures of a run.
+
+A :class:`Cycle` is what a test bench runs (for example the paper's 16 h no-load bearing
+run-in, Fig. 7) or a load point held to a steady state. It holds
+
+* ``steps``: :class:`Step` rows of speed [rpm], duration [s], load torque [N m] and,
+  optionally, the motor's electrical power [kW]; each step's values hold for its duration;
+* ``T_ambient_K`` and ``T_coolant_K``: :class:`~spindle.loads.TimeSeries` in K.
+
+:meth:`Cycle.to_load_case` turns it into the :class:`~spindle.loads.LoadCase` a solver
+reads. Heat-source powers are not computed here (that is the power balance's job): they are
+passed in as series.
+
+Files (format: docs/cycles.md): a short TOML (:func:`read_cycle_toml`) or a CSV of steps
+(:func:`read_cycle_steps_csv`). Temperatures are in degC in files (fields ending ``_C``) and
+in K in memory. The ambient and coolant may be constant, a table, or one of two
+deterministic generators, :func:`drifting_ambient` (a room that is not climate-controlled,
+paper Fig. 10) and :func:`chiller_cycling` (a chiller's on/off hysteresis). Every problem
+in a file raises :class:`~spindle.errors.InputError` naming the file, the field (with the
+step, row or line) and the fix.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import tomllib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+
+from spindle.errors import InputError
+from spindle.loads import LoadCase, TimeSeries
+
+if TYPE_CHECKING:  # only for the annotation: spec.py is not imported at run time
+    from spindle.spec import Spec
+
+#: 0 degC in K.
+ZERO_C_K = 273.15
+#: Temperatures accepted in cycle files [degC] (as spindle.loads.read_cycle_csv).
+T_MIN_C, T_MAX_C = -60.0, 200.0
+#: Ambient and coolant when a file gives none [degC].
+DEFAULT_T_C = 20.0
+
+
+class ParameterError(ValueError):
+    """A generator parameter is out of its range; ``param`` is its name (as in the TOML)."""
+
+    def __init__(self, param: str, message: str, fix: str):
+        self.param, self.message, self.fix = param, message, fix
+        super().__init__(f"{param}: {message}; fix: {fix}")
+
+
+# --------------------------------------------------------------------------- steps and cycles
+
+
+@dataclass(frozen=True)
+class Step:
+    """One plateau of a cycle: ``speed_rpm`` [1/min] held for ``duration_s`` [s] against a
+    process ``load_torque_Nm`` [N m] (0: no load); ``power_kW`` is the motor's active
+    electrical power [kW] from the drive when known (None: not given)."""
+
+    speed_rpm: float
+    duration_s: float
+    load_torque_Nm: float = 0.0
+    power_kW: float | None = None
+
+    def __post_init__(self) -> None:
+        values = {"speed_rpm": self.speed_rpm, "duration_s": self.duration_s,
+                  "load_torque_Nm": self.load_torque_Nm}
+        if self.power_kW is not None:
+            values["power_kW"] = self.power_kW
+        for key, v in values.items():
+            if not math.isfinite(v) or v < 0:
+                raise ValueError(f"Step.{key} must be a finite number >= 0, not {v!r}")
+        if self.duration_s <= 0:
+            raise ValueError(f"Step.duration_s must be > 0, not {self.duration_s!r}")
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """A load cycle: speed steps and the ambient and coolant temperatures [K] of one run.
+
+    ``steady``: the cycle stands for a load point held until the temperatures stop changing
+    (a steady solve evaluates it at t = 0); its duration is still used by a transient run.
+    """
+
+    name: str
+    description: str
+    source: str
+    steps: tuple[Step, ...]
+    T_ambient_K: TimeSeries
+    T_coolant_K: TimeSeries
+    steady: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "steps", tuple(self.steps))
+        if not self.steps:
+            raise ValueError("a Cycle needs at least one step")
+
+    @property
+    def duration_s(self) -> float:
+        """Total duration [s]: the sum of the step durations."""
+        return float(self.boundaries_s[-1])
+
+    @property
+    def boundaries_s(self) -> np.ndarray:
+        """Start of every step and the end of the last, [s] (len(steps) + 1 values)."""
+        return np.concatenate([[0.0], np.cumsum([s.duration_s for s in self.steps])])
+
+    @property
+    def max_speed_rpm(self) -> float:
+        return float(max(s.speed_rpm for s in self.steps))
+
+    def _steps_series(self, values: list[float]) -> TimeSeries:
+        starts = tuple(float(t) for t in self.boundaries_s[:-1])
+        return TimeSeries(starts, tuple(float(v) for v in values), "previous")
+
+    @property
+    def speed_rpm(self) -> TimeSeries:
+        """Speed [rpm] as a step signal ("previous"): sample i at the start of step i."""
+        return self._steps_series([s.speed_rpm for s in self.steps])
+
+    @property
+    def load_torque_Nm(self) -> TimeSeries:
+        """Process load torque [N m] as a step signal."""
+        return self._steps_series([s.load_torque_Nm for s in self.steps])
+
+    @property
+    def power_kW(self) -> TimeSeries | None:
+        """Electrical motor power [kW] as a step signal; None unless every step gives it."""
+        if any(s.power_kW is None for s in self.steps):
+            return None
+        return self._steps_series([float(s.power_kW) for s in self.steps])  # type: ignore[arg-type]
+
+    def step_index(self, t_s: float) -> int:
+        """Index of the step running at time ``t_s`` [s] (a boundary starts the next step;
+        before 0 the first, after the end the last)."""
+        i = int(np.searchsorted(self.boundaries_s, t_s, side="right")) - 1
+        return min(max(i, 0), len(self.steps) - 1)
+
+    def to_load_case(self, spec: Spec | None = None,
+                     sources: Mapping[str, TimeSeries] | None = None,
+                     *, others: Literal["spec", "zero"] = "spec") -> LoadCase:
+        """The :class:`~spindle.loads.LoadCase` of this cycle: duration = :attr:`duration_s`,
+        speed from the steps, ambient and coolant from the series.
+
+        ``sources`` (heat-source name -> power series [W], from the power balance) is passed
+        through. With a ``spec``, every name must be one of its heat sources, and the spec's
+        sources not named keep their own (nominal) power (``others="spec"``, as LoadCase
+        does) or get 0 W (``others="zero"``, for a run whose every loss is in ``sources``).
+        """
+        srcs = dict(sources or {})
+        for key, series in srcs.items():
+            if not isinstance(series, TimeSeries):
+                raise TypeError(f"source '{key}' must be a TimeSeries, not {type(series).__name__}")
+        if others not in ("spec", "zero"):
+            raise ValueError(f"others must be 'spec' or 'zero', not {others!r}")
+        if spec is not None:
+            known = [h.name for h in spec.heat_sources]
+            unknown = sorted(set(srcs) - set(known))
+            if unknown:
+                raise InputError(spec.path, f"heat_sources ({unknown[0]})",
+                                 f"cycle '{self.name}' gives a power for a heat source the spec "
+                                 "does not have", f"use one of {known}")
+            if others == "zero":
+                srcs = {**{k: TimeSeries.constant(0.0) for k in known}, **srcs}
+        elif others == "zero":
+            raise ValueError("others='zero' needs the spec (to know its heat sources)")
+        return LoadCase(name=self.name, speed_rpm=self.speed_rpm, T_ambient_K=self.T_ambient_K,
+                        T_coolant_K=self.T_coolant_K, sources=srcs, duration_s=self.duration_s)
+
+
+# --------------------------------------------------------------------------- generators
+
+
+def _check_number(param: str, value: float, lo: float | None = None, hi: float | None = None,
+                  strict_lo: bool = False, unit: str = "") -> float:
+    v = float(value)
+    if not math.isfinite(v):
+        raise ParameterError(param, "is not finite", "give a finite number")
+    if lo is not None and (v < lo or (strict_lo and v == lo)):
+        rel = ">" if strict_lo else ">="
+        raise ParameterError(param, f"must be {rel} {lo:g} {unit}".rstrip(), f"give {param} {rel} {lo:g}")
+    if hi is not None and v > hi:
+        raise ParameterError(param, f"must be <= {hi:g} {unit}".rstrip(), f"give {param} <= {hi:g}")
+    return v
+
+
+def _check_temperature(param: str, value: float) -> float:
+    v = _check_number(param, value)
+    if not T_MIN_C <= v <= T_MAX_C:
+        raise ParameterError(param, f"{v:g} degC is outside {T_MIN_C:g}..{T_MAX_C:g} degC",
+                             "give the temperature in degrees Celsius")
+    return v
+
+
+def _half_cosine(x: np.ndarray) -> np.ndarray:
+    """0 at x = 0, 1 at x = 1, zero slope at both ends: (1 - cos(pi x)) / 2."""
+    return 0.5 * (1.0 - np.cos(np.pi * np.clip(x, 0.0, 1.0)))
+
+
+def drifting_ambient(duration_s: float, *, T_start_C: float = 19.5, T_peak_C: float = 22.5,
+                     t_peak_h: float = 9.0, T_end_C: float | None = None,
+                     sample_s: float = 900.0) -> TimeSeries:
+    """Air temperature of a room that is not climate-controlled (paper Fig. 10) [K].
+
+    A smooth day profile: from ``T_start_C`` at t = 0 to ``T_peak_C`` at ``t_peak_h``, then
+    to ``T_end_C`` (default: stays at the peak) at ``duration_s``, each leg a half cosine
+    (zero slope at the start, the peak and the end)::
+
+        T(t) = T_start + (T_peak - T_start) (1 - cos(pi t / t_peak)) / 2,   t <= t_peak
+        T(t) = T_peak + (T_end - T_peak) (1 - cos(pi (t - t_peak) / (D - t_peak))) / 2
+
+    with D = ``duration_s``. Sampled every ``sample_s`` [s] from 0 to D, plus t_peak and D,
+    and interpolated linearly (error below A (pi dt)^2 / (16 t_leg^2): 1.4 mK for 3 K over
+    9 h at 15 min). If t_peak >= D only the rise is used (up to D).
+    """
+    D = _check_number("duration_s", duration_s, lo=0.0, strict_lo=True, unit="s")
+    T0 = _check_temperature("T_start_C", T_start_C)
+    Tp = _check_temperature("T_peak_C", T_peak_C)
+    Te = Tp if T_end_C is None else _check_temperature("T_end_C", T_end_C)
+    tp = _check_number("t_peak_h", t_peak_h, lo=0.0, strict_lo=True, unit="h") * 3600.0
+    dt = _check_number("sample_s", sample_s, lo=0.0, strict_lo=True, unit="s")
+    t = np.unique(np.concatenate([np.arange(0.0, D, dt), [min(tp, D), D]]))
+    rise = T0 + (Tp - T0) * _half_cosine(t / tp)
+    if tp < D:
+        fall = Tp + (Te - Tp) * _half_cosine((t - tp) / (D - tp))
+        T = np.where(t <= tp, rise, fall)
+    else:
+        T = rise
+    return TimeSeries(tuple(t.tolist()), tuple((T + ZERO_C_K).tolist()), "linear")
+
+
+def chiller_cycling(duration_s: float, *, setpoint_C: float = 20.0, band_K: float = 0.5,
+                    period_s: float = 1200.0, rise_fraction: float = 0.5) -> TimeSeries:
+    """Coolant supply of an on/off chiller with a hysteresis of +-``band_K`` [K].
+
+    The water warms linearly from ``setpoint_C - band_K`` to ``setpoint_C + band_K`` while
+    the compressor is off (``rise_fraction`` of ``period_s``), then cools linearly back
+    (the rest of the period): a triangle wave (a sawtooth as rise_fraction -> 0 or 1) with
+    mean ``setpoint_C`` over a period. It starts at the set point, warming: with
+    r = rise_fraction, P = period_s and s = (t / P + r / 2) mod 1 (the phase from the last
+    minimum),
+
+        T(t) = setpoint - band + 2 band s / r,                 s < r
+        T(t) = setpoint + band - 2 band (s - r) / (1 - r),     s >= r
+
+    so the maxima are at t = (k + r/2) P and the minima at t = (k + 1 - r/2) P. The series
+    holds t = 0, every extremum before ``duration_s`` and ``duration_s``: linear
+    interpolation reproduces the wave exactly.
+    """
+    D = _check_number("duration_s", duration_s, lo=0.0, strict_lo=True, unit="s")
+    Ts = _check_temperature("setpoint_C", setpoint_C)
+    b = _check_number("band_K", band_K, lo=0.0, unit="K")
+    P = _check_number("period_s", period_s, lo=0.0, strict_lo=True, unit="s")
+    r = float(rise_fraction)
+    if not (math.isfinite(r) and 0.0 < r < 1.0):
+        raise ParameterError("rise_fraction", f"must be strictly between 0 and 1, not {r:g}",
+                             "give 0.5 for a symmetric triangle")
+    for name, v in (("setpoint_C - band_K", Ts - b), ("setpoint_C + band_K", Ts + b)):
+        if not T_MIN_C <= v <= T_MAX_C:
+            raise ParameterError("band_K", f"{name} = {v:g} degC is outside "
+                                 f"{T_MIN_C:g}..{T_MAX_C:g} degC", "give a smaller band_K")
+    k = np.arange(0, math.ceil(D / P) + 1)
+    extrema = np.concatenate([(k + r / 2) * P, (k + 1 - r / 2) * P])
+    t = np.unique(np.concatenate([[0.0, D], extrema[extrema < D]]))
+    s = np.mod(t / P + r / 2, 1.0)
+    T = np.where(s < r, Ts - b + 2 * b * s / r, Ts + b - 2 * b * (s - r) / (1 - r))
+    return TimeSeries(tuple(t.tolist()), tuple((T + ZERO_C_K).tolist()), "linear")
+
+
+#: Generators a cycle file can name in [ambient] or [coolant] with ``model = "..."``.
+GENERATORS: dict[str, Callable[..., TimeSeries]] = {
+    "drift": drifting_ambient,
+    "chiller": chiller_cycling,
+}
+_GENERATOR_KEYS = {
+    "drift": ("T_start_C", "T_peak_C", "t_peak_h", "T_end_C", "sample_s"),
+    "chiller": ("setpoint_C", "band_K", "period_s", "rise_fraction"),
+}
+
+
+# --------------------------------------------------------------------------- TOML reader
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+class _File:
+    """Error helpers bound to one file."""
+
+    def __init__(self, path: Path):
+        self.name = str(path)
+
+    def error(self, fld: str, message: str, fix: str) -> InputError:
+        return InputError(self.name, fld, message, fix)
+
+    def number(self, d: Mapping[str, Any], key: str, where: str, *, required: bool = True,
+               default: float | None = None, lo: float | None = None,
+               strict_lo: bool = False, unit: str = "") -> float | None:
+        fld = f"{where}.{key}" if where else key
+        if key not in d:
+            if required:
+                raise self.error(fld, "required field is missing", f"add {key} = <number> [{unit}]")
+            return default
+        v = d[key]
+        if not _is_number(v):
+            raise self.error(fld, f"{v!r} is not a number", f"write {key} = <number> [{unit}]")
+        v = float(v)
+        if not math.isfinite(v):
+            raise self.error(fld, "is not finite", "write a finite number")
+        if lo is not None and (v < lo or (strict_lo and v == lo)):
+            word = "negative" if v < 0 else "zero" if v == 0 else f"below {lo:g}"
+            rel = ">" if strict_lo else ">="
+            raise self.error(fld, f"{v:g} is {word}", f"give {key} {rel} {lo:g} {unit}".rstrip())
+        return v
+
+    def temperature(self, v: Any, fld: str) -> float:
+        if not _is_number(v) or not math.isfinite(v):
+            raise self.error(fld, f"{v!r} is not a number", "write the temperature in degC")
+        if not T_MIN_C <= v <= T_MAX_C:
+            raise self.error(fld, f"{v:g} degC is outside {T_MIN_C:g}..{T_MAX_C:g} degC",
+                             "give temperatures in degrees Celsius")
+        return float(v)
+
+    def unknown_keys(self, d: Mapping[str, Any], allowed: tuple[str, ...], where: str) -> None:
+        extra = [k for k in d if k not in allowed]
+        if extra:
+            fld = f"{where}.{extra[0]}" if where else extra[0]
+            raise self.error(fld, "is not a field here", f"use one of {list(allowed)}")
+
+
+_STEP_KEYS = ("speed_rpm", "duration_s", "duration_h", "load_torque_Nm", "power_kW")
+
+
+def _read_step(f: _File, d: Any, where: str) -> Step:
+    if not isinstance(d, dict):
+        raise f.error(where, "is not a table", "write each step as { speed_rpm = ..., duration_h = ... }")
+    f.unknown_keys(d, _STEP_KEYS, where)
+    speed = f.number(d, "speed_rpm", where, lo=0.0, unit="rpm")
+    if ("duration_s" in d) == ("duration_h" in d):
+        raise f.error(f"{where}.duration_s", "give exactly one of duration_s and duration_h",
+                      "write duration_s = <seconds> or duration_h = <hours>")
+    if "duration_s" in d:
+        dur = f.number(d, "duration_s", where, lo=0.0, strict_lo=True, unit="s")
+    else:
+        dur = f.number(d, "duration_h", where, lo=0.0, strict_lo=True, unit="h") * 3600.0
+    torque = f.number(d, "load_torque_Nm", where, required=False, default=0.0, lo=0.0, unit="N m")
+    power = f.number(d, "power_kW", where, required=False, lo=0.0, unit="kW")
+    return Step(speed, dur, torque, power)  # type: ignore[arg-type]
+
+
+def _read_temperature(f: _File, data: Mapping[str, Any], key: str, duration_s: float,
+                      default: TimeSeries) -> TimeSeries:
+    """[ambient] or [coolant]: constant, table or generator; in degC, returned in K."""
+    d = data.get(key)
+    if d is None:
+        return default
+    if not isinstance(d, dict):
+        raise f.error(key, "is not a table", f"write a [{key}] table with T_C = 20.0")
+    model = d.get("model")
+    if model is None:
+        model = "table" if isinstance(d.get("T_C"), list) else "constant"
+    models = ("constant", "table", *GENERATORS)
+    if model not in models:
+        raise f.error(f"{key}.model", f"unknown model {model!r}", f"use one of {list(models)}")
+    if model == "constant":
+        f.unknown_keys(d, ("model", "T_C"), key)
+        if "T_C" not in d:
+            raise f.error(f"{key}.T_C", "required field is missing", "add T_C = <degC>")
+        return TimeSeries.constant(f.temperature(d["T_C"], f"{key}.T_C") + ZERO_C_K)
+    if model == "table":
+        f.unknown_keys(d, ("model", "T_C", "time_s", "time_h"), key)
+        if ("time_s" in d) == ("time_h" in d):
+            raise f.error(f"{key}.time_h", "a table needs exactly one of time_s and time_h",
+                          "write time_h = [0, 8, 16] and T_C = [20, 22, 21]")
+        tkey = "time_s" if "time_s" in d else "time_h"
+        times, temps = d[tkey], d.get("T_C")
+        if not isinstance(times, list) or not times:
+            raise f.error(f"{key}.{tkey}", "is not a non-empty list", f"write {tkey} = [0, ...]")
+        if not isinstance(temps, list) or len(temps) != len(times):
+            raise f.error(f"{key}.T_C", f"needs a list of {len(times)} values (one per {tkey})",
+                          f"give one T_C value per {tkey} entry")
+        scale = 1.0 if tkey == "time_s" else 3600.0
+        t = []
+        for i, v in enumerate(times):
+            if not _is_number(v) or not math.isfinite(v):
+                raise f.error(f"{key}.{tkey}[{i}]", f"{v!r} is not a number", "write a number")
+            t.append(float(v) * scale)
+        if t[0] < 0:
+            raise f.error(f"{key}.{tkey}[0]", "is negative", "start the table at 0 or later")
+        for i in range(1, len(t)):
+            if t[i] <= t[i - 1]:
+                raise f.error(f"{key}.{tkey}[{i}]", "time does not increase",
+                              "sort the entries by time and remove duplicates")
+        T = [f.temperature(v, f"{key}.T_C[{i}]") + ZERO_C_K for i, v in enumerate(temps)]
+        return TimeSeries(tuple(t), tuple(T), "linear")
+    allowed = _GENERATOR_KEYS[model]
+    f.unknown_keys(d, ("model", *allowed), key)
+    kwargs: dict[str, float] = {}
+    for p in allowed:
+        if p in d:
+            v = d[p]
+            if not _is_number(v):
+                raise f.error(f"{key}.{p}", f"{v!r} is not a number", f"write {p} = <number>")
+            kwargs[p] = float(v)
+    try:
+        return GENERATORS[model](duration_s, **kwargs)
+    except ParameterError as exc:
+        raise f.error(f"{key}.{exc.param}", exc.message, exc.fix) from None
+
+
+def _read_text(path: Path, f: _File) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise f.error("file", f"cannot be read ({exc})",
+                      "check the path and that the file is UTF-8 text") from None
+
+
+def read_cycle_toml(path: str | Path) -> Cycle:
+    """Read a cycle from TOML (format: docs/cycles.md). Raises InputError."""
+    path = Path(path)
+    f = _File(path)
+    try:
+        data = tomllib.loads(_read_text(path, f))
+    except tomllib.TOMLDecodeError as exc:
+        raise f.error("syntax", str(exc), "fix the TOML syntax at that line") from None
+    f.unknown_keys(data, ("cycle", "ambient", "coolant"), "")
+    head = data.get("cycle")
+    if not isinstance(head, dict):
+        raise f.error("cycle", "required table is missing", "add a [cycle] table with steps = [...]")
+    f.unknown_keys(head, ("name", "description", "source", "steady", "steps"), "cycle")
+    for key in ("name", "description", "source"):
+        if key in head and not isinstance(head[key], str):
+            raise f.error(f"cycle.{key}", "is not a string", f'write {key} = "..."')
+    steady = head.get("steady", False)
+    if not isinstance(steady, bool):
+        raise f.error("cycle.steady", f"{steady!r} is not true or false", "write steady = true or false")
+    raw = head.get("steps")
+    if raw is None:
+        raise f.error("cycle.steps", "required field is missing",
+                      "add steps = [{ speed_rpm = 1000, duration_h = 1.0 }, ...]")
+    if not isinstance(raw, list) or not raw:
+        raise f.error("cycle.steps", "the step table is empty",
+                      "give at least one { speed_rpm = ..., duration_s = ... }")
+    steps = tuple(_read_step(f, d, f"cycle.steps[{i}]") for i, d in enumerate(raw))
+    duration = float(sum(s.duration_s for s in steps))
+    amb = _read_temperature(f, data, "ambient", duration, TimeSeries.constant(DEFAULT_T_C + ZERO_C_K))
+    cool = _read_temperature(f, data, "coolant", duration, amb)
+    return Cycle(name=head.get("name", path.stem), description=head.get("description", ""),
+                 source=head.get("source", ""), steps=steps, T_ambient_K=amb, T_coolant_K=cool,
+                 steady=steady)
+
+
+# --------------------------------------------------------------------------- CSV reader
+
+_CSV_REQUIRED = ("speed_rpm", "duration_s")
+_CSV_OPTIONAL = ("load_torque_Nm", "power_kW")
+_CSV_META = ("name", "description", "source", "steady", "T_ambient_C", "T_coolant_C")
+
+
+def read_cycle_steps_csv(path: str | Path, *, T_ambient_C: float | None = None,
+                         T_coolant_C: float | None = None) -> Cycle:
+    """Read a cycle's steps from CSV (comment lines start with ``#``).
+
+    Columns: ``speed_rpm``, ``duration_s`` (required), ``load_torque_Nm`` (0 when absent or
+    empty), ``power_kW`` (None when absent or empty); one row per step. Comment lines of the
+    form ``# key: value`` may set ``name`` (default: the file stem), ``description``,
+    ``source``, ``steady`` (true/false), ``T_ambient_C`` and ``T_coolant_C`` (constants;
+    default 20 degC, coolant = ambient); other comments are ignored. The keyword arguments
+    override those two temperatures. Errors name the field and the line of the file.
+    """
+    path = Path(path)
+    f = _File(path)
+    text = _read_text(path, f)
+    meta: dict[str, tuple[str, int]] = {}
+    numbered: list[tuple[int, str]] = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        s = line.strip()
+        if not s:
+            continue
+        if s.startswith("#"):
+            key, sep, value = s[1:].partition(":")
+            if sep and key.strip() in _CSV_META:
+                meta[key.strip()] = (value.strip(), lineno)
+            continue
+        numbered.append((lineno, line))
+    if not numbered:
+        raise f.error("header", "the file has no header row",
+                      "add a header such as 'speed_rpm,duration_s,load_torque_Nm'")
+    rows = list(csv.reader([ln for _, ln in numbered]))
+    header = [h.strip() for h in rows[0]]
+    hline = numbered[0][0]
+    for col in _CSV_REQUIRED:
+        if col not in header:
+            raise f.error(col, f"required column is missing from the header (line {hline})",
+                          f"add a '{col}' column (header: {','.join(_CSV_REQUIRED + _CSV_OPTIONAL)})")
+    for h in header:
+        if h not in _CSV_REQUIRED + _CSV_OPTIONAL:
+            raise f.error(f"{h or '(empty)'} (line {hline})", "is not a step column",
+                          f"use only {list(_CSV_REQUIRED + _CSV_OPTIONAL)}")
+        if header.count(h) > 1:
+            raise f.error(f"{h} (line {hline})", "column appears twice", "keep one of them")
+    if len(rows) < 2:
+        raise f.error("steps", "the step table is empty", "add one row per step below the header")
+    steps = []
+    for (lineno, _), row in zip(numbered[1:], rows[1:], strict=True):
+        if len(row) != len(header):
+            raise f.error(f"line {lineno}", f"has {len(row)} cells, the header has {len(header)}",
+                          "give every row one cell per column")
+        vals: dict[str, float | None] = {}
+        for h, cell in zip(header, row, strict=True):
+            fld = f"{h} (line {lineno})"
+            cell = cell.strip()
+            if not cell:
+                if h in _CSV_REQUIRED:
+                    raise f.error(fld, "is empty", "give a number in every row")
+                vals[h] = None
+                continue
+            try:
+                v = float(cell)
+            except ValueError:
+                raise f.error(fld, f"'{cell}' is not a number",
+                              "write a decimal number with '.' as the separator") from None
+            if not math.isfinite(v):
+                raise f.error(fld, "is not finite", "write a finite number")
+            if v < 0:
+                raise f.error(fld, f"{v:g} is negative", f"give {h} >= 0")
+            if h == "duration_s" and v == 0:
+                raise f.error(fld, "is zero", "give every step a duration > 0 s or drop the row")
+            vals[h] = v
+        steps.append(Step(vals["speed_rpm"], vals["duration_s"],  # type: ignore[arg-type]
+                          vals.get("load_torque_Nm") or 0.0, vals.get("power_kW")))
+
+    def meta_temperature(key: str, override: float | None, default: float) -> float:
+        if override is not None:
+            return f.temperature(override, key)
+        if key not in meta:
+            return default
+        value, lineno = meta[key]
+        try:
+            v = float(value)
+        except ValueError:
+            raise f.error(f"{key} (line {lineno})", f"'{value}' is not a number",
+                          f"write '# {key}: 20.0'") from None
+        return f.temperature(v, f"{key} (line {lineno})")
+
+    T_amb = meta_temperature("T_ambient_C", T_ambient_C, DEFAULT_T_C)
+    T_cool = meta_temperature("T_coolant_C", T_coolant_C, T_amb)
+    steady = False
+    if "steady" in meta:
+        value, lineno = meta["steady"]
+        if value.lower() not in ("true", "false"):
+            raise f.error(f"steady (line {lineno})", f"'{value}' is not true or false",
+                          "write '# steady: true' or '# steady: false'")
+        steady = value.lower() == "true"
+    return Cycle(name=meta.get("name", (path.stem, 0))[0],
+                 description=meta.get("description", ("", 0))[0],
+                 source=meta.get("source", ("", 0))[0], steps=tuple(steps),
+                 T_ambient_K=TimeSeries.constant(T_amb + ZERO_C_K),
+                 T_coolant_K=TimeSeries.constant(T_cool + ZERO_C_K), steady=steady)
+
+
+# --------------------------------------------------------------------------- shipped cycles
+
+
+def shipped_cycles() -> dict[str, Path]:
+    """Shipped cycles (spindle/data/cycles/*.toml and *.csv) by name (the file stem)."""
+    root = resources.files("spindle").joinpath("data/cycles")
+    return {Path(str(p)).stem: Path(str(p)) for p in sorted(root.iterdir(), key=str)
+            if str(p).endswith((".toml", ".csv"))}
+
+
+def load_cycle(name_or_path: str | Path) -> Cycle:
+    """A cycle from a file (``.toml`` or ``.csv``) or the name of a shipped cycle."""
+    p = Path(name_or_path)
+    if not p.is_file():
+        shipped = shipped_cycles()
+        if str(name_or_path) not in shipped:
+            raise InputError(str(name_or_path), "file", "is neither a file nor a shipped cycle",
+                             f"give the path of a .toml or .csv cycle or one of {sorted(shipped)}")
+        p = shipped[str(name_or_path)]
+    suffix = p.suffix.lower()
+    if suffix == ".toml":
+        return read_cycle_toml(p)
+    if suffix == ".csv":
+        return read_cycle_steps_csv(p)
+    raise InputError(str(p), "file", f"unknown cycle file type '{p.suffix}'",
+                     "give a .toml cycle or a .csv step table")
