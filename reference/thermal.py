@@ -189,6 +189,14 @@ class ThermalModel:
         return (D.T @ Ma @ D).tocsr()
 
     # ------------------------------------------------------------------ sensors
+    def mean_functional(self, part: str) -> np.ndarray:
+        """Vector w with w . T = volume-mean temperature of ``part`` [K]."""
+        sm = self.smesh
+        cb = Basis(sm.mesh, self.basis.elem, elements=sm.elements_of(part),
+                   intorder=2 * self.order + 1)
+        w = asm(volume_source, cb, q=1.0)
+        return w / w.sum()
+
     def probe_matrix(self, points: np.ndarray) -> sp.csr_matrix:
         """Interpolation (not nearest node) of the field at points (2 x n, z and r in m)."""
         return self.basis.probes(np.asarray(points, dtype=float)).tocsr()

@@ -167,6 +167,7 @@ class Spec:
     heat_sources: tuple[HeatSource, ...]
     sensors: tuple[Sensor, ...]
     sensor_arrays: tuple[SensorArray, ...] = field(default_factory=tuple)
+    power_preset: str | None = None  # [power_balance] preset: motor and bearing parameters
 
     def part(self, name: str) -> Part:
         return next(p for p in self.parts if p.name == name)
@@ -610,6 +611,9 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass o
             r.add(f"sensors.{s.name}", "sensor name is used twice", "give each sensor its own name")
         seen.add(s.name)
 
+    pb = r.table(data, "power_balance", "", required=False) or {}
+    preset = r.string(pb, "preset", "power_balance", required=False)
+
     if not r.problems:
         _check_geometry(r, parts, links, surfaces, sensors)
     if r.problems:
@@ -620,7 +624,8 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass o
         T_coolant_K=T_cool, T_initial_K=T_init, h0_m=h0,
         materials={m: materials[m] for m in {s.material for p in parts for s in p.sections}},
         parts=tuple(parts), links=tuple(links), surfaces=tuple(surfaces),
-        heat_sources=tuple(sources), sensors=tuple(sensors), sensor_arrays=tuple(arrays))
+        heat_sources=tuple(sources), sensors=tuple(sensors), sensor_arrays=tuple(arrays),
+        power_preset=preset)
 
 
 def _array_sensors(arr: SensorArray, part: Part) -> list[Sensor]:

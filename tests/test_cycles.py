@@ -27,8 +27,8 @@ K0 = 273.15
 H = 3600.0
 
 # the documented spl-16h table (docs/cycles.md): speed [rpm], duration [h]
-SPL_16H = [(1000, 1.0), (2000, 1.0), (3000, 1.5), (4300, 2.0), (6000, 2.0), (8000, 2.0),
-           (6000, 1.5), (4300, 2.0), (1000, 1.0), (0, 2.0)]
+SPL_16H = [(1000, 1.5), (2000, 2.0), (3000, 2.0), (4300, 3.0), (3000, 1.5), (4300, 2.0),
+           (2000, 1.0), (1000, 1.0), (0, 2.0)]
 
 
 def write(tmp_path, name: str, text: str):
@@ -53,12 +53,12 @@ def test_spl_16h_steps_duration_and_speeds():
     assert [(s.speed_rpm, s.duration_s / H) for s in c.steps] == SPL_16H
     assert c.duration_s == pytest.approx(16 * H, abs=1e-9)
     assert sum(s.duration_s for s in c.steps) == 16 * H
-    assert c.max_speed_rpm == 8000.0
+    assert c.max_speed_rpm == 4300.0  # up to the rated speed, not beyond
     assert 4300.0 in [s.speed_rpm for s in c.steps]  # the rated speed is a plateau
     assert all(s.load_torque_Nm == 0.0 and s.power_kW is None for s in c.steps)  # no load
     assert c.power_kW is None
     assert c.steps[-1] == Step(0.0, 2 * H)  # final standstill cool-down
-    assert all(1 * H <= s.duration_s <= 2 * H for s in c.steps)
+    assert all(1 * H <= s.duration_s <= 3 * H for s in c.steps)
     # ambient drifts 19.5 -> 22.5 (at 9 h) -> 21.0 degC; coolant 20 +- 0.5 degC
     amb = np.asarray(c.T_ambient_K.values) - K0
     assert amb[0] == pytest.approx(19.5) and amb.max() == pytest.approx(22.5)
@@ -95,9 +95,10 @@ def test_speed_series_holds_steps_and_lands_on_boundaries():
         assert sp(t0 + 0.5 * dur * H) == speed  # held, not interpolated
         assert sp(t0 + dur * H - 1e-6) == speed
         assert c.steps[c.step_index(t0 + 1.0)].speed_rpm == speed
-    assert sp(3.5 * H - 1.0) == 3000.0 and sp(3.5 * H) == 4300.0
+    assert sp(5.5 * H - 1.0) == 3000.0 and sp(5.5 * H) == 4300.0
     assert sp(20 * H) == 0.0  # after the end: the last step
-    np.testing.assert_array_equal(sp(np.array([0.5, 1.5, 8.0]) * H), [1000.0, 2000.0, 8000.0])
+    np.testing.assert_array_equal(sp(np.array([0.5, 1.5, 8.0, 9.0, 11.0]) * H),
+                                  [1000.0, 2000.0, 4300.0, 3000.0, 4300.0])
     assert c.load_torque_Nm(5 * H) == 0.0
 
 
@@ -360,8 +361,8 @@ def test_to_load_case():
     case = c.to_load_case(sources={"front_bearing": bearing})
     assert isinstance(case, LoadCase)
     assert case.name == "spl-16h" and case.duration_s == 16 * H
-    for t_h, speed in ((0.0, 1000), (1.0, 2000), (3.49, 3000), (3.5, 4300), (8.0, 8000), (9.5, 6000),
-                       (12.0, 4300), (14.0, 0), (16.0, 0)):
+    for t_h, speed in ((0.0, 1000), (1.5, 2000), (5.49, 3000), (5.5, 4300), (8.0, 4300), (8.5, 3000),
+                       (10.0, 4300), (12.0, 2000), (13.0, 1000), (14.0, 0), (16.0, 0)):
         assert case.speed_rpm(t_h * H) == speed
     assert case.T_ambient_K is c.T_ambient_K and case.T_coolant_K is c.T_coolant_K
     assert dict(case.sources) == {"front_bearing": bearing}
