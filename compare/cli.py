@@ -65,10 +65,31 @@ def _print_sensor_table(table: dict, title: str) -> None:
               f"{table['T_C'][i]:9.3f} {table['rise_K'][i]:8.3f}")
 
 
+def _read_cycle(name: str, spec, base):
+    """A shipped cycle name, a cycle TOML, a step-table CSV (speed_rpm, duration_s, ...) or
+    a time-series CSV (time_s, speed_rpm, T_env_C, T_coolant_C, <source>_W)."""
+    from dataclasses import replace as _replace
+
+    from spindle.cycles import load_cycle
+    from spindle.drive import cycle_load_case
+    from spindle.loads import read_cycle_csv
+
+    path = Path(name)
+    if path.suffix.lower() == ".csv" and path.is_file():
+        header = next((ln for ln in path.read_text(encoding="utf-8", errors="replace").splitlines()
+                       if ln.strip() and not ln.lstrip().startswith("#")), "")
+        if "time_s" in [h.strip() for h in header.split(",")]:
+            return read_cycle_csv(path, [h.name for h in spec.heat_sources], base)
+    cycle = load_cycle(name)
+    return _replace(cycle_load_case(spec, cycle), name=cycle.name)
+
+
 def _cmd_solve(args: argparse.Namespace) -> int:
     from compare.progress import Progress
     from reference import ReferenceModel
-    from spindle.loads import TimeSeries, read_cycle_csv
+    from spindle.cycles import load_cycle
+    from spindle.drive import cycle_load_case
+    from spindle.loads import TimeSeries
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
 
@@ -79,14 +100,20 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     model = ref.thermal
     t_asm = time.perf_counter() - t0
     case = spec.default_load_case()
+    inputs = [spec.path]
+    if args.case:
+        cycle = load_cycle(args.case)
+        case = replace(cycle_load_case(spec, cycle), name=cycle.name)
+        if Path(args.case).is_file():
+            inputs.append(args.case)
     if args.speed is not None:
         case = replace(case, speed_rpm=TimeSeries.constant(args.speed))
-    inputs = [spec.path]
     quiet = args.quiet
     if args.cycle:
-        case = read_cycle_csv(args.cycle, [h.name for h in spec.heat_sources], case)
-        inputs.append(args.cycle)
-        result = ref.transient(case, args.dt, theta=args.theta,
+        case = _read_cycle(args.cycle, spec, case)
+        if Path(args.cycle).is_file():
+            inputs.append(args.cycle)
+        result = ref.transient(case, args.dt, theta=args.theta, T0=float(case.T_ambient_K(0.0)),
                                save_every=max(1, int(round(args.save_every / args.dt))),
                                progress=Progress("transient", not quiet))
     else:
@@ -152,9 +179,13 @@ def build_parser() -> argparse.ArgumentParser:
                     help="element order (default 2)")
     mode = so.add_mutually_exclusive_group()
     mode.add_argument("--steady", action="store_true", help="steady state (the default)")
-    mode.add_argument("--cycle", metavar="FILE",
-                      help="transient cycle CSV: time_s, speed_rpm, T_env_C, T_coolant_C, "
-                           "<heat source>_W")
+    mode.add_argument("--cycle", metavar="CYCLE",
+                      help="transient: a shipped cycle (spl-16h, nominal), a cycle TOML, a "
+                           "step-table CSV (speed_rpm, duration_s, load_torque_Nm) or a time "
+                           "series CSV (time_s, speed_rpm, T_env_C, T_coolant_C, <source>_W)")
+    so.add_argument("--case", metavar="CYCLE",
+                    help="steady load case from a cycle's first step, e.g. 'nominal' "
+                         "(38 kW / 4300 rpm); heat sources from the power balance")
     so.add_argument("--speed", type=float, help="spindle speed for a steady solve [rpm]")
     so.add_argument("--dt", type=float, default=60.0, help="time step [s] (default 60)")
     so.add_argument("--theta", type=float, default=1.0,

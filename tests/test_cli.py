@@ -109,3 +109,27 @@ def test_output_never_overwrites_input(tmp_path):
     r = run("solve", str(spec), "--level", "0", "--out", str(tmp_path), "--no-pictures")
     assert r.returncode == 2 and "overwrite" in r.stderr
     assert spec.read_text() == before
+
+
+def test_solve_nominal_case_uses_the_power_balance(tmp_path, capsys):
+    out = tmp_path / "n"
+    assert main(["solve", "spl2782", "--case", "nominal", "--level", "0", "--out", str(out),
+                 "--no-pictures"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    # the nominal cycle gives 38 kW electrical at 4300 rpm: losses P_el - P_shaft = 5146 W
+    assert summary["energy"]["heat_in_W"] == pytest.approx(5146.0, rel=1e-3)
+    assert summary["speed_rpm"] == 4300.0
+
+
+def test_solve_shipped_cycle_and_step_csv(tmp_path, capsys):
+    out = tmp_path / "c"
+    assert main(["solve", "spl2782", "--cycle", "spl-16h", "--level", "0", "--dt", "1800",
+                 "--out", str(out), "--quiet", "--no-pictures"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["duration_s"] == 16 * 3600 and s["peak_growth_um"]["P1"] > 0
+    steps = tmp_path / "steps.csv"
+    steps.write_text("speed_rpm,duration_s\n4300,3600\n0,3600\n")
+    assert main(["solve", "spl2782", "--cycle", str(steps), "--level", "0", "--dt", "900",
+                 "--out", str(tmp_path / "s"), "--quiet", "--no-pictures"]) == 0
+    s2 = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert s2["duration_s"] == 7200 and s2["peak_C"]["T1"] > 20.0
