@@ -67,7 +67,7 @@ def test_solve_cycle(tmp_path, capsys):
 @pytest.mark.parametrize("content, words", [
     ("# a comment\ntime_s,speed_rpm\n0,100\n0,200\n", "time_s (line 4): time does not increase"),
     ("time_s,speed_rpm\n0,abc\n10,1\n", "speed_rpm (line 2): 'abc' is not a number"),
-    ("speed_rpm\n0\n", "time_s: required column is missing"),
+    ("speed_rpm\n0\n", "duration_s: required column is missing"),  # read as a step table
     ("time_s,torque_Nm\n0,1\n10,1\n", "torque_Nm: is not a cycle column"),
     ("time_s,T_env_C\n0,293\n10,293\n", "outside -60..200 degC"),
 ])
