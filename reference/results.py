@@ -150,6 +150,8 @@ class TransientResult:
     energy_stored_J: float
     functionals: dict[str, np.ndarray] = field(default_factory=dict)
     growth_m: dict[str, np.ndarray] = field(default_factory=dict)  # per reading, per time [m]
+    U_fields: np.ndarray | None = None  # displacement DOFs at field_times_s [m]
+    elastic: object = None
 
     @property
     def energy(self) -> dict[str, float]:
@@ -203,7 +205,7 @@ class TransientResult:
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         """Summary JSON, sensor time series CSV, VTU per saved time with a PVD, PNGs."""
         from reference import plots
-        from reference.fields import field_grid
+        from reference.fields import add_displacement, field_grid
 
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
@@ -219,6 +221,8 @@ class TransientResult:
         for i, (t, T) in enumerate(zip(self.field_times_s, self.fields_K, strict=True)):
             name = f"fields/temperature_{i:04d}.vtu"
             grid = field_grid(self.model, T)
+            if self.U_fields is not None:
+                add_displacement(grid, self.elastic, self.U_fields[i])
             atomic_write(out / name, lambda tmp, g=grid: g.save(str(tmp)))
             entries.append(f'    <DataSet timestep="{t:.6g}" file="{name}"/>')
         pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'

@@ -61,4 +61,9 @@ class ReferenceModel:
         for k, (g, c) in gains.items():
             res.growth_m[k] = res.functionals[k] - T_ref * g.sum() \
                 + (omega2 * c if self.centrifugal else 0.0)
+        if self.elastic is not None:  # displacement fields at the saved times, for ParaView
+            res.elastic = self.elastic
+            res.U_fields = np.array([
+                self.elastic.displacement(T, float(case.speed_rpm(t)), self.centrifugal)
+                for t, T in zip(res.field_times_s, res.fields_K, strict=True)])
         return res

@@ -525,7 +525,10 @@ def power_balance(motor: MotorParams, bearings: Mapping[str, BearingParams], spe
     output P_mech and appears as bearing heat, never twice.
     """
     fr = {name: bearing_friction(p, speed_rpm) for name, p in bearings.items()}
-    M_L = (_finite("process_torque_Nm", process_torque_Nm) + sum(b.torque_Nm for b in fr.values())
+    # a standing shaft demands no friction torque (Palmgren's M0 is a running torque), so
+    # friction adds to the motor's load only while the shaft turns
+    friction_Nm = sum(b.torque_Nm for b in fr.values()) if speed_rpm > 0 else 0.0
+    M_L = (_finite("process_torque_Nm", process_torque_Nm) + friction_Nm
            + _finite("windage_torque_Nm", windage_torque_Nm))
     ml = motor_losses(motor, speed_rpm, M_L, T_winding_K, P_el_W=P_el_W, J_kgm2=J_kgm2,
                       dw_dt_rad_s2=dw_dt_rad_s2)

@@ -48,3 +48,24 @@ def test_transient_to_pandas_and_save(fin_model, tmp_path):
 
     grid = pv.read(tmp_path / "fields" / "temperature_0002.vtu")
     assert grid.point_data["T_C"].max() == pytest.approx(res.fields_K[-1].max() - 273.15)
+
+
+def test_transient_vtu_carries_displacement(tmp_path):
+    import pyvista as pv
+
+    from reference import ReferenceModel
+
+    spec = load_spec("spl2782")
+    ref = ReferenceModel(spec, level=0)
+    case = spec.default_load_case()
+    case = LoadCase("short", case.speed_rpm, case.T_ambient_K, case.T_coolant_K, case.sources,
+                    duration_s=1800.0)
+    res = ref.transient(case, 600.0, save_every=1)
+    res.save(tmp_path, pictures=False)
+    grid = pv.read(tmp_path / "fields" / "temperature_0003.vtu")
+    # u_z at the probe points equals the P1 reading at the last time
+    uz = grid.point_data["u_z_um"]
+    assert np.ptp(uz) > 1.0
+    assert res.growth_m["P1"][-1] * 1e6 == pytest.approx(
+        ((ref.elastic.axial_probe(0.5295, 0.05) - ref.elastic.axial_probe(0.5, 0.095))
+         @ res.U_fields[-1])[0] * 1e6, rel=1e-9)
