@@ -304,6 +304,8 @@ class _Reader:
                 self.add(f"{path}.{key}", "required field is missing",
                          f"add {key} = <number in {unit}>")
             return None
+        if isinstance(v, dict) and "correlation" in v:
+            return self.correlation(v, f"{path}.{key}")
         if isinstance(v, dict):
             n, vals = v.get("speed_rpm"), v.get("value")
             ok = (isinstance(n, list) and isinstance(vals, list) and len(n) == len(vals) >= 1
@@ -323,6 +325,44 @@ class _Reader:
             return SpeedTable(tuple(float(x) for x in n), tuple(float(x) for x in vals))
         num = self.number(data, key, path, unit, lo=0.0)
         return None if num is None else SpeedTable.constant(num)
+
+    def correlation(self, d: dict, path: str) -> SpeedTable | None:
+        """A film coefficient from a cited correlation of spindle.power, tabulated in speed:
+        ``rotating_shaft`` (d_m), ``air_gap`` (r_rotor_m, gap_m) or ``coolant_channel``
+        (flow_l_min, width_m, height_m); ``factor`` (default 1) scales the result, e.g. for
+        the wetted fraction of a channel modelled as an annulus."""
+        from spindle import power
+
+        name = d.get("correlation")
+        needs = {"rotating_shaft": ("d_m",), "air_gap": ("r_rotor_m", "gap_m"),
+                 "coolant_channel": ("flow_l_min", "width_m", "height_m")}
+        if name not in needs:
+            self.add(f"{path}.correlation", f"unknown correlation {name!r}",
+                     f"use one of: {', '.join(needs)}")
+            return None
+        extra = set(d) - {"correlation", "factor", *needs[name]}
+        if extra:
+            self.add(f"{path}.{sorted(extra)[0]}", f"is not a parameter of '{name}'",
+                     f"give only {', '.join(needs[name])} (and factor)")
+            return None
+        n0 = len(self.problems)
+        args = [self.number(d, k, path, "SI", lo=0.0, lo_open=True) for k in needs[name]]
+        factor = self.number(d, "factor", path, "-", required=False, default=1.0, lo=0.0,
+                             lo_open=True)
+        if len(self.problems) > n0:
+            return None
+        try:
+            if name == "rotating_shaft":
+                table = power.shaft_film_table(*args)
+            elif name == "air_gap":
+                table = power.air_gap_film_table(*args)
+            else:
+                table = SpeedTable.constant(power.h_coolant_channel_W_m2K(*args))
+        except ValueError as exc:
+            self.add(path, f"the correlation cannot be evaluated ({exc})",
+                     "check the parameters against the correlation's range in docs/power.md")
+            return None
+        return SpeedTable(table.speed_rpm, tuple(factor * h for h in table.values))
 
     def power(self, data: dict, path: str) -> TimeSeries | None:
         """A constant power [W] or {time_s = [...], value = [...]} (linear in time)."""

@@ -144,3 +144,17 @@ def test_shipped_specs_load():
     assert {"spl2782", "fin-shaft"} <= set(shipped_specs())
     for path in shipped_specs().values():
         load_spec(path)
+
+
+def test_film_from_a_correlation(tmp_path):
+    from spindle.power import h_rotating_shaft_W_m2K
+
+    body = GOOD.replace("h_W_m2K = 10.0",
+                        'h_W_m2K = { correlation = "rotating_shaft", d_m = 0.08, factor = 2.0 }')
+    spec = load_spec(write_spec(tmp_path, body))
+    h = spec.surfaces[0].h_W_m2K
+    assert h(4300.0) == pytest.approx(2.0 * h_rotating_shaft_W_m2K(4300.0, 0.08))
+    bad = GOOD.replace("h_W_m2K = 10.0", 'h_W_m2K = { correlation = "magic", d_m = 0.08 }')
+    assert any(p.field == "surfaces[0].h_W_m2K.correlation" for p in problems(tmp_path, bad))
+    bad = GOOD.replace("h_W_m2K = 10.0", 'h_W_m2K = { correlation = "air_gap", d_m = 0.08 }')
+    assert any("not a parameter" in p.message for p in problems(tmp_path, bad))
