@@ -68,8 +68,6 @@ def _print_sensor_table(table: dict, title: str) -> None:
 def _read_cycle(name: str, spec, base):
     """A shipped cycle name, a cycle TOML, a step-table CSV (speed_rpm, duration_s, ...) or
     a time-series CSV (time_s, speed_rpm, T_env_C, T_coolant_C, <source>_W)."""
-    from dataclasses import replace as _replace
-
     from spindle.cycles import load_cycle
     from spindle.drive import cycle_load_case
     from spindle.loads import read_cycle_csv
@@ -80,15 +78,12 @@ def _read_cycle(name: str, spec, base):
                        if ln.strip() and not ln.lstrip().startswith("#")), "")
         if "time_s" in [h.strip() for h in header.split(",")]:
             return read_cycle_csv(path, [h.name for h in spec.heat_sources], base)
-    cycle = load_cycle(name)
-    return _replace(cycle_load_case(spec, cycle), name=cycle.name)
+    return cycle_load_case(spec, load_cycle(name))
 
 
 def _cmd_solve(args: argparse.Namespace) -> int:
     from compare.progress import Progress
     from reference import ReferenceModel
-    from spindle.cycles import load_cycle
-    from spindle.drive import cycle_load_case
     from spindle.loads import TimeSeries
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
@@ -102,8 +97,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     case = spec.default_load_case()
     inputs = [spec.path]
     if args.case:
-        cycle = load_cycle(args.case)
-        case = replace(cycle_load_case(spec, cycle), name=cycle.name)
+        case = _read_cycle(args.case, spec, case)
         if Path(args.case).is_file():
             inputs.append(args.case)
     if args.speed is not None:

@@ -54,7 +54,7 @@ class ThermoelasticModel:
         self.B = asm(thermal_coupling, tb, self.basis, lam=fields["lam"], mu=fields["mu"],
                      alpha=fields["alpha"]).tocsr()  # (n_u, n_T)
         self.f_cf = asm(centrifugal, self.basis, rho_rot=fields["rho_rot"])
-        self.P, keep = self._reduction(fixed_axial)
+        self.P = self._reduction(fixed_axial)
         self.K_red = (self.P.T @ K @ self.P).tocsr()
         self._lu = factorize(self.K_red)
         self._gains: dict[str, tuple[np.ndarray, float]] = {}
@@ -105,8 +105,7 @@ class ThermoelasticModel:
         col = -np.ones(n, dtype=np.int64)
         col[keep] = np.arange(len(keep))
         rows = np.nonzero(col[rep] >= 0)[0]
-        P = sp.csr_matrix((np.ones(len(rows)), (rows, col[rep[rows]])), shape=(n, len(keep)))
-        return P, keep
+        return sp.csr_matrix((np.ones(len(rows)), (rows, col[rep[rows]])), shape=(n, len(keep)))
 
     def _axial_support_dof(self) -> int:
         b = self.basis
@@ -151,6 +150,11 @@ class ThermoelasticModel:
             pts["TCP"] = (tip.z_end, 0.0 if tip.r_inner[1] == 0 else tip.r_inner[1],
                           ref[2], ref[3])
         return pts
+
+    def growth(self, U: np.ndarray) -> dict[str, float]:
+        """Every reading of :meth:`growth_points` [m] from a displacement vector U."""
+        return {k: float(((self.axial_probe(z, r) - self.axial_probe(zr, rr)) @ U)[0])
+                for k, (z, r, zr, rr) in self.growth_points().items()}
 
     def gain(self, sensor: str) -> tuple[np.ndarray, float]:
         """(g, c): the axial-displacement reading ``sensor`` (see :meth:`growth_points`) is

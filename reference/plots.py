@@ -125,17 +125,13 @@ def timeseries_png(times_s: np.ndarray, names: list[str], values_C: np.ndarray, 
     plt.close(fig)
 
 
-def deformed_png(model, T: np.ndarray, elastic, U: np.ndarray, path: Path, title: str = "",
-                 growth_m: dict | None = None) -> None:
+def deformed_png(grid, path: Path, title: str = "", growth_m: dict | None = None) -> None:
     """Half-section deformed by the displacement, exaggerated so that the largest
-    displacement shows as 3 % of the spindle length; colour: axial displacement [µm]."""
+    displacement shows as 3 % of the spindle length; colour: axial displacement [µm].
+    ``grid`` is a field grid with displacement (reference.fields.add_displacement)."""
     import matplotlib.tri as mtri
 
-    from reference.fields import add_displacement
-
     plt = _pyplot()
-    grid = field_grid(model, T)
-    add_displacement(grid, elastic, U)
     tri = grid.cells.reshape(-1, 4)[:, 1:]
     pts, d = grid.points[:, :2], grid.point_data["displacement"][:, :2]
     length = np.ptp(pts[:, 0])

@@ -120,8 +120,7 @@ class SteadyResult:
         atomic_write(out / "temperature.vtu", lambda tmp: grid.save(str(tmp)))
         files = ["summary.json", "sensors.csv", "temperature.vtu"]
         if self.U is not None and pictures:
-            plots.deformed_png(self.model, self.T, self.elastic, self.U,
-                               out / "deformation_section.png", self._title(), self.growth_m)
+            plots.deformed_png(grid, out / "deformation_section.png", self._title(), self.growth_m)
             files.append("deformation_section.png")
         if pictures:
             plots.section_png(self.model, self.T, out / "temperature_section.png", self._title())

@@ -41,9 +41,7 @@ class ReferenceModel:
         if self.elastic is not None:
             res.elastic = self.elastic
             res.U = self.elastic.displacement(res.T, res.speed_rpm, self.centrifugal)
-            res.growth_m = {k: float(self.elastic.read(k, res.T, res.speed_rpm,
-                                                        self.centrifugal))
-                            for k in self.readings}
+            res.growth_m = self.elastic.growth(res.U)
         return res
 
     def transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
@@ -57,13 +55,15 @@ class ReferenceModel:
         # value that applied in the step ending there (the first sample: the start value)
         t = res.times_s
         mid = np.concatenate([[t[0]], 0.5 * (t[1:] + t[:-1])])
-        omega2 = (np.asarray(case.speed_rpm(mid), dtype=float) * np.pi / 30.0) ** 2
+        speed = np.asarray(case.speed_rpm(mid), dtype=float)
+        omega2 = (speed * np.pi / 30.0) ** 2
         for k, (g, c) in gains.items():
             res.growth_m[k] = res.functionals[k] - T_ref * g.sum() \
                 + (omega2 * c if self.centrifugal else 0.0)
         if self.elastic is not None:  # displacement fields at the saved times, for ParaView
             res.elastic = self.elastic
+            at = np.searchsorted(t, res.field_times_s)  # saved times are grid times
             res.U_fields = np.array([
-                self.elastic.displacement(T, float(case.speed_rpm(t)), self.centrifugal)
-                for t, T in zip(res.field_times_s, res.fields_K, strict=True)])
+                self.elastic.displacement(T, speed[k], self.centrifugal)
+                for k, T in zip(at, res.fields_K, strict=True)])
         return res

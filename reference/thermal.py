@@ -163,10 +163,8 @@ class ThermalModel:
                 area = TWO_PI * asm(surface_flux, fb, qs=1.0).sum()
                 sources.append((src, asm(surface_flux, fb, qs=1.0 / area)))
             else:
-                els = sm.elements_of(src.part, src.section)
-                cb = Basis(sm.mesh, basis.elem, elements=els, intorder=2 * self.order + 1)
-                vol = TWO_PI * asm(volume_source, cb, q=1.0).sum()
-                sources.append((src, asm(volume_source, cb, q=1.0 / vol)))
+                w = self._volume_weights(src.part, src.section)
+                sources.append((src, w / (TWO_PI * w.sum())))  # 2 pi w.sum() is the volume
         return Operator(K_solid, M, links, films, contacts, sources)
 
     def _contact_matrix(self, fa: np.ndarray, fb: np.ndarray) -> sp.csr_matrix:
@@ -189,12 +187,16 @@ class ThermalModel:
         return (D.T @ Ma @ D).tocsr()
 
     # ------------------------------------------------------------------ sensors
+    def _volume_weights(self, part: str, section: str | None = None) -> np.ndarray:
+        """int phi_i r dA over the part (or one section): sums to its volume / 2 pi [m3]."""
+        sm = self.smesh
+        cb = Basis(sm.mesh, self.basis.elem, elements=sm.elements_of(part, section),
+                   intorder=2 * self.order + 1)
+        return asm(volume_source, cb, q=1.0)
+
     def mean_functional(self, part: str) -> np.ndarray:
         """Vector w with w . T = volume-mean temperature of ``part`` [K]."""
-        sm = self.smesh
-        cb = Basis(sm.mesh, self.basis.elem, elements=sm.elements_of(part),
-                   intorder=2 * self.order + 1)
-        w = asm(volume_source, cb, q=1.0)
+        w = self._volume_weights(part)
         return w / w.sum()
 
     def probe_matrix(self, points: np.ndarray) -> sp.csr_matrix:
