@@ -125,34 +125,49 @@ class PaperStudy:
             P1_peak_um=float(tr.growth_m["P1"].max()) * 1e6)
 
 
-def calibrate(study: PaperStudy, start: dict[str, float] | None = None,
+#: plausible ranges of the calibration factors (film and air-gap correlations are trusted to
+#: a factor of about 3; Harris gives f0 = 0.7-2 for grease-lubricated angular-contact pairs,
+#: halved for run-in grease; the rotor carries a few to 40 % of an induction motor's losses)
+PLAUSIBLE = {"coolant": (0.3, 3.0), "housing_air": (0.3, 3.0), "rotating": (0.3, 3.0),
+             "air_gap": (0.3, 3.0), "contact": (0.2, 5.0), "f0": (0.25, 3.0),
+             "rotor_share": (0.02, 0.4)}
+#: shipped starting point of every factor (1 = the spec's own value)
+SHIPPED = {"coolant": 1.0, "housing_air": 1.0, "rotating": 1.0, "air_gap": 1.0, "contact": 1.0,
+           "f0": 0.30, "rotor_share": 0.06}
+
+
+def calibrate(study: PaperStudy, targets: tuple[str, ...] | None = None,
+              parameters: tuple[str, ...] = PARAMETERS,
+              bounds: dict[str, tuple[float, float]] | None = None,
+              start: dict[str, float] | None = None,
               verbose: bool = True) -> tuple[dict[str, float], PaperFigures]:
-    """Fit the factors (log scale, bounded) so the figures meet the paper's targets."""
+    """Fit ``parameters`` (log scale, within ``bounds``, default :data:`PLAUSIBLE`) so the
+    figures named in ``targets`` (default: all but the losses, which follow from the power
+    balance) meet the paper's values."""
     from scipy.optimize import least_squares
 
-    x0 = {"coolant": 1.0, "housing_air": 1.0, "rotating": 1.0, "air_gap": 1.0, "contact": 1.0,
-          "f0": 0.5, "rotor_share": 0.06, **(start or {})}
-    lo = {"coolant": 0.005, "housing_air": 0.2, "rotating": 0.02, "air_gap": 0.05,
-          "contact": 0.05, "f0": 0.1, "rotor_share": 0.02}
-    hi = {"coolant": 5.0, "housing_air": 3.0, "rotating": 3.0, "air_gap": 3.0, "contact": 20.0,
-          "f0": 3.0, "rotor_share": 0.3}
-    keys = list(PARAMETERS)
-    fitted = [k for k in TARGETS if k != "losses_W"]  # losses follow from the power balance
+    bounds = {**PLAUSIBLE, **(bounds or {})}
+    x0 = {**SHIPPED, **(start or {})}
+    keys = list(parameters)
+    fitted = list(targets or [k for k in TARGETS if k != "losses_W"])
+    lo = np.log([bounds[k][0] for k in keys])
+    hi = np.log([bounds[k][1] for k in keys])
+    z0 = np.clip(np.log([x0[k] for k in keys]), lo, hi)
 
     def residuals(z: np.ndarray) -> np.ndarray:
         f = study.figures(dict(zip(keys, np.exp(z), strict=True)))
         dev = f.deviations()
-        # weak pull towards the starting values keeps the fit well posed (7 unknowns, 5 targets)
-        prior = 0.02 * (z - np.log([x0[k] for k in keys]))
+        # weak pull towards the starting values keeps the fit well posed when there are more
+        # factors than targets
+        prior = 0.02 * (z - z0)
         r = np.concatenate([[dev[k] for k in fitted], prior])
         if verbose:
             print("  " + " ".join(f"{k}={v:.4g}" for k, v in zip(keys, np.exp(z), strict=True))
                   + " | " + " ".join(f"{k}={100 * dev[k]:+.1f}%" for k in fitted), flush=True)
         return r
 
-    sol = least_squares(residuals, np.log([x0[k] for k in keys]),
-                        bounds=(np.log([lo[k] for k in keys]), np.log([hi[k] for k in keys])),
-                        diff_step=1e-3, xtol=1e-6, ftol=1e-8, max_nfev=200)
+    sol = least_squares(residuals, z0, bounds=(lo, hi), diff_step=1e-3, xtol=1e-6, ftol=1e-8,
+                        max_nfev=200)
     factors = dict(zip(keys, np.exp(sol.x), strict=True))
     return factors, study.figures(factors)
 
@@ -161,11 +176,15 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description="Reproduce (or calibrate to) the paper's figures.")
     ap.add_argument("--level", type=int, default=1)
     ap.add_argument("--calibrate", action="store_true")
+    ap.add_argument("--targets", nargs="+", choices=[k for k in TARGETS if k != "losses_W"],
+                    help="figures to fit (default: all but the losses)")
+    ap.add_argument("--parameters", nargs="+", choices=PARAMETERS, default=list(PARAMETERS))
     args = ap.parse_args(argv)
     t = time.perf_counter()
     study = PaperStudy(level=args.level)
     if args.calibrate:
-        factors, fig = calibrate(study)
+        factors, fig = calibrate(study, args.targets and tuple(args.targets),
+                                 tuple(args.parameters))
         print("factors:", {k: round(v, 4) for k, v in factors.items()})
     else:
         fig = study.figures()

@@ -1,14 +1,25 @@
-"""The paper-figure harness (compare/paper.py): plumbing and directions of the factors.
+"""The paper's figures (compare/paper.py, docs/paper.md).
 
-The paper's figures themselves are calibration targets that the shipped spec does not yet
-meet (docs/paper.md explains why the fitted set is not shipped); these tests check that the
-harness reads the figures the way docs/paper.md says and that each factor acts on the
-figure it should.
+The spl-16h peaks T1 = 32.4 degC and P1 = 6.5 µm and the nominal losses 5146 W are
+CALIBRATION TARGETS, not predictions: the shipped bearing friction factor f0 and the film
+factor of the rotating surfaces were fitted to the two peaks (docs/paper.md), and the motor
+parameters to the losses. The test asserts them within the issue's 5 % on FEM level 1, the
+level the fit ran on (level 2 gives +2.0 % and -3.4 %, docs/paper.md).
+The nominal shaft, housing and growth figures are not met by any plausible parameter set
+(docs/paper.md); the other tests check that the harness reads the figures as documented and
+that each factor acts on the figure it should.
 """
 
 import pytest
 
 from compare.paper import TARGETS, PaperStudy
+
+
+def test_calibration_targets_within_five_percent():
+    f = PaperStudy(level=1).figures()
+    dev = f.deviations()
+    for key in ("losses_W", "T1_peak_C", "P1_peak_um"):  # calibration targets (module doc)
+        assert abs(dev[key]) <= 0.05, (key, getattr(f, key), TARGETS[key])
 
 
 @pytest.fixture(scope="module")
