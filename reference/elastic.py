@@ -139,17 +139,8 @@ class ThermoelasticModel:
         return pm[0]
 
     def growth_points(self) -> dict[str, tuple[float, float, float, float]]:
-        """Axial-displacement readings: every displacement sensor of the spec and, when a
-        tool is clamped, ``TCP`` (tool tip on the axis) against the first sensor's reference."""
-        pts = {s.name: (s.z, s.r, s.z_ref, s.r_ref) for s in self.spec.sensors
-               if s.kind == "axial_displacement"}
-        tools = [p for p in self.spec.parts if p.role == "tool"]
-        if tools and pts:
-            ref = next(iter(pts.values()))
-            tip = max(tools[0].sections, key=lambda s: s.z_end)
-            pts["TCP"] = (tip.z_end, 0.0 if tip.r_inner[1] == 0 else tip.r_inner[1],
-                          ref[2], ref[3])
-        return pts
+        """Axial-displacement readings (see :meth:`spindle.spec.Spec.growth_points`)."""
+        return self.spec.growth_points()
 
     def growth(self, U: np.ndarray) -> dict[str, float]:
         """Every reading of :meth:`growth_points` [m] from a displacement vector U."""

@@ -5,30 +5,17 @@ Temperatures are kept in K; tables and files name their unit (``T_C`` in degC).
 
 from __future__ import annotations
 
-import csv
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from spindle import plots as shared_plots
 from spindle.outputs import atomic_write
+from spindle.outputs import write_csv as _write_csv
+from spindle.outputs import write_json as _write_json
 
 KELVIN = 273.15
-
-
-def _write_csv(path: Path, header: list[str], rows) -> None:
-    def write(tmp: Path) -> None:
-        with open(tmp, "w", newline="", encoding="utf-8") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            w.writerows(rows)
-
-    atomic_write(path, write)
-
-
-def _write_json(path: Path, data: dict) -> None:
-    atomic_write(path, lambda tmp: tmp.write_text(json.dumps(data, indent=2) + "\n", "utf-8"))
 
 
 def _mesh_info(model) -> dict:
@@ -125,7 +112,7 @@ class SteadyResult:
         if pictures:
             plots.section_png(self.model, self.T, out / "temperature_section.png", self._title())
             plots.revolved_png(self.model, self.T, out / "temperature_3d.png", self._title())
-            plots.sensor_profile_png(table, out / "sensor_profile.png", self._title())
+            shared_plots.sensor_profile_png(table, out / "sensor_profile.png", self._title())
             files += ["temperature_section.png", "temperature_3d.png", "sensor_profile.png"]
         return [out / f for f in files]
 
@@ -231,14 +218,14 @@ class TransientResult:
         if pictures:
             title = f"{self.model.spec.name}: {self.case.name}"
             arrays = {s.name: s.array for s in self.model.spec.temperature_sensors() if s.array}
-            plots.timeseries_png(self.times_s, self.names, self.sensor_K - KELVIN,
+            shared_plots.timeseries_png(self.times_s, self.names, self.sensor_K - KELVIN,
                                  out / "sensors_timeseries.png", title, arrays)
             plots.section_png(self.model, self.fields_K[-1], out / "temperature_section.png",
                               f"{title}, t = {self.field_times_s[-1] / 3600:.2f} h")
             plots.revolved_png(self.model, self.fields_K[-1], out / "temperature_3d.png", title)
             files += ["sensors_timeseries.png", "temperature_section.png", "temperature_3d.png"]
             if "P1" in self.growth_m and "T1" in self.names:
-                plots.growth_band_png(self.times_s, self.sensor("T1") - KELVIN,
+                shared_plots.growth_band_png(self.times_s, self.sensor("T1") - KELVIN,
                                       self.growth_m["P1"] * 1e6, out / "T1_P1_tolerance.png",
                                       title)
                 files.append("T1_P1_tolerance.png")

@@ -24,7 +24,7 @@ from skfem import Basis, ElementTriP0, ElementTriP1, ElementTriP2, FacetBasis, a
 from meshes import SpindleMesh
 from reference.forms import capacity, conduction, film, surface_flux, volume_source
 from spindle.errors import SolverError
-from spindle.loads import LoadCase
+from spindle.loads import LoadCase, time_grid
 from spindle.spec import BearingLink, ContactLink
 
 TWO_PI = 2.0 * math.pi
@@ -257,9 +257,7 @@ class ThermalModel:
             raise ValueError("theta must be within [0, 1]")
         if dt_s <= 0 or case.duration_s <= 0:
             raise SolverError("a transient run needs dt_s > 0 and a duration > 0")
-        grid = np.unique(np.concatenate([np.arange(0.0, case.duration_s, dt_s),
-                                         case.breakpoints(), [case.duration_s]]))
-        grid = grid[np.concatenate([[True], np.diff(grid) > 1e-9 * dt_s])]
+        grid = time_grid(case, dt_s)
         op = self.op
         N = op.M.shape[0]
         if T0 is None:

@@ -118,6 +118,14 @@ class LoadCase:
         return replace(self, sources={**self.sources, **sources})
 
 
+def time_grid(case: LoadCase, dt_s: float) -> np.ndarray:
+    """Output times of a transient run [s]: every dt_s, plus every sample time of the
+    inputs, so that steps land on the inputs' corners (both models use the same grid)."""
+    grid = np.unique(np.concatenate([np.arange(0.0, case.duration_s, dt_s),
+                                     case.breakpoints(), [case.duration_s]]))
+    return grid[np.concatenate([[True], np.diff(grid) > 1e-9 * dt_s])]
+
+
 _KNOWN_CYCLE_COLUMNS = {"time_s", "speed_rpm", "T_env_C", "T_coolant_C"}
 
 

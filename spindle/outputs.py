@@ -4,6 +4,8 @@ half-written output; an output never replaces one of the run's inputs."""
 
 from __future__ import annotations
 
+import csv
+import json
 import os
 import shutil
 import tempfile
@@ -55,3 +57,19 @@ def output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[
             os.replace(f, dest)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def write_csv(path: Path, header: list[str], rows) -> None:
+    """A CSV file with a header row, written atomically."""
+    def write(tmp: Path) -> None:
+        with open(tmp, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(header)
+            w.writerows(rows)
+
+    atomic_write(path, write)
+
+
+def write_json(path: Path, data: dict) -> None:
+    """An indented JSON file, written atomically."""
+    atomic_write(path, lambda tmp: tmp.write_text(json.dumps(data, indent=2) + "\n", "utf-8"))

@@ -188,6 +188,20 @@ class Spec:
     def temperature_sensors(self) -> list[Sensor]:
         return [s for s in self.sensors if s.kind == "temperature"]
 
+    def growth_points(self) -> dict[str, tuple[float, float, float, float]]:
+        """Axial-growth readings (z, r, z_ref, r_ref) [m]: every displacement sensor and, when a
+        tool is clamped, ``TCP`` (tool tip on the axis, or on its bore) against the first
+        sensor's reference point (paper sec. 2.1: the TCP is at the tool tip)."""
+        pts = {s.name: (s.z, s.r, s.z_ref, s.r_ref) for s in self.sensors
+               if s.kind == "axial_displacement"}
+        tools = self.parts_with_role("tool")
+        if tools and pts:
+            ref = next(iter(pts.values()))
+            tip = max(tools[0].sections, key=lambda s: s.z_end)
+            pts["TCP"] = (tip.z_end, 0.0 if tip.r_inner[1] == 0 else tip.r_inner[1],
+                          ref[2], ref[3])
+        return pts
+
     def default_load_case(self) -> LoadCase:
         """Constant inputs from the spec's [operating] table and heat sources."""
         return LoadCase(
