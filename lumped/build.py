@@ -1,0 +1,484 @@
+"""The paper's function-block network built from the spec (CAD description): N thermal masses
+along the shaft and N along the housing, plus the bearings, rotor, stator, sleeve, tool.
+
+Discretisation (vertex-centred, like the paper's 11 virtual sensors spaced l/10):
+
+- A part of role ``shaft`` or ``housing`` gets ``nodes`` masses at z_i = z_0 + i L/(N-1);
+  mass i owns the slice [z_i - h/2, z_i + h/2] (half slices at the ends). Any other part gets
+  max(1, round((N-1) L_part / L_shaft) + 1) masses the same way, so refining N refines all
+  of them (one mass sits at the part's middle).
+- A bearing part with a bearing link is the paper's bearing: each ring is one mass and the
+  rolling layer's conductance G(n) joins them (its small capacity is split between the rings).
+- Capacity: rho c of each section's material times its volume in the slice (eq. 6, 9).
+- Axial conductance between neighbouring masses: 1 / integral dz / (k_z A(z)).
+- Two touching parts exchange heat through each overlap of their slices, in series:
+  conduction from each mass to the interface (radial: ln(r_face / r_c) / (2 pi k_r dz) from
+  the slice's mean radius r_c = sqrt((r_i^2 + r_o^2) / 2); axial: from the slice's middle),
+  and the contact conductance h A of a contact link (eq. 7, alpha_ijcont). Without a contact
+  link the parts are bonded.
+- The rotor-stator air gap and the bearings are :class:`~lumped.blocks.Convection` blocks
+  whose conductance follows the speed.
+- Each named surface with a film coefficient is a convection to ambient or coolant from the
+  masses whose slices carry its exposed faces (same faces as the mesh: spindle.faces),
+  with the conduction from the mass to the face in series.
+- Heat sources go into the masses by volume (part or section) or by area (surface).
+
+Approximations of the model form, which the comparison with the FEM reference measures:
+one temperature per slice (no radial gradient inside a slice beyond the series conduction to
+its faces), radially stacked sections of a non-bearing part share their slice's mass, and a
+bearing's rolling layer exchanges heat only with its own rings.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lumped.blocks import (
+    Convection,
+    FixedTemperature,
+    HeatCapacitor,
+    PrescribedHeatFlow,
+    ThermalConductor,
+)
+from lumped.network import Network, ThermalSystem
+from spindle.errors import Problem, SpecError
+from spindle.faces import Face, exposed_faces, surface_faces
+from spindle.geometry import TOL_M
+from spindle.loads import SpeedTable
+from spindle.spec import (
+    BEARING_ROLES,
+    AirGapLink,
+    BearingLink,
+    ContactLink,
+    Part,
+    Section,
+    Spec,
+)
+
+#: the paper's models: 5 masses along shaft and housing (Fig. 5), and 11 (the 11 virtual
+#: sensors of [6], extended by the two bearing temperatures)
+PRESETS = {"paper5": 5, "paper11": 11}
+CHAIN_ROLES = ("shaft", "housing")
+_GAUSS = np.polynomial.legendre.leggauss(6)
+
+
+@dataclass
+class Mass:
+    """One thermal mass: a z slice of a part, or one ring of a bearing."""
+
+    name: str
+    part: str
+    z_m: float  # node position [m]
+    z_lo: float  # slice [m]
+    z_hi: float
+    section: Section | None = None  # bearing ring
+    block: HeatCapacitor | None = None
+    index: int = -1  # position in the state vector
+
+
+@dataclass
+class PartMasses:
+    part: Part
+    masses: list[Mass]
+    ring: bool = False
+
+    def at(self, z: float, section: Section | None = None) -> Mass | None:
+        """The mass holding (z, section): ring by section, slice by z."""
+        if self.ring:
+            return next((m for m in self.masses if m.section is section), None)
+        for m in self.masses:
+            if m.z_lo - TOL_M <= z <= m.z_hi + TOL_M:
+                return m
+        return None
+
+    def interpolation(self, z: float) -> dict[int, float]:
+        """Weights on the masses' state indices giving the temperature at z (linear between
+        node positions, constant beyond the end nodes)."""
+        ms = self.masses
+        if len(ms) == 1:
+            return {ms[0].index: 1.0}
+        zs = np.array([m.z_m for m in ms])
+        k = int(np.clip(np.searchsorted(zs, z) - 1, 0, len(ms) - 2))
+        s = float(np.clip((z - zs[k]) / (zs[k + 1] - zs[k]), 0.0, 1.0))
+        return {ms[k].index: 1.0 - s, ms[k + 1].index: s}
+
+
+@dataclass
+class LumpedNetwork:
+    """The network of a spec with its masses, ready to assemble."""
+
+    spec: Spec
+    nodes: int
+    network: Network
+    parts: dict[str, PartMasses]
+    masses: list[Mass] = field(default_factory=list)
+    system: ThermalSystem | None = None
+
+
+def _section_area(sec: Section, z: np.ndarray) -> np.ndarray:
+    return np.pi * (np.asarray(sec.r_out(z)) ** 2 - np.asarray(sec.r_in(z)) ** 2)
+
+
+def _volume(sec: Section, lo: float, hi: float) -> float:
+    a, b = max(lo, sec.z_start), min(hi, sec.z_end)
+    if b - a <= TOL_M:
+        return 0.0
+    z = [a, 0.5 * (a + b), b]  # Simpson is exact: the area is quadratic in z
+    A = _section_area(sec, np.array(z))
+    return float((b - a) * (A[0] + 4 * A[1] + A[2]) / 6.0)
+
+
+def _r_mean(sec: Section, z: float) -> float:
+    ri, ro = float(sec.r_in(z)), float(sec.r_out(z))
+    return float(np.sqrt(0.5 * (ri * ri + ro * ro)))
+
+
+def _axial_resistance(spec: Spec, part: Part, z0: float, z1: float) -> float:
+    """integral dz / (k_z A(z)) from z0 to z1 [K/W], Gauss-Legendre per section piece."""
+    x, w = _GAUSS
+    edges = sorted({z0, z1, *[s.z_start for s in part.sections], *[s.z_end for s in part.sections]})
+    edges = [e for e in edges if z0 - TOL_M <= e <= z1 + TOL_M]
+    total = 0.0
+    for a, b in zip(edges, edges[1:], strict=False):
+        if b - a <= TOL_M:
+            continue
+        z = 0.5 * (a + b) + 0.5 * (b - a) * x
+        kA = np.zeros_like(z)
+        for s in part.sections:
+            inside = (z >= s.z_start) & (z <= s.z_end)
+            kA += np.where(inside, spec.materials[s.material].k_z_W_mK * _section_area(s, z), 0.0)
+        if np.any(kA <= 0):
+            raise SpecError([Problem(spec.path, f"parts.{part.name}", f"has no cross-section "
+                                     f"between z = {a:g} and {b:g} m", "make its sections "
+                                     "follow each other without axial gaps")])
+        total += 0.5 * (b - a) * float(np.sum(w / kA))
+    return total
+
+
+def _node_count(spec: Spec, part: Part, nodes: int) -> int:
+    if part.role in CHAIN_ROLES:
+        return nodes
+    shafts = spec.parts_with_role("shaft")
+    ref = shafts[0] if shafts else part
+    L_ref = max(s.z_end for s in ref.sections) - min(s.z_start for s in ref.sections)
+    L = max(s.z_end for s in part.sections) - min(s.z_start for s in part.sections)
+    return max(1, int(round((nodes - 1) * L / L_ref)) + 1)
+
+
+def _slices(part: Part, n: int) -> list[tuple[float, float, float]]:
+    z0 = min(s.z_start for s in part.sections)
+    z1 = max(s.z_end for s in part.sections)
+    if n == 1:
+        return [(0.5 * (z0 + z1), z0, z1)]
+    zs = np.linspace(z0, z1, n)
+    h = (z1 - z0) / (n - 1)
+    return [(float(z), float(max(z0, z - h / 2)), float(min(z1, z + h / 2))) for z in zs]
+
+
+def _bearing_sections(spec: Spec, part: Part) -> tuple[Section, Section, Section, BearingLink] | None:
+    """(inner ring, rolling layer, outer ring, link) of a bearing part, or None."""
+    link = next((lk for lk in spec.links if isinstance(lk, BearingLink) and lk.part == part.name),
+                None)
+    if link is None or part.role not in BEARING_ROLES:
+        return None
+    rolling = next(s for s in part.sections if s.name == link.section)
+    z = 0.5 * (rolling.z_start + rolling.z_end)
+    inner = next((s for s in part.sections if s is not rolling
+                  and abs(float(s.r_out(z)) - float(rolling.r_in(z))) <= TOL_M), None)
+    outer = next((s for s in part.sections if s is not rolling
+                  and abs(float(s.r_in(z)) - float(rolling.r_out(z))) <= TOL_M), None)
+    if inner is None or outer is None or len(part.sections) != 3:
+        raise SpecError([Problem(spec.path, f"parts.{part.name}", "a bearing part is an inner "
+                                 f"ring, the rolling section '{link.section}' and an outer ring",
+                                 "give it exactly these three sections, rings against the "
+                                 "rolling section")])
+    return inner, rolling, outer, link
+
+
+def _radial_R(spec: Spec, sec: Section, r_face: float, dz: float) -> float:
+    """Conduction from the slice's mean radius to a line face at r_face [K/W]."""
+    rc = _r_mean(sec, 0.5 * (sec.z_start + sec.z_end))
+    k = spec.materials[sec.material].k_r_W_mK
+    return abs(np.log(max(r_face, 1e-12) / rc)) / (2 * np.pi * k * dz)
+
+
+def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = True
+                  ) -> LumpedNetwork:
+    """The function-block network of ``spec`` with ``nodes`` masses along shaft and housing
+    (an int >= 2, or a preset name of :data:`PRESETS`). ``radial_conduction=False`` drops the
+    conduction from a mass to its faces (film and contact resistances only), as eq. 7 does."""
+    if isinstance(nodes, str):
+        if nodes not in PRESETS:
+            raise SpecError([Problem("--nodes", "nodes", f"unknown preset '{nodes}'",
+                                     f"use an integer >= 2 or one of {sorted(PRESETS)}")])
+        nodes = PRESETS[nodes]
+    if int(nodes) != nodes or nodes < 2:
+        raise SpecError([Problem("--nodes", "nodes", f"{nodes!r} is not an integer >= 2",
+                                 "give the number of masses along shaft and housing, >= 2")])
+    nodes = int(nodes)
+    rad = 1.0 if radial_conduction else 0.0
+    net = Network(f"{spec.name}-{nodes}")
+    parts: dict[str, PartMasses] = {}
+    masses: list[Mass] = []
+    rings: dict[str, tuple] = {}
+
+    # ------------------------------------------------------------------ masses
+    for part in spec.parts:
+        bs = _bearing_sections(spec, part)
+        if bs is not None:
+            inner, rolling, outer, _ = bs
+            rings[part.name] = bs
+            pm = PartMasses(part, [], ring=True)
+            for tag, sec in (("inner", inner), ("outer", outer)):
+                C = sum(spec.materials[s.material].rho_kg_m3 * spec.materials[s.material].c_J_kgK
+                        * s.volume_m3 * (1.0 if s is sec else 0.5)
+                        for s in (sec, rolling))
+                m = Mass(f"{part.name}.{tag}", part.name, 0.5 * (sec.z_start + sec.z_end),
+                         sec.z_start, sec.z_end, section=sec)
+                m.block = HeatCapacitor(m.name, C_J_K=C, part=part.name, z_m=m.z_m)
+                pm.masses.append(m)
+            parts[part.name] = pm
+        else:
+            pm = PartMasses(part, [])
+            for k, (z, lo, hi) in enumerate(_slices(part, _node_count(spec, part, nodes))):
+                C = sum(spec.materials[s.material].rho_kg_m3 * spec.materials[s.material].c_J_kgK
+                        * _volume(s, lo, hi) for s in part.sections)
+                m = Mass(f"{part.name}[{k}]", part.name, z, lo, hi)
+                m.block = HeatCapacitor(m.name, C_J_K=C, part=part.name, z_m=z)
+                pm.masses.append(m)
+            parts[part.name] = pm
+        for m in parts[part.name].masses:
+            net.add(m.block)
+            masses.append(m)
+
+    ports = {"ambient": None, "coolant": None}
+
+    def fixed(ref: str):
+        if ports[ref] is None:
+            ports[ref] = net.add(FixedTemperature(ref, source=ref))
+        return ports[ref].port
+
+    # ------------------------------------------------------------------ axial chains
+    for pm in parts.values():
+        if pm.ring:
+            continue
+        for a, b in zip(pm.masses, pm.masses[1:], strict=False):
+            R = _axial_resistance(spec, pm.part, a.z_m, b.z_m)
+            c = net.add(ThermalConductor(f"axial:{a.name}-{b.name}", G_W_K=1.0 / R))
+            net.connect(a.block.port, c.port_a)
+            net.connect(b.block.port, c.port_b)
+
+    # ------------------------------------------------------------------ interfaces
+    contact_h = {frozenset(lk.parts): lk.h_W_m2K for lk in spec.links
+                 if isinstance(lk, ContactLink)}
+    conductance: dict[tuple[str, str], float] = {}
+
+    def owner(part: Part, sec: Section, z: float) -> Mass | None:
+        pm = parts[part.name]
+        if pm.ring:
+            inner, rolling, outer, _ = rings[part.name]
+            if sec is rolling:
+                return None  # the rolling layer touches only its rings (module docstring)
+            return pm.at(z, sec)
+        return pm.at(z)
+
+    def edges_of(part: Part) -> list[float]:
+        return [e for m in parts[part.name].masses for e in (m.z_lo, m.z_hi)]
+
+    sections = list(spec.sections())
+    for ia, (pa, sa) in enumerate(sections):
+        for pb, sb in sections[ia + 1:]:
+            if pa.name == pb.name:
+                continue
+            h = contact_h.get(frozenset((pa.name, pb.name)))
+            a, b = max(sa.z_start, sb.z_start), min(sa.z_end, sb.z_end)
+            if b - a > TOL_M:  # radial interface?
+                for lo, hi in ((sa, sb), (sb, sa)):
+                    if not all(abs(float(lo.r_out(z)) - float(hi.r_in(z))) <= TOL_M
+                               for z in (a, b)):
+                        continue
+                    plo, phi = (pa, pb) if lo is sa else (pb, pa)
+                    cuts = sorted({a, b, *[e for e in edges_of(plo) + edges_of(phi) if a < e < b]})
+                    for p, q in zip(cuts, cuts[1:], strict=False):
+                        zm, dz = 0.5 * (p + q), q - p
+                        ma, mb = owner(plo, lo, zm), owner(phi, hi, zm)
+                        if ma is None or mb is None or ma is mb:
+                            continue
+                        r = float(lo.r_out(zm))
+                        R = rad * (_radial_R(spec, lo, r, dz) + _radial_R(spec, hi, r, dz))
+                        if h is not None:
+                            R += 1.0 / (h * 2 * np.pi * r * dz)
+                        key = (ma.name, mb.name)
+                        conductance[key] = conductance.get(key, 0.0) + 1.0 / R
+                continue
+            for first, second, pf, ps in ((sa, sb, pa, pb), (sb, sa, pb, pa)):
+                if abs(first.z_end - second.z_start) > TOL_M:
+                    continue
+                z = first.z_end
+                r1 = max(float(first.r_in(z)), float(second.r_in(z)))
+                r2 = min(float(first.r_out(z)), float(second.r_out(z)))
+                if r2 - r1 <= TOL_M:
+                    continue
+                A = np.pi * (r2 * r2 - r1 * r1)
+                ma, mb = owner(pf, first, z - TOL_M), owner(ps, second, z + TOL_M)
+                if ma is None or mb is None:
+                    continue
+                R = 0.0
+                for m, sec in ((ma, first), (mb, second)):
+                    mid = 0.5 * (m.z_lo + m.z_hi)
+                    R += rad * abs(z - mid) / (spec.materials[sec.material].k_z_W_mK * A)
+                if h is not None:
+                    R += 1.0 / (h * A)
+                if R <= 0:
+                    continue
+                key = (ma.name, mb.name)
+                conductance[key] = conductance.get(key, 0.0) + 1.0 / R
+    by_name = {m.name: m for m in masses}
+    for (na, nb), G in conductance.items():
+        c = net.add(ThermalConductor(f"contact:{na}-{nb}", G_W_K=G))
+        net.connect(by_name[na].block.port, c.port_a)
+        net.connect(by_name[nb].block.port, c.port_b)
+
+    # ------------------------------------------------------------------ bearings
+    for name, (inner, rolling, outer, link) in rings.items():
+        L = rolling.z_end - rolling.z_start
+        z = 0.5 * (rolling.z_start + rolling.z_end)
+        R_rings = rad * (_radial_R(spec, inner, float(rolling.r_in(z)), L)
+                         + _radial_R(spec, outer, float(rolling.r_out(z)), L))
+        c = net.add(Convection(f"bearing:{name}", Gc_W_K=_series(link.G_W_K, R_rings)))
+        net.connect(parts[name].masses[0].block.port, c.port_a)
+        net.connect(parts[name].masses[1].block.port, c.port_b)
+
+    # ------------------------------------------------------------------ air gap
+    for lk in spec.links:
+        if not isinstance(lk, AirGapLink):
+            continue
+        pin, pout = spec.part(lk.inner), spec.part(lk.outer)
+        pieces: dict[tuple[str, str], list[tuple[float, float]]] = {}
+        for si in pin.sections:
+            for so in pout.sections:
+                a, b = max(si.z_start, so.z_start), min(si.z_end, so.z_end)
+                if b - a <= TOL_M:
+                    continue
+                cuts = sorted({a, b, *[e for e in edges_of(pin) + edges_of(pout) if a < e < b]})
+                for p, q in zip(cuts, cuts[1:], strict=False):
+                    zm, dz = 0.5 * (p + q), q - p
+                    ma, mb = owner(pin, si, zm), owner(pout, so, zm)
+                    r = float(si.r_out(zm))
+                    R = rad * (_radial_R(spec, si, r, dz)
+                               + _radial_R(spec, so, float(so.r_in(zm)), dz))
+                    pieces.setdefault((ma.name, mb.name), []).append((2 * np.pi * r * dz, R))
+        for (na, nb), pcs in pieces.items():
+            c = net.add(Convection(f"air_gap:{na}-{nb}", Gc_W_K=_film(lk.h_W_m2K, pcs)))
+            net.connect(by_name[na].block.port, c.port_a)
+            net.connect(by_name[nb].block.port, c.port_b)
+
+    # ------------------------------------------------------------------ surfaces, sources
+    faces = exposed_faces(spec)
+
+    def face_pieces(f: Face) -> list[tuple[Mass, float, float]]:
+        """(mass, area, conduction resistance to the face) for each slice the face crosses."""
+        part = spec.part(f.part)
+        if f.is_line:
+            cuts = sorted({f.lo, f.hi, *[e for e in edges_of(part) if f.lo < e < f.hi]})
+            out = []
+            for p, q in zip(cuts, cuts[1:], strict=False):
+                piece = Face(f.part, f.section, f.side, p, q)
+                zm = 0.5 * (p + q)
+                m = owner(part, f.section, zm)
+                if m is None:
+                    continue
+                out.append((m, piece.area_m2, rad * _radial_R(spec, f.section, f.radius(zm), q - p)))
+            return out
+        m = owner(part, f.section, f.z - TOL_M if f.side == "front" else f.z + TOL_M)
+        if m is None:
+            return []
+        A = f.area_m2
+        mid = 0.5 * (m.z_lo + m.z_hi)
+        return [(m, A, rad * abs(f.z - mid) / (spec.materials[f.section.material].k_z_W_mK * A))]
+
+    surface_map: dict[str, list[tuple[Mass, float, float]]] = {}
+    for s in spec.surfaces:
+        surface_map[s.name] = [p for f in surface_faces(s, faces) for p in face_pieces(f)]
+        if s.h_W_m2K is None:
+            continue
+        grouped: dict[str, list[tuple[float, float]]] = {}
+        for m, A, R in surface_map[s.name]:
+            grouped.setdefault(m.name, []).append((A, R))
+        for mname, pcs in grouped.items():
+            c = net.add(Convection(f"film:{s.name}:{mname}", Gc_W_K=_film(s.h_W_m2K, pcs)))
+            net.connect(by_name[mname].block.port, c.port_a)
+            net.connect(fixed(s.T_ref), c.port_b)
+
+    for src in spec.heat_sources:
+        shares: dict[str, float] = {}
+        if src.surface is not None:
+            pcs = surface_map[src.surface]
+            total = sum(A for _, A, _ in pcs)
+            for m, A, _ in pcs:
+                shares[m.name] = shares.get(m.name, 0.0) + A / total
+        else:
+            part = spec.part(src.part)
+            secs = [s for s in part.sections if src.section is None or s.name == src.section]
+            pm = parts[part.name]
+            weights: dict[str, float] = {}
+            for s in secs:
+                if pm.ring:
+                    inner, rolling, outer, _ = rings[part.name]
+                    targets = [(pm.masses[0], 0.5), (pm.masses[1], 0.5)] if s is rolling else \
+                        [(pm.at(0.0, s), 1.0)] if pm.at(0.0, s) else []
+                    for m, f in targets:
+                        weights[m.name] = weights.get(m.name, 0.0) + f * s.volume_m3
+                else:
+                    for m in pm.masses:
+                        v = _volume(s, m.z_lo, m.z_hi)
+                        if v > 0:
+                            weights[m.name] = weights.get(m.name, 0.0) + v
+            total = sum(weights.values())
+            shares = {k: v / total for k, v in weights.items()}
+        for mname, share in shares.items():
+            q = net.add(PrescribedHeatFlow(f"source:{src.name}:{mname}", source=src.name,
+                                           share=share))
+            net.connect(by_name[mname].block.port, q.port)
+
+    return LumpedNetwork(spec, nodes, net, parts, masses)
+
+
+def _series(G: SpeedTable, R_extra: float):
+    """Conductance of G(n) in series with a fixed resistance [K/W]."""
+    if len(G.values) == 1:
+        return 1.0 / (1.0 / G.values[0] + R_extra)
+    return SpeedTable(G.speed_rpm, tuple(1.0 / (1.0 / g + R_extra) for g in G.values)) \
+        if R_extra == 0 else _SeriesConductance(G, R_extra)
+
+
+@dataclass(frozen=True)
+class _SeriesConductance:
+    G: SpeedTable
+    R_extra: float
+
+    def __call__(self, speed_rpm: float) -> float:
+        return 1.0 / (1.0 / self.G(speed_rpm) + self.R_extra)
+
+
+@dataclass(frozen=True)
+class _FilmConductance:
+    """Sum over face pieces of 1 / (R_i + 1 / (h(n) A_i)) [W/K]."""
+
+    h: SpeedTable
+    A: tuple[float, ...]
+    R: tuple[float, ...]
+
+    def __call__(self, speed_rpm: float) -> float:
+        h = self.h(speed_rpm)
+        if h <= 0:
+            return 0.0
+        A, R = np.asarray(self.A), np.asarray(self.R)
+        return float(np.sum(1.0 / (R + 1.0 / (h * A))))
+
+
+def _film(h: SpeedTable, pieces: list[tuple[float, float]]):
+    f = _FilmConductance(h, tuple(A for A, _ in pieces), tuple(R for _, R in pieces))
+    return f(0.0) if len(h.values) == 1 else f

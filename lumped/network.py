@@ -1,0 +1,344 @@
+"""A network of function blocks, assembled into eq. 8: C dT/dt + K(n) T = Q(t).
+
+Ports joined by :meth:`Network.connect` form a node. A node holding a
+:class:`~lumped.blocks.FixedTemperature` is an input; every other node is an unknown, with
+the sum of its capacitors as capacity. Nodes without capacity (pure junctions) are condensed
+out (static condensation), so the state is the set of thermal masses.
+
+With inputs u = [heat-source powers (W) ..., fixed temperatures (K) ...] the assembled
+:class:`ThermalSystem` is::
+
+    C dT/dt + K(n, u_q) T = B(n) u      (eq. 8-11)
+
+K depends on speed n through the speed-dependent conductances, and on the heat-source powers
+only through temperature-dependent heat flows (copper loss).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lumped.blocks import (
+    Block,
+    Conductance,
+    Convection,
+    FixedTemperature,
+    HeatCapacitor,
+    HeatPort,
+    PrescribedHeatFlow,
+    ThermalConductor,
+    conductance_at,
+)
+from spindle.errors import SpindleVerifyError
+from spindle.loads import SpeedTable
+
+
+class NetworkError(SpindleVerifyError):
+    """A network that cannot be assembled: each line names the block and the fix."""
+
+    def __init__(self, name: str, problems: list[str]):
+        self.problems = problems
+        super().__init__("\n".join(f"network '{name}': {p}" for p in problems))
+
+
+class Network:
+    """A composition of blocks joined at their heat ports (Modelica ``connect``)."""
+
+    def __init__(self, name: str = "network"):
+        self.name = name
+        self.blocks: list[Block] = []
+        self._names: set[str] = set()
+        self._parent: dict[HeatPort, HeatPort] = {}
+        self._connected: set[HeatPort] = set()
+
+    def add(self, *blocks: Block) -> Block:
+        """Add blocks; returns the last one (so ``cap = net.add(HeatCapacitor(...))``)."""
+        for b in blocks:
+            if b.name in self._names:
+                raise NetworkError(self.name, [f"block name '{b.name}' is used twice; fix: give "
+                                               "every block its own name"])
+            self._names.add(b.name)
+            self.blocks.append(b)
+            for p in b.ports:
+                self._parent[p] = p
+        return blocks[-1]
+
+    def _root(self, p: HeatPort) -> HeatPort:
+        while self._parent[p] is not p:
+            self._parent[p] = self._parent[self._parent[p]]
+            p = self._parent[p]
+        return p
+
+    def connect(self, a: HeatPort, b: HeatPort) -> None:
+        """Join two ports: they share one temperature, and their heat flows sum to zero."""
+        for p in (a, b):
+            if p not in self._parent:
+                raise NetworkError(self.name, [f"port {p!r} belongs to a block that was not "
+                                               "added; fix: net.add(block) before connecting"])
+        ra, rb = self._root(a), self._root(b)
+        if ra is not rb:
+            self._parent[ra] = rb
+        self._connected |= {a, b}
+
+    def assemble(self) -> ThermalSystem:
+        """Check the network and build :class:`ThermalSystem`; raises :class:`NetworkError`
+        listing every unconnected port, conflicting fixed temperature and node group without a
+        path to a fixed temperature."""
+        problems: list[str] = []
+        connected = self._connected
+        for b in self.blocks:
+            for p in b.ports:
+                if p not in connected:
+                    problems.append(f"port {p!r} is not connected; fix: connect it or remove "
+                                    f"block '{b.name}'")
+        for b in self.blocks:
+            bad = [(k, v) for k, v in (("C_J_K", getattr(b, "C_J_K", 0.0)),
+                                       ("G_W_K", getattr(b, "G_W_K", 0.0))) if v < 0]
+            if isinstance(b, Convection) and isinstance(b.Gc_W_K, SpeedTable) \
+                    and b.Gc_W_K.min < 0:
+                bad.append(("Gc_W_K", b.Gc_W_K.min))
+            elif isinstance(b, Convection) and isinstance(b.Gc_W_K, int | float) \
+                    and b.Gc_W_K < 0:
+                bad.append(("Gc_W_K", b.Gc_W_K))
+            problems += [f"block '{b.name}': {k} = {v:g} is negative; fix: give a value >= 0"
+                         for k, v in bad]
+        if problems:
+            raise NetworkError(self.name, problems)
+
+        roots: dict[HeatPort, int] = {}
+        for b in self.blocks:
+            for p in b.ports:
+                roots.setdefault(self._root(p), len(roots))
+        n_all = len(roots)
+
+        def node(p: HeatPort) -> int:
+            return roots[self._root(p)]
+
+        capacity = np.zeros(n_all)
+        labels: list[list[str]] = [[] for _ in range(n_all)]
+        fixed: dict[int, str | float] = {}
+        where: dict[int, tuple[str, float]] = {}
+        for b in self.blocks:
+            if isinstance(b, HeatCapacitor):
+                i = node(b.port)
+                capacity[i] += b.C_J_K
+                labels[i].append(b.name)
+                where.setdefault(i, (b.part, b.z_m))
+            elif isinstance(b, FixedTemperature):
+                i = node(b.port)
+                if i in fixed and fixed[i] != b.source:
+                    problems.append(f"block '{b.name}' holds a node at '{b.source}' that "
+                                    f"another block holds at '{fixed[i]}'; fix: connect them "
+                                    "through a conductor")
+                fixed[i] = b.source
+                labels[i].append(b.name)
+        edges: list[tuple[int, int, Conductance, str]] = []
+        for b in self.blocks:
+            if isinstance(b, ThermalConductor):
+                edges.append((node(b.port_a), node(b.port_b), float(b.G_W_K), b.name))
+            elif isinstance(b, Convection):
+                edges.append((node(b.port_a), node(b.port_b), b.Gc_W_K, b.name))
+        flows = [(node(b.port), b) for b in self.blocks if isinstance(b, PrescribedHeatFlow)]
+
+        # every group of unknown nodes joined by conductances needs a fixed temperature
+        adj: dict[int, set[int]] = {i: set() for i in range(n_all)}
+        for i, j, G, _ in edges:
+            if _may_conduct(G):
+                adj[i].add(j)
+                adj[j].add(i)
+        seen: set[int] = set()
+        for start in range(n_all):
+            if start in seen or start in fixed:
+                continue
+            group, stack = set(), [start]
+            while stack:
+                k = stack.pop()
+                if k not in group:
+                    group.add(k)
+                    stack.extend(adj[k] - group)
+            seen |= group
+            if not group & set(fixed):
+                names = sorted({lab for k in group for lab in labels[k]}) or ["(junction)"]
+                problems.append(f"nodes {names[:6]}{' ...' if len(names) > 6 else ''} have no "
+                                "heat path to a fixed temperature (the system would be "
+                                "singular); fix: add a Convection or ThermalConductor to a "
+                                "FixedTemperature")
+        if problems:
+            raise NetworkError(self.name, problems)
+
+        free = [i for i in range(n_all) if i not in fixed]
+        fixed_nodes = sorted(fixed)
+        fixed_sources = [fixed[i] for i in fixed_nodes]
+        source_names = list(dict.fromkeys(f.source for _, f in flows))
+        return ThermalSystem(
+            name=self.name, n_all=n_all, free=free, fixed_nodes=fixed_nodes,
+            fixed_sources=fixed_sources, capacity=capacity, labels=labels, where=where,
+            edges=edges, flows=flows, source_names=source_names)
+
+
+def _may_conduct(G: Conductance) -> bool:
+    if isinstance(G, SpeedTable):
+        return G.max > 0
+    if callable(G):
+        return True
+    return float(G) > 0
+
+
+@dataclass
+class ThermalSystem:
+    """Eq. 8 for a network: matrices at a speed, inputs, and node bookkeeping.
+
+    Inputs: ``u = [q_1..q_m, T_1..T_d]``, the heat-source series named in ``source_names``
+    (W; a constant source is a name ``"<value> W"``) and the fixed temperatures named in
+    ``fixed_sources`` (K).
+    """
+
+    name: str
+    n_all: int
+    free: list[int]
+    fixed_nodes: list[int]
+    fixed_sources: list[str | float]
+    capacity: np.ndarray
+    labels: list[list[str]]
+    where: dict[int, tuple[str, float]]
+    edges: list[tuple[int, int, Conductance, str]]
+    flows: list[tuple[int, PrescribedHeatFlow]]
+    source_names: list[str | float]
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        pos = {n: k for k, n in enumerate(self.free)}
+        self._pos = pos
+        C = self.capacity[self.free]
+        self.state = np.nonzero(C > 0)[0]  # positions (in free) of the thermal masses
+        self.junction = np.nonzero(C <= 0)[0]
+        self.C = C[self.state]
+        self.input_names = [f"{s} W" if not isinstance(s, str) else s for s in self.source_names] \
+            + [f"{s} K" if not isinstance(s, str) else s for s in self.fixed_sources]
+        self.temperature_dependent = any(f.tc_1_K != 0 for _, f in self.flows)
+
+    # ------------------------------------------------------------------ matrices
+    @property
+    def n_states(self) -> int:
+        return len(self.state)
+
+    @property
+    def n_inputs(self) -> int:
+        return len(self.source_names) + len(self.fixed_nodes)
+
+    def _full(self, speed_rpm: float, q: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """K over all free nodes and B (free x inputs) at a speed, for source powers q."""
+        nf = len(self.free)
+        pos = self._pos
+        K = np.zeros((nf, nf))
+        B = np.zeros((nf, self.n_inputs))
+        m = len(self.source_names)
+        fixed_col = {n: m + k for k, n in enumerate(self.fixed_nodes)}
+        for i, j, G, _ in self.edges:
+            g = conductance_at(G, speed_rpm)
+            for a, b in ((i, j), (j, i)):
+                if a in pos:
+                    K[pos[a], pos[a]] += g
+                    if b in pos:
+                        K[pos[a], pos[b]] -= g
+                    else:
+                        B[pos[a], fixed_col[b]] += g
+        col = {s: k for k, s in enumerate(self.source_names)}
+        for n, f in self.flows:
+            if n not in pos:
+                continue  # heat into a fixed temperature leaves the network at once
+            # Q = share q (1 + tc (T - T_ref)) = share q (1 - tc T_ref) + share q tc T
+            B[pos[n], col[f.source]] += f.share * (1.0 - f.tc_1_K * f.T_ref_K)
+            if f.tc_1_K and q is not None:
+                K[pos[n], pos[n]] -= f.share * f.tc_1_K * q[col[f.source]]
+        return K, B
+
+    def matrices(self, speed_rpm: float, q: np.ndarray | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(K, B, R, S) at a speed: C dT/dt + K T = B u for the masses; the junction
+        temperatures follow as T_j = R T + S u (static condensation)."""
+        key = (float(speed_rpm), None if not self.temperature_dependent or q is None
+               else tuple(np.round(q, 12)))
+        if key in self._cache:
+            return self._cache[key]
+        Kf, Bf = self._full(speed_rpm, q)
+        s, j = self.state, self.junction
+        if len(j):
+            Kjj = Kf[np.ix_(j, j)]
+            R = -np.linalg.solve(Kjj, Kf[np.ix_(j, s)])
+            S = np.linalg.solve(Kjj, Bf[j])
+            K = Kf[np.ix_(s, s)] + Kf[np.ix_(s, j)] @ R
+            B = Bf[s] - Kf[np.ix_(s, j)] @ S
+        else:
+            R = np.zeros((0, len(s)))
+            S = np.zeros((0, self.n_inputs))
+            K, B = Kf, Bf
+        if len(self._cache) > 256:
+            self._cache.clear()
+        self._cache[key] = (K, B, R, S)
+        return K, B, R, S
+
+    def node_temperatures(self, x: np.ndarray, u: np.ndarray, speed_rpm: float) -> np.ndarray:
+        """Temperature of every network node [K] from the mass temperatures x and inputs u
+        (junctions from the condensation; fixed nodes from u)."""
+        _, _, R, S = self.matrices(speed_rpm, u[:len(self.source_names)])
+        T = np.empty(self.n_all)
+        free = np.asarray(self.free)
+        T[free[self.state]] = x
+        if len(self.junction):
+            T[free[self.junction]] = R @ x + S @ u
+        T[self.fixed_nodes] = u[len(self.source_names):]
+        return T
+
+    def heat_to_fixed(self, T_all: np.ndarray, speed_rpm: float) -> dict[str, float]:
+        """Heat [W] leaving into each fixed temperature (ambient, coolant, ...)."""
+        out: dict[str, float] = {}
+        fixed = dict(zip(self.fixed_nodes, self.fixed_sources, strict=True))
+        for i, j, G, _ in self.edges:
+            g = conductance_at(G, speed_rpm)
+            for a, b in ((i, j), (j, i)):
+                if b in fixed and a not in fixed:
+                    key = str(fixed[b])
+                    out[key] = out.get(key, 0.0) + g * (T_all[a] - T_all[b])
+        return out
+
+    def heat_in(self, T_all: np.ndarray, q: np.ndarray) -> float:
+        """Heat [W] from the prescribed heat flows at node temperatures T_all."""
+        col = {s: k for k, s in enumerate(self.source_names)}
+        return float(sum(f.share * q[col[f.source]] * (1 + f.tc_1_K * (T_all[n] - f.T_ref_K))
+                         for n, f in self.flows))
+
+    # ------------------------------------------------------------------ solves
+    def steady(self, u: np.ndarray, speed_rpm: float) -> np.ndarray:
+        """Mass temperatures [K] at steady state for inputs u."""
+        K, B, _, _ = self.matrices(speed_rpm, u[:len(self.source_names)])
+        return np.linalg.solve(K, B @ u)
+
+    def discretize(self, dt_s: float, speed_rpm: float, q: np.ndarray | None = None,
+                   integrals: bool = False) -> tuple[np.ndarray, ...]:
+        """Exact zero-order-hold step: x+ = Phi x + Gamma u for inputs held over dt_s [s]
+        (matrix exponential of the augmented system, scipy.linalg.expm). With ``integrals``
+        also (Psi, Lambda) with integral_0^dt x dt = Psi x + Lambda u, for exact energy
+        bookkeeping."""
+        from scipy.linalg import expm
+
+        key = ("zoh", round(float(dt_s), 9), float(speed_rpm), integrals,
+               None if not self.temperature_dependent or q is None else tuple(np.round(q, 12)))
+        if key in self._cache:
+            return self._cache[key]
+        K, B, _, _ = self.matrices(speed_rpm, q)
+        n, m = K.shape[0], B.shape[1]
+        size = 2 * n + m if integrals else n + m
+        M = np.zeros((size, size))
+        M[:n, :n] = -K / self.C[:, None] * dt_s
+        M[:n, n:n + m] = B / self.C[:, None] * dt_s
+        if integrals:
+            M[n + m:, :n] = np.eye(n)  # in time scaled by dt: d(integral of x)/dtau = x
+        E = expm(M)
+        out = (E[:n, :n], E[:n, n:n + m])
+        if integrals:
+            out += (E[n + m:, :n] * dt_s, E[n + m:, n:n + m] * dt_s)
+        self._cache[key] = out
+        return out
