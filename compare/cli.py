@@ -90,9 +90,19 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
     spec = load_spec(args.spec)
     t0 = time.perf_counter()
-    ref = ReferenceModel(spec, args.level, args.order, centrifugal=args.centrifugal,
-                         elastic=not args.thermal_only)
-    model = ref.thermal
+    if args.model == "lumped":
+        from lumped import build
+
+        nodes = int(args.nodes) if args.nodes.isdigit() else args.nodes
+        ref = build(spec, nodes)
+        header = (f"{spec.name}: lumped function-block model, {ref.nodes} nodes along shaft "
+                  f"and housing, {ref.n_states} masses")
+    else:
+        ref = ReferenceModel(spec, args.level, args.order, centrifugal=args.centrifugal,
+                             elastic=not args.thermal_only)
+        c = ref.thermal.smesh.counts(args.order)
+        header = (f"{spec.name}: FEM P{args.order}, level {args.level}, {c['elements']} "
+                  f"elements, {ref.thermal.basis.N} DOFs")
     t_asm = time.perf_counter() - t0
     case = spec.default_load_case()
     inputs = [spec.path]
@@ -107,22 +117,27 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         case = _read_cycle(args.cycle, spec, case)
         if Path(args.cycle).is_file():
             inputs.append(args.cycle)
-        result = ref.transient(case, args.dt, theta=args.theta, T0=float(case.T_ambient_K(0.0)),
-                               save_every=max(1, int(round(args.save_every / args.dt))),
-                               progress=Progress("transient", not quiet))
+        if args.model == "lumped":  # exact zero-order hold: no theta, no fields
+            result = ref.transient(case, args.dt, T0=float(case.T_ambient_K(0.0)),
+                                   progress=Progress("transient", not quiet))
+        else:
+            result = ref.transient(case, args.dt, theta=args.theta,
+                                   T0=float(case.T_ambient_K(0.0)),
+                                   save_every=max(1, int(round(args.save_every / args.dt))),
+                                   progress=Progress("transient", not quiet))
     else:
         result = ref.steady(case)
     t_solve = time.perf_counter() - t0 - t_asm
     out = Path(args.out or f"results/{spec.name}")
     with output_dir(out, inputs=inputs) as tmp:
         files = result.save(tmp, pictures=not args.no_pictures)
-    c = model.smesh.counts(args.order)
-    print(f"{spec.name}: FEM P{args.order}, level {args.level}, {c['elements']} elements, "
-          f"{model.basis.N} DOFs; assembly {t_asm:.2f} s, solve {t_solve:.2f} s")
+    print(f"{header}; {'build' if args.model == 'lumped' else 'assembly'} {t_asm:.2f} s, "
+          f"solve {t_solve:.2f} s")
     if args.cycle:
         s = result.summary()
+        scheme = "exact zero-order hold" if args.model == "lumped" else f"theta = {args.theta:g}"
         print(f"transient '{case.name}': {s['steps']} steps over {s['duration_s'] / 3600:.2f} h, "
-              f"theta = {args.theta:g}")
+              f"{scheme}")
         print(f"  {'sensor':<16} {'peak_C':>9} {'final_C':>9}")
         for n in result.names:
             print(f"  {n:<16} {s['peak_C'][n]:9.3f} {s['final_C'][n]:9.3f}")
@@ -165,9 +180,15 @@ def build_parser() -> argparse.ArgumentParser:
     mp.add_argument("--no-pictures", action="store_true", help="skip the PNG")
     mp.set_defaults(func=_cmd_mesh)
 
-    so = sub.add_parser("solve", help="FEM reference: temperatures and axial growth (P1), steady "
-                        "or over a transient cycle")
+    so = sub.add_parser("solve", help="temperatures and axial growth (P1) from the FEM reference "
+                        "or a lumped model, steady or over a transient cycle")
     so.add_argument("spec", metavar="SPEC")
+    so.add_argument("--model", choices=("fem", "lumped"), default="fem",
+                    help="fem: the FEM reference (default); lumped: the paper's function-block "
+                         "model")
+    so.add_argument("--nodes", default="11",
+                    help="lumped model: masses along shaft and housing, an integer >= 2 or "
+                         "paper5 / paper11 (default 11)")
     so.add_argument("--level", type=int, default=2, help="mesh level (default 2)")
     so.add_argument("--order", type=int, choices=(1, 2), default=2,
                     help="element order (default 2)")

@@ -211,11 +211,11 @@ def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = T
     conduction from a mass to its faces (film and contact resistances only), as eq. 7 does."""
     if isinstance(nodes, str):
         if nodes not in PRESETS:
-            raise SpecError([Problem("--nodes", "nodes", f"unknown preset '{nodes}'",
+            raise SpecError([Problem("command line", "--nodes", f"unknown preset '{nodes}'",
                                      f"use an integer >= 2 or one of {sorted(PRESETS)}")])
         nodes = PRESETS[nodes]
     if int(nodes) != nodes or nodes < 2:
-        raise SpecError([Problem("--nodes", "nodes", f"{nodes!r} is not an integer >= 2",
+        raise SpecError([Problem("command line", "--nodes", f"{nodes!r} is not an integer >= 2",
                                  "give the number of masses along shaft and housing, >= 2")])
     nodes = int(nodes)
     rad = 1.0 if radial_conduction else 0.0

@@ -58,3 +58,54 @@ class Fin:
     def curvature_K_m2(self, x_m: float | np.ndarray) -> np.ndarray:
         """d2T/dx2 [K/m2]."""
         return self.m_1_m**2 * self.rise_K(x_m)
+
+    def sensors_rise_K(self, count: int = 11) -> np.ndarray:
+        """Rise above ambient [K] at ``count`` points spaced l/(count-1), the paper's 11
+        virtual sensors at l/10."""
+        return self.rise_K(np.linspace(0.0, self.length_m, count))
+
+    @classmethod
+    def from_spec(cls, spec, part: str = "shaft", speed_rpm: float | None = None,
+                  Q1_W: float | None = None, Q2_W: float | None = None,
+                  h_W_m2K: float | None = None) -> Fin:
+        """Eq. 14 for one part of a spec (SI).
+
+        Length l = the part's axial extent; A = volume / l (mean cross-section); P = outer
+        lateral area / l (mean perimeter); lambda = volume-weighted k_z of its materials.
+        ``h_W_m2K`` defaults to the effective alpha: the film conductance of all the part's
+        convective surfaces at ``speed_rpm`` (spec speed if None), spread over its lateral
+        area. ``Q1_W`` / ``Q2_W`` default to the heat sources on the part's rear and front end
+        faces; a part without such sources needs them given.
+        """
+        from spindle.errors import Problem, SpecError
+        from spindle.faces import exposed_faces, surface_faces
+
+        p = spec.part(part)
+        z0 = min(s.z_start for s in p.sections)
+        z1 = max(s.z_end for s in p.sections)
+        length = z1 - z0
+        volume = sum(s.volume_m3 for s in p.sections)
+        k = sum(spec.materials[s.material].k_z_W_mK * s.volume_m3 for s in p.sections) / volume
+        lateral = sum(np.pi * (s.r_outer[0] + s.r_outer[1])
+                      * np.hypot(s.length, s.r_outer[1] - s.r_outer[0]) for s in p.sections)
+        faces = exposed_faces(spec)
+        n = spec.speed_rpm if speed_rpm is None else speed_rpm
+        if h_W_m2K is None:
+            hA = sum(s.h_W_m2K(n) * sum(f.area_m2 for f in surface_faces(s, faces)
+                                        if f.part == part)
+                     for s in spec.surfaces if s.h_W_m2K is not None)
+            h_W_m2K = hA / lateral
+        Q = {"rear": Q1_W, "front": Q2_W}
+        for end, value in Q.items():
+            if value is not None:
+                continue
+            names = {s.name for s in spec.surfaces
+                     if part in s.parts and s.side == end and s.h_W_m2K is None}
+            found = [src for src in spec.heat_sources if src.surface in names]
+            if not found:
+                raise SpecError([Problem(spec.path, "heat_sources", f"no heat source on the "
+                                         f"{end} end face of '{part}' for eq. 14",
+                                         f"give Q{1 if end == 'rear' else 2}_W explicitly")])
+            Q[end] = sum(float(src.power_W(0.0)) for src in found)
+        return cls(float(length), float(volume / length), float(lateral / length), float(k),
+                   float(h_W_m2K), float(Q["rear"]), float(Q["front"]))

@@ -294,15 +294,21 @@ class ThermalSystem:
 
     def heat_to_fixed(self, T_all: np.ndarray, speed_rpm: float) -> dict[str, float]:
         """Heat [W] leaving into each fixed temperature (ambient, coolant, ...)."""
-        out: dict[str, float] = {}
-        fixed = dict(zip(self.fixed_nodes, self.fixed_sources, strict=True))
-        for i, j, G, _ in self.edges:
-            g = conductance_at(G, speed_rpm)
-            for a, b in ((i, j), (j, i)):
-                if b in fixed and a not in fixed:
-                    key = str(fixed[b])
-                    out[key] = out.get(key, 0.0) + g * (T_all[a] - T_all[b])
-        return out
+        key = ("out", float(speed_rpm))
+        if key not in self._cache:
+            fixed = dict(zip(self.fixed_nodes, self.fixed_sources, strict=True))
+            names = list(dict.fromkeys(str(v) for v in self.fixed_sources))
+            H = np.zeros((len(names), self.n_all))
+            for i, j, G, _ in self.edges:
+                g = conductance_at(G, speed_rpm)
+                for a, b in ((i, j), (j, i)):
+                    if b in fixed and a not in fixed:
+                        row = names.index(str(fixed[b]))
+                        H[row, a] += g
+                        H[row, b] -= g
+            self._cache[key] = (names, H)
+        names, H = self._cache[key]
+        return dict(zip(names, (H @ T_all).tolist(), strict=True))
 
     def heat_in(self, T_all: np.ndarray, q: np.ndarray) -> float:
         """Heat [W] from the prescribed heat flows at node temperatures T_all."""

@@ -133,3 +133,29 @@ def test_solve_shipped_cycle_and_step_csv(tmp_path, capsys):
                  "--out", str(tmp_path / "s"), "--quiet", "--no-pictures"]) == 0
     s2 = json.loads((tmp_path / "s" / "summary.json").read_text())
     assert s2["duration_s"] == 7200 and s2["peak_C"]["T1"] > 20.0
+
+
+def test_solve_lumped_steady_and_cycle(tmp_path, capsys):
+    out = tmp_path / "l"
+    assert main(["solve", "spl2782", "--model", "lumped", "--nodes", "paper11", "--case",
+                 "nominal", "--out", str(out), "--no-pictures"]) == 0
+    text = capsys.readouterr().out
+    assert "lumped function-block model, 11 nodes" in text and "P1_um" in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["model"] == {"kind": "lumped", "nodes": 11, "masses": 48}
+    assert abs(summary["energy"]["relative_imbalance"]) < 1e-12
+    assert (out / "masses.csv").exists()
+    out2 = tmp_path / "c"
+    assert main(["solve", "spl2782", "--model", "lumped", "--nodes", "5", "--cycle", "spl-16h",
+                 "--dt", "300", "--quiet", "--out", str(out2)]) == 0
+    assert "exact zero-order hold" in capsys.readouterr().out
+    assert (out2 / "T1_P1_tolerance.png").exists()
+    assert "P1_um" in (out2 / "sensors_timeseries.csv").read_text().splitlines()[0]
+
+
+@pytest.mark.parametrize("nodes", ["1", "paper7"])
+def test_bad_node_count_exits_2(tmp_path, nodes):
+    r = run("solve", "fin-shaft", "--model", "lumped", "--nodes", nodes, "--out",
+            str(tmp_path / "x"))
+    assert r.returncode == 2 and "--nodes" in r.stderr and "fix:" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "x").exists()

@@ -1,0 +1,131 @@
+"""Function blocks and their network (lumped.blocks, lumped.network): small networks with
+hand solutions, the exact zero-order hold, and the checks on bad networks."""
+
+import numpy as np
+import pytest
+
+from lumped.blocks import (
+    Convection,
+    FixedTemperature,
+    HeatCapacitor,
+    PrescribedHeatFlow,
+    ThermalConductor,
+)
+from lumped.network import Network, NetworkError
+from spindle.loads import SpeedTable
+
+T_AMB = 293.15
+
+
+def one_mass(C=1000.0, G=2.0, Q=10.0, tc=0.0):
+    """A mass C [J/K] heated by Q [W] and cooled through G [W/K] to ambient."""
+    net = Network("one")
+    m = net.add(HeatCapacitor("m", C_J_K=C))
+    g = net.add(ThermalConductor("g", G_W_K=G))
+    amb = net.add(FixedTemperature("amb", source="ambient"))
+    q = net.add(PrescribedHeatFlow("q", source="Q", tc_1_K=tc))
+    net.connect(m.port, g.port_a)
+    net.connect(g.port_b, amb.port)
+    net.connect(q.port, m.port)
+    return net.assemble()
+
+
+def test_one_mass_steady_and_exact_zero_order_hold():
+    sys = one_mass()
+    u = np.array([10.0, T_AMB])  # inputs: source power, then ambient
+    assert sys.input_names == ["Q", "ambient"]
+    assert sys.steady(u, 0.0)[0] == pytest.approx(T_AMB + 10.0 / 2.0, abs=1e-12)
+    # exact solution of C dT/dt = Q - G (T - T_amb) from T_amb: tau = C / G = 500 s
+    for dt in (1.0, 60.0, 3600.0):
+        Phi, Gam = sys.discretize(dt, 0.0)
+        x1 = Phi @ np.array([T_AMB]) + Gam @ u
+        # exact up to the round-off of expm on a ~300 K state (a few ulp)
+        assert x1[0] == pytest.approx(T_AMB + 5.0 * (1 - np.exp(-dt / 500.0)), rel=1e-14)
+
+
+def test_temperature_dependent_heat_flow_stays_linear():
+    """Q = Q0 (1 + tc (T - T_ref)) with G to ambient: T = (Q0 (1 - tc T_ref) + G T_a) /
+    (G - Q0 tc), the copper-loss form of eq. 16-17."""
+    tc, Q0, G = 0.00393, 10.0, 2.0
+    sys = one_mass(G=G, Q=Q0, tc=tc)
+    T = sys.steady(np.array([Q0, T_AMB]), 0.0)[0]
+    assert T == pytest.approx((Q0 * (1 - tc * 293.15) + G * T_AMB) / (G - Q0 * tc), rel=1e-14)
+    assert sys.heat_in(np.array([T, T_AMB]), np.array([Q0])) == pytest.approx(G * (T - T_AMB))
+
+
+def test_junction_without_capacity_is_condensed():
+    """Two conductors in series through a massless junction act as G1 G2 / (G1 + G2)."""
+    net = Network("series")
+    m = net.add(HeatCapacitor("m", C_J_K=50.0))
+    g1 = net.add(ThermalConductor("g1", G_W_K=3.0))
+    g2 = net.add(ThermalConductor("g2", G_W_K=6.0))
+    amb = net.add(FixedTemperature("amb", source=300.0))
+    q = net.add(PrescribedHeatFlow("q", source=4.0))
+    net.connect(m.port, g1.port_a)
+    net.connect(g1.port_b, g2.port_a)  # the junction
+    net.connect(g2.port_b, amb.port)
+    net.connect(q.port, m.port)
+    sys = net.assemble()
+    assert sys.n_states == 1 and len(sys.junction) == 1
+    u = np.array([4.0, 300.0])
+    x = sys.steady(u, 0.0)
+    assert x[0] == pytest.approx(300.0 + 4.0 / 2.0, abs=1e-12)
+    T_all = sys.node_temperatures(x, u, 0.0)
+    assert sorted(T_all) == pytest.approx([300.0, 300.0 + 4.0 / 6.0, 302.0])
+
+
+def test_convection_follows_speed():
+    net = Network("conv")
+    m = net.add(HeatCapacitor("m", C_J_K=10.0))
+    c = net.add(Convection("c", Gc_W_K=SpeedTable((0.0, 1000.0), (1.0, 5.0))))
+    amb = net.add(FixedTemperature("amb", source="ambient"))
+    q = net.add(PrescribedHeatFlow("q", source="Q"))
+    net.connect(m.port, c.port_a)
+    net.connect(c.port_b, amb.port)
+    net.connect(q.port, m.port)
+    sys = net.assemble()
+    u = np.array([10.0, T_AMB])
+    assert sys.steady(u, 0.0)[0] - T_AMB == pytest.approx(10.0)
+    assert sys.steady(u, 500.0)[0] - T_AMB == pytest.approx(10.0 / 3.0)
+
+
+def test_bad_networks_name_the_block_and_the_fix():
+    net = Network("bad")
+    m = net.add(HeatCapacitor("lonely", C_J_K=1.0))
+    with pytest.raises(NetworkError, match=r"port lonely.port is not connected; fix:"):
+        net.assemble()
+
+    net = Network("floating")
+    a = net.add(HeatCapacitor("a", C_J_K=1.0))
+    b = net.add(HeatCapacitor("b", C_J_K=1.0))
+    g = net.add(ThermalConductor("g", G_W_K=1.0))
+    net.connect(a.port, g.port_a)
+    net.connect(g.port_b, b.port)
+    with pytest.raises(NetworkError, match=r"\['a', 'b'\] have no heat path to a fixed "
+                                           r"temperature.*fix: add a Convection"):
+        net.assemble()
+
+    net = Network("clash")
+    m = net.add(HeatCapacitor("m", C_J_K=1.0))
+    t1 = net.add(FixedTemperature("t1", source="ambient"))
+    t2 = net.add(FixedTemperature("t2", source="coolant"))
+    net.connect(m.port, t1.port)
+    net.connect(m.port, t2.port)
+    with pytest.raises(NetworkError, match="'t2' holds a node at 'coolant'"):
+        net.assemble()
+
+    net = Network("negative")
+    m = net.add(HeatCapacitor("m", C_J_K=-1.0))
+    amb = net.add(FixedTemperature("amb"))
+    g = net.add(ThermalConductor("g", G_W_K=1.0))
+    net.connect(m.port, g.port_a)
+    net.connect(g.port_b, amb.port)
+    with pytest.raises(NetworkError, match=r"'m': C_J_K = -1 is negative; fix"):
+        net.assemble()
+
+    net = Network("names")
+    net.add(HeatCapacitor("m", C_J_K=1.0))
+    with pytest.raises(NetworkError, match="block name 'm' is used twice"):
+        net.add(HeatCapacitor("m", C_J_K=1.0))
+    with pytest.raises(NetworkError, match="was not added"):
+        net.connect(HeatCapacitor("x").port, HeatCapacitor("y").port)
