@@ -1,0 +1,245 @@
+"""The verification study of a spec: how far can its models be trusted?
+
+1. Grid convergence of the FEM reference on nested levels (compare.convergence): observed
+   order, Richardson extrapolation, GCI; the ground-truth level.
+2. Steady accuracy (the nominal point, or the spec's own load case): eq. 14, the lumped models
+   for every N and the FEM levels against the Richardson-extrapolated reference.
+3. Transient accuracy (spl-16h, or an 8 h warm-up for a spec without a power balance): the
+   lumped models and the coarser FEM levels against the FEM ground-truth level.
+4. A self-contained HTML report with the tables, the plots and the revolved 3-D field.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from compare.accuracy import (
+    NODES,
+    TOL_GROWTH_UM,
+    TOL_TEMP_K,
+    AccuracyResult,
+    Entry,
+    eq14_entry,
+    fem_entry,
+    lumped_entries,
+)
+from compare.convergence import ConvergenceResult, convergence_study
+from spindle.loads import LoadCase
+from spindle.spec import Spec
+
+WARMUP_S = 8 * 3600.0
+
+
+@dataclass
+class StudyResult:
+    spec: Spec
+    convergence: ConvergenceResult
+    steady: AccuracyResult
+    transient: AccuracyResult | None
+    ground_truth_level: int | None
+    reference_level: int
+    runtime_s: float
+    steady_case: LoadCase
+    reference_result: object  # the FEM steady result on the reference level (3-D picture)
+
+    def summary(self) -> dict:
+        return {"spec": self.spec.name, "runtime_s": self.runtime_s,
+                "ground_truth_level": self.ground_truth_level,
+                "reference_level": self.reference_level,
+                "convergence": self.convergence.summary(),
+                "steady": self.steady.summary(),
+                "transient": self.transient.summary() if self.transient else None}
+
+    def verdicts(self) -> list[tuple[str, str, str]]:
+        """(case, model, verdict) for the lumped presets and eq. 14."""
+        out = []
+        for acc in (self.steady, self.transient):
+            if acc is None:
+                continue
+            t = acc.table()
+            for i, name in enumerate(t["model"]):
+                if t["preset"][i] or t["kind"][i] == "eq14":
+                    out.append((acc.case_name, name + (f" ({t['preset'][i]})"
+                                                       if t["preset"][i] else ""),
+                                t["verdict"][i]))
+        return out
+
+    def save(self, out: Path, pictures: bool = True) -> list[Path]:
+        from spindle.outputs import write_json
+
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        files = self.convergence.save(out, pictures)
+        files += self.steady.save(out, "accuracy_steady", pictures)
+        if self.transient is not None:
+            files += self.transient.save(out, "accuracy_transient", pictures)
+        if pictures:
+            from reference import plots
+
+            res = self.reference_result
+            title = (f"{self.spec.name}: {self.steady_case.name}, FEM level "
+                     f"{self.reference_level}")
+            plots.revolved_png(res.model, res.T, out / "reference_3d.png", title)
+            plots.section_png(res.model, res.T, out / "reference_section.png", title)
+            files += [out / "reference_3d.png", out / "reference_section.png"]
+        write_json(out / "study.json", self.summary())
+        files.append(out / "study.json")
+        (out / "report.html").write_text(self._html(out, pictures), encoding="utf-8")
+        files.append(out / "report.html")
+        return files
+
+    # ------------------------------------------------------------------ report
+    def _html(self, out: Path, pictures: bool) -> str:
+        def img(name: str, alt: str) -> str:
+            path = out / name
+            if not pictures or not path.exists():
+                return ""
+            data = base64.b64encode(path.read_bytes()).decode("ascii")
+            return f'<figure><img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">' \
+                   f"<figcaption>{html.escape(alt)}</figcaption></figure>"
+
+        def table(md: str) -> str:
+            lines = [ln for ln in md.splitlines() if ln.startswith("|")]
+            head = [c.strip() for c in lines[0].strip("|").split("|")]
+            rows = [[c.strip() for c in ln.strip("|").split("|")] for ln in lines[2:]]
+            th = "".join(f"<th>{html.escape(h)}</th>" for h in head)
+            body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>"
+                           for r in rows)
+            return f"<table><thead><tr>{th}</tr></thead><tbody>{body}</tbody></table>"
+
+        conv = self.convergence
+        gt = self.ground_truth_level
+        gt_text = (f"level {gt} (the coarsest with GCI ≤ {100 * conv.threshold:g} % for every "
+                   "sensor and growth reading)" if gt is not None else
+                   f"none of levels {conv.analysed_levels} has GCI ≤ {100 * conv.threshold:g} % "
+                   f"for every quantity; the finest, level {self.reference_level}, is used")
+        flagged = conv.summary()["flagged"]
+        verdicts = "".join(f"<tr><td>{html.escape(c)}</td><td>{html.escape(m)}</td>"
+                           f"<td>{html.escape(v)}</td></tr>" for c, m, v in self.verdicts())
+        parts = [
+            "<!doctype html><html><head><meta charset='utf-8'>",
+            f"<title>spindle-verify study: {html.escape(self.spec.name)}</title>",
+            "<style>body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}"
+            "table{border-collapse:collapse;font-size:12px;margin:1em 0}"
+            "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
+            "th{background:#f2f2f2}img{max-width:100%}figcaption{font-size:12px;color:#555}"
+            "</style></head><body>",
+            f"<h1>Verification study: {html.escape(self.spec.name)}</h1>",
+            f"<p>{html.escape(self.spec.description)}<br>Source: {html.escape(self.spec.source)}"
+            f"<br>Run time {self.runtime_s:.1f} s. Tolerances (paper): {TOL_TEMP_K:g} K, "
+            f"±{TOL_GROWTH_UM:g} µm.</p>",
+            "<h2>Verdicts</h2><table><thead><tr><th>case</th><th>model</th><th>verdict</th>"
+            f"</tr></thead><tbody>{verdicts}</tbody></table>",
+            "<h2>1. Grid convergence of the FEM reference</h2>",
+            f"<p>Case: {html.escape(conv.case_name)}; levels {conv.levels} "
+            f"({', '.join(f'{d} DOFs' for d in conv.dofs)}). Ground truth: "
+            f"{html.escape(gt_text)}. Temperatures as rises above ambient [K], growth in µm. "
+            + (f"Flagged: {html.escape(str(flagged))}." if flagged else "No quantity is flagged "
+               "oscillatory or divergent on the finest triplet.") + "</p>",
+            table(conv.markdown()), img("convergence.png", "grid convergence"),
+            img("reference_3d.png", "reference temperature field, revolved"),
+            img("reference_section.png", "reference temperature on the half-section"),
+            f"<h2>2. Steady accuracy ({html.escape(self.steady.case_name)})</h2>",
+            f"<p>Reference: {html.escape(self.steady.reference_label)}.</p>",
+            table(self.steady.markdown()),
+            img("accuracy_steady_error.png", "error against unknowns"),
+            img("accuracy_steady_shaft_profile.png", "shaft sensors per model (paper Fig. 4)"),
+        ]
+        if self.transient is not None:
+            parts += [
+                f"<h2>3. Transient accuracy ({html.escape(self.transient.case_name)})</h2>",
+                f"<p>Reference: {html.escape(self.transient.reference_label)}. Errors are "
+                "over the sensors and over time.</p>",
+                table(self.transient.markdown()),
+                img("accuracy_transient_error.png", "error against unknowns"),
+                img("accuracy_transient_shaft_profile.png", "shaft sensors at the peak"),
+            ]
+        parts.append("</body></html>\n")
+        return "\n".join(parts)
+
+
+def _reference_entry(conv: ConvergenceResult, case: LoadCase) -> tuple[Entry, str]:
+    """The Richardson-extrapolated values where the finest triplet allows, else the finest
+    level's value."""
+    fine = conv.levels[-1]
+    T_amb = float(case.T_ambient_K(0.0))
+    sensors, growth, fallback = {}, {}, []
+    for q, vals in conv.values.items():
+        g = conv.gci(q, fine)
+        v = g.extrapolated
+        if math.isnan(v):
+            v = vals[-1]
+            fallback.append(q)
+        if conv.units[q] == "um":
+            growth[q] = v * 1e-6
+        else:
+            sensors[q] = T_amb + v
+    label = f"Richardson extrapolation of FEM levels {conv.levels[-3:]}"
+    if fallback:
+        label += f" (finest level for {len(fallback)} flagged quantities)"
+    return Entry(label, "reference", 0, 0.0, sensors, growth), label
+
+
+def study_cases(spec: Spec) -> tuple[LoadCase, LoadCase]:
+    """(steady case, transient case): nominal and spl-16h through the power balance for a spec
+    with one; otherwise its own load case, and an 8 h warm-up from ambient."""
+    from spindle.cycles import load_cycle
+    from spindle.drive import cycle_load_case, drive_for
+
+    drive = drive_for(spec)
+    if drive is not None:
+        return (cycle_load_case(spec, load_cycle("nominal"), drive),
+                cycle_load_case(spec, load_cycle("spl-16h"), drive))
+    base = spec.default_load_case()
+    return base, replace(base, name="warm-up 8 h", duration_s=WARMUP_S)
+
+
+def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[int] = NODES,
+              steady_case: LoadCase | None = None, transient_case: LoadCase | None = None,
+              transient: bool = True, dt_s: float = 60.0, threshold: float = 0.01,
+              progress: Callable[[str], None] | None = None) -> StudyResult:
+    """Run the whole study (see the module docstring)."""
+    t0 = time.perf_counter()
+    s_case, t_case = study_cases(spec)
+    s_case = steady_case or s_case
+    t_case = transient_case or t_case
+    conv = convergence_study(spec, s_case, levels, threshold=threshold, progress=progress,
+                             keep_results=True)
+    gt = conv.ground_truth_level()
+    ref_level = gt if gt is not None else conv.levels[-1]
+    ref_entry, label = _reference_entry(conv, s_case)
+    fem = []
+    for lv, res, rt, n in zip(conv.levels, conv.results, conv.runtime_s, conv.dofs, strict=True):
+        fem.append(Entry(f"FEM level {lv}", "fem", n, rt, res.sensors, res.growth_m, level=lv))
+    entries = lumped_entries(spec, s_case, nodes, None, None, progress)
+    eq14 = eq14_entry(spec, s_case)
+    steady = AccuracyResult(spec, s_case.name, False, ref_entry, label,
+                            ([eq14] if eq14 else []) + entries + fem)
+    trans = None
+    if transient:
+        T0 = float(t_case.T_ambient_K(0.0))
+        if progress:
+            progress(f"FEM level {ref_level} transient ({t_case.name}, dt {dt_s:g} s)")
+        ref_tr = fem_entry(spec, ref_level, t_case, dt_s, T0)
+        coarse = []
+        for lv in conv.levels:
+            if lv < ref_level:
+                if progress:
+                    progress(f"FEM level {lv} transient")
+                coarse.append(fem_entry(spec, lv, t_case, dt_s, T0))
+        lumped_tr = lumped_entries(spec, t_case, nodes, dt_s, T0, progress)
+        from spindle.loads import time_grid
+
+        trans = AccuracyResult(spec, t_case.name, True, ref_tr,
+                               f"FEM level {ref_level}, backward Euler dt {dt_s:g} s",
+                               lumped_tr + coarse, times_s=time_grid(t_case, dt_s))
+    ref_res = conv.results[conv.levels.index(ref_level)]
+    return StudyResult(spec, conv, steady, trans, gt, ref_level, time.perf_counter() - t0,
+                       s_case, ref_res)
+
