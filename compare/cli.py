@@ -168,20 +168,8 @@ def _cmd_study(args: argparse.Namespace) -> int:
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
-    quiet = args.quiet
-
-    def say(msg: str) -> None:
-        if not quiet:
-            print(f"  ... {msg}", file=sys.stderr, flush=True)
-
-    levels = sorted(set(args.levels))
-    if len(levels) < 3:
-        raise InputError("command line", "--levels", f"{levels} has fewer than 3 levels",
-                         "give three or more levels, e.g. --levels 0 1 2 3")
-    nodes = sorted(set(args.nodes))
-    if min(nodes) < 2:
-        raise InputError("command line", "--nodes", "a lumped model needs >= 2 nodes",
-                         "give node counts >= 2")
+    say = _progress(args.quiet)
+    levels, nodes = sorted(set(args.levels)), sorted(set(args.nodes))
     result = run_study(spec, levels, nodes, transient=not args.steady_only, dt_s=args.dt,
                        threshold=args.threshold / 100.0, progress=say)
     out = Path(args.out or f"results/{spec.name}/study")
@@ -217,6 +205,52 @@ def _cmd_study(args: argparse.Namespace) -> int:
             print("  fitted slopes of error against unknowns: "
                   + ", ".join(f"{k} {v:.2f}" for k, v in slopes.items()))
     print(f"wrote {out}/report.html (and tables, plots, JSON)")
+    return 0
+
+
+def _progress(quiet: bool):
+    def say(msg: str) -> None:
+        if not quiet:
+            print(f"  ... {msg}", file=sys.stderr, flush=True)
+
+    return say
+
+
+def _cmd_baseline(args: argparse.Namespace) -> int:
+    from compare.regression import make_baseline
+    from spindle.outputs import atomic_write
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)  # validates before the long run
+    out = Path(args.out)
+    if out.exists() and out.is_dir():
+        raise InputError(str(out), "--out", "is a folder", "give a file name, e.g. baseline.json")
+    if out.resolve() == Path(spec.path).resolve():
+        raise InputError(str(out), "--out", "would overwrite the spec", "choose another file")
+    settings = {"levels": sorted(set(args.levels)), "nodes": sorted(set(args.nodes)),
+                "dt_s": args.dt, "transient": not args.steady_only}
+    tolerances = {"temperature_K": args.tol_temp, "growth_um": args.tol_growth}
+    doc = make_baseline(args.spec, settings, tolerances, _progress(args.quiet))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(out, lambda tmp: tmp.write_text(json.dumps(doc, indent=1) + "\n", "utf-8"))
+    print(f"{spec.name}: {len(doc['figures'])} figures in {doc['created_with_runtime_s']:.1f} s; "
+          f"wrote {out}")
+    return 0
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from compare.regression import check, read_baseline
+
+    doc = read_baseline(args.file)
+    changes = check(doc, progress=_progress(args.quiet))
+    moved = [c for c in changes if c.moved]
+    if moved:
+        print(f"{args.file}: {len(moved)} of {len(changes)} figures moved beyond their "
+              "tolerance:")
+        for c in moved:
+            print(c.line())
+        return 1
+    print(f"{args.file}: all {len(changes)} figures within their tolerances")
     return 0
 
 
@@ -290,6 +324,29 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
     st.add_argument("--quiet", action="store_true", help="no progress on stderr")
     st.set_defaults(func=_cmd_study)
+
+    bp = sub.add_parser("baseline", help="store the figures of a study (values, errors, "
+                        "tolerances) as JSON for regression checks")
+    bp.add_argument("spec", metavar="SPEC")
+    bp.add_argument("--out", required=True, help="the JSON file to write")
+    bp.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2],
+                    help="FEM levels, three or more (default 0 1 2)")
+    bp.add_argument("--nodes", type=int, nargs="+", default=[5, 11],
+                    help="lumped node counts (default 5 11)")
+    bp.add_argument("--dt", type=float, default=300.0, help="transient time step [s] (300)")
+    bp.add_argument("--steady-only", action="store_true", help="skip the transient figures")
+    bp.add_argument("--tol-temp", type=float, default=0.01,
+                    help="how far a temperature may move [K] (default 0.01)")
+    bp.add_argument("--tol-growth", type=float, default=0.01,
+                    help="how far a growth may move [um] (default 0.01)")
+    bp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    bp.set_defaults(func=_cmd_baseline)
+
+    cp = sub.add_parser("check", help="recompute a baseline's figures; exit 1 with a diff when "
+                        "any moved beyond its tolerance")
+    cp.add_argument("file", metavar="FILE")
+    cp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    cp.set_defaults(func=_cmd_check)
     return p
 
 
@@ -304,6 +361,18 @@ def _check_args(args: argparse.Namespace) -> None:
                          "use 1 (backward Euler) or 0.5 (Crank-Nicolson)")
     if (getattr(args, "speed", None) or 0) < 0:
         raise InputError("command line", "--speed", "is negative", "give |n| in rpm")
+    levels = getattr(args, "levels", None)
+    if levels is not None:
+        if any(not 0 <= lv <= 5 for lv in levels):
+            raise InputError("command line", "--levels", f"{levels} has a level outside 0..5",
+                             "give levels between 0 and 5")
+        if len(set(levels)) < 3:
+            raise InputError("command line", "--levels", f"{levels} has fewer than 3 levels",
+                             "give three or more levels, e.g. --levels 0 1 2 3")
+    nodes = getattr(args, "nodes", None)
+    if isinstance(nodes, list) and min(nodes) < 2:
+        raise InputError("command line", "--nodes", "a lumped model needs >= 2 nodes",
+                         "give node counts >= 2")
 
 
 def main(argv: list[str] | None = None) -> int:

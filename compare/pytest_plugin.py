@@ -1,0 +1,99 @@
+"""A pytest plugin: assert in one line that a model of a spindle stays within a tolerance of
+the FEM reference.
+
+Installed with spindle-verify (entry point ``pytest11``), it gives every test suite the
+``spindle_verify`` fixture::
+
+    def test_my_spindle(spindle_verify):
+        spindle_verify.assert_within("my_spindle.toml", "lumped:11", case="nominal",
+                                     tol_temp_K=1.0, tol_growth_um=1.5)
+
+``model`` is ``"lumped:N"`` (N an integer or paper5 / paper11) or ``"fem:L"`` (mesh level);
+``case`` a shipped cycle name (``nominal`` is steady, other cycles are transients) or None
+for the spec's own steady load case. The reference is the FEM at ``reference_level``.
+The error is the worst temperature error over the spec's sensors (K; over time for a
+transient) and the P1 error (µm), as in compare.accuracy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pytest
+
+from compare.accuracy import AccuracyResult, Entry, fem_entry, lumped_entries
+
+
+@dataclass
+class Verdict:
+    model: str
+    worst_temp_K: float
+    P1_um: float
+    row: dict
+
+
+def model_error(spec_ref: str, model: str, case: str | None = None, reference_level: int = 2,
+                dt_s: float = 120.0) -> Verdict:
+    """Errors of ``model`` against the FEM reference on ``case`` (see the module doc)."""
+    from spindle.cycles import load_cycle
+    from spindle.drive import cycle_load_case
+    from spindle.spec import load_spec
+
+    spec = load_spec(spec_ref)
+    kind, _, size = model.partition(":")
+    if case is None:
+        load, transient = spec.default_load_case(), False
+    else:
+        load = cycle_load_case(spec, load_cycle(case))
+        transient = case != "nominal"
+    dt = dt_s if transient else None
+    T0 = float(load.T_ambient_K(0.0)) if transient else None
+    ref = fem_entry(spec, reference_level, load, dt, T0)
+    if kind == "lumped":
+        nodes = int(size) if size.isdigit() else size
+        if isinstance(nodes, str):
+            from lumped import PRESETS
+
+            nodes = PRESETS[nodes]
+        entry: Entry = lumped_entries(spec, load, [nodes], dt, T0)[0]
+    elif kind == "fem":
+        entry = fem_entry(spec, int(size), load, dt, T0)
+    else:
+        raise ValueError(f"model '{model}': use 'lumped:N' or 'fem:L'")
+    acc = AccuracyResult(spec, load.name, transient, ref, f"FEM level {reference_level}",
+                         [entry])
+    row = acc.errors(entry)
+    temps = [v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)]
+    return Verdict(model, max(temps) if temps else math.nan, row.get("P1_max_um", math.nan),
+                   row)
+
+
+class SpindleVerify:
+    """The fixture's object."""
+
+    def error(self, spec: str, model: str, case: str | None = None, reference_level: int = 2,
+              dt_s: float = 120.0) -> Verdict:
+        return model_error(spec, model, case, reference_level, dt_s)
+
+    def assert_within(self, spec: str, model: str, case: str | None = None,
+                      tol_temp_K: float = 1.0, tol_growth_um: float = 1.5,
+                      reference_level: int = 2, dt_s: float = 120.0) -> Verdict:
+        v = model_error(spec, model, case, reference_level, dt_s)
+        msgs = []
+        if not v.worst_temp_K <= tol_temp_K:
+            worst = max((k for k in v.row if k.endswith("_max_K")), key=lambda k: v.row[k])
+            msgs.append(f"temperature error {v.worst_temp_K:.3f} K > {tol_temp_K:g} K "
+                        f"(worst: {worst})")
+        if not math.isnan(v.P1_um) and v.P1_um > tol_growth_um:
+            msgs.append(f"P1 error {v.P1_um:.3f} µm > {tol_growth_um:g} µm")
+        if msgs:
+            pytest.fail(f"{model} of {spec} ({case or 'own load case'}) against FEM level "
+                        f"{reference_level}: " + "; ".join(msgs), pytrace=False)
+        return v
+
+
+@pytest.fixture
+def spindle_verify() -> SpindleVerify:
+    """Assert that a model of a spindle stays within a tolerance of the FEM reference."""
+    return SpindleVerify()

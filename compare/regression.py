@@ -1,0 +1,146 @@
+"""Regression verification: store the figures of a study, recompute them later, and fail
+when one moved beyond its tolerance.
+
+``spindle-verify baseline SPEC --out FILE`` writes a JSON file with the settings of the study
+(spec, levels, node counts, time step), the tolerances, and a flat table of figures:
+values (sensor temperatures in degC, growth in µm), errors against the reference, the
+ground-truth level and the worst GCI. ``spindle-verify check FILE`` recomputes them with the
+same settings and exits 1 with a readable diff when any figure moved by more than its
+tolerance, 0 otherwise. Edit the tolerances in the file to suit; by default a temperature
+may move 0.01 K, a growth 0.01 µm, a GCI 0.01 percentage points, a level not at all.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from spindle.errors import InputError
+
+FORMAT = "spindle-verify-baseline/1"
+DEFAULT_TOLERANCES = {"temperature_K": 0.01, "growth_um": 0.01, "gci_pct": 0.01, "level": 0}
+DEFAULT_SETTINGS = {"levels": [0, 1, 2], "nodes": [5, 11], "dt_s": 300.0, "transient": True,
+                    "threshold_pct": 1.0}
+KELVIN = 273.15
+
+
+def figures_of(study) -> dict[str, float | int | None]:
+    """The flat table of figures of a :class:`compare.study.StudyResult`."""
+    fig: dict[str, float | int | None] = {}
+    conv = study.convergence
+    fig["convergence/ground_truth_level"] = study.ground_truth_level
+    worst = conv.summary()["worst_GCI_pct_per_level"]
+    for lv, v in worst.items():
+        fig[f"convergence/level_{lv}/worst_GCI_pct"] = v
+    for acc in (study.steady, study.transient):
+        if acc is None:
+            continue
+        tag = "transient" if acc.transient else "steady"
+        t = acc.table()
+        for i, name in enumerate(t["model"]):
+            for k, col in t.items():
+                if (k.endswith("_K") or k.endswith("_um")) and isinstance(col[i], float):
+                    fig[f"{tag}/{name}/err_{k}"] = None if math.isnan(col[i]) else col[i]
+        for e in acc.entries:
+            for s in ("T1", "T2"):
+                if s in e.sensors:
+                    v = e.sensors[s]
+                    fig[f"{tag}/{e.name}/{s}_{'peak_' if acc.transient else ''}C"] = \
+                        float(max(v) if acc.transient else v) - KELVIN
+            for g, v in e.growth.items():
+                fig[f"{tag}/{e.name}/{g}_{'peak_' if acc.transient else ''}um"] = \
+                    float(max(v) if acc.transient else v) * 1e6
+    return fig
+
+
+def _tolerance(name: str, tol: dict) -> float:
+    if name.endswith("_level"):
+        return float(tol.get("level", 0))
+    if name.endswith("_pct"):
+        return float(tol["gci_pct"])
+    if name.endswith("_um"):
+        return float(tol["growth_um"])
+    return float(tol["temperature_K"])  # _C and _K
+
+
+def compute(spec_ref: str, settings: dict, progress: Callable[[str], None] | None = None
+            ) -> dict[str, float | int | None]:
+    from compare.study import run_study
+    from spindle.spec import load_spec
+
+    spec = load_spec(spec_ref)
+    study = run_study(spec, settings["levels"], settings["nodes"],
+                      transient=settings["transient"], dt_s=settings["dt_s"],
+                      threshold=settings["threshold_pct"] / 100.0, progress=progress)
+    return figures_of(study)
+
+
+def make_baseline(spec_ref: str, settings: dict | None = None,
+                  tolerances: dict | None = None,
+                  progress: Callable[[str], None] | None = None) -> dict:
+    """The baseline document (a dict ready for JSON)."""
+    settings = {**DEFAULT_SETTINGS, **(settings or {})}
+    t = time.perf_counter()
+    figures = compute(spec_ref, settings, progress)
+    return {"format": FORMAT, "spec": spec_ref, "settings": settings,
+            "tolerances": {**DEFAULT_TOLERANCES, **(tolerances or {})},
+            "created_with_runtime_s": round(time.perf_counter() - t, 1), "figures": figures}
+
+
+@dataclass
+class Change:
+    figure: str
+    baseline: float | int | None
+    now: float | int | None
+    tolerance: float
+
+    @property
+    def moved(self) -> bool:
+        if self.baseline is None or self.now is None:  # a figure appeared or vanished
+            return self.baseline != self.now
+        return abs(self.now - self.baseline) > self.tolerance
+
+    def line(self) -> str:
+        if self.baseline is None or self.now is None:
+            return f"  {self.figure}: {self.baseline} -> {self.now}"
+        return (f"  {self.figure}: {self.baseline:.6g} -> {self.now:.6g} "
+                f"(change {self.now - self.baseline:+.3g}, tolerance {self.tolerance:g})")
+
+
+def read_baseline(path: str | Path) -> dict:
+    path = Path(path)
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InputError(str(path), "file", f"cannot be read ({exc.strerror})",
+                         "give the file written by 'spindle-verify baseline'") from None
+    except json.JSONDecodeError as exc:
+        raise InputError(str(path), f"line {exc.lineno}", f"is not valid JSON ({exc.msg})",
+                         "restore the file or write a new one with 'spindle-verify baseline'"
+                         ) from None
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        raise InputError(str(path), "format", f"is not a {FORMAT} file",
+                         "write one with 'spindle-verify baseline SPEC --out FILE'")
+    for key in ("spec", "settings", "tolerances", "figures"):
+        if key not in doc:
+            raise InputError(str(path), key, "is missing", "write a new baseline")
+    tol = doc["tolerances"]
+    for key in ("temperature_K", "growth_um", "gci_pct"):
+        if not isinstance(tol.get(key), int | float) or tol[key] < 0:
+            raise InputError(str(path), f"tolerances.{key}", "must be a number >= 0",
+                             f"set it, e.g. {DEFAULT_TOLERANCES[key]}")
+    return doc
+
+
+def check(doc: dict, figures: dict | None = None,
+          progress: Callable[[str], None] | None = None) -> list[Change]:
+    """Recompute (unless ``figures`` are given) and list every figure with its change."""
+    settings = {**DEFAULT_SETTINGS, **doc["settings"]}
+    now = figures if figures is not None else compute(doc["spec"], settings, progress)
+    names = list(dict.fromkeys([*doc["figures"], *now]))
+    return [Change(n, doc["figures"].get(n), now.get(n), _tolerance(n, doc["tolerances"]))
+            for n in names]
