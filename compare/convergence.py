@@ -19,8 +19,8 @@ Series whose differences change sign are flagged ``oscillatory`` and get, instea
 Fs times half the range of the three values (the oscillatory uncertainty of Stern et al.,
 J. Fluids Eng. 123 (2001) 793); those whose differences grow (p < 0) are flagged
 ``divergent`` and get no bound, which blocks the choice of a ground-truth level; a fine-grid
-change below 1e-8 of the value is ``converged`` (bound Fs |e21 / f1|). Flags are reported,
-never hidden.
+change below 1e-8 of the value is ``converged`` (bound Fs |e21 / f1|); an observed order
+below 0.5 is ``slow`` (no extrapolation; GCI with p = 0.5). Flags are reported, never hidden.
 """
 
 from __future__ import annotations
@@ -37,6 +37,9 @@ from spindle.loads import LoadCase
 from spindle.spec import Spec
 
 SAFETY_FACTOR = 1.25
+#: observed orders below this are flagged ``slow`` (e.g. a logarithmic corner singularity):
+#: no extrapolation, and the GCI is computed with this floor order instead
+P_SLOW = 0.5
 #: a fine-grid change below this fraction of the value is converged (solver round-off of the
 #: sparse direct solve is ~1e-12; 1e-8 is far below any engineering tolerance)
 ROUNDOFF = 1e-8
@@ -70,12 +73,14 @@ class GCI:
             return "oscillatory"
         if abs(self.e21) >= abs(self.e32):
             return "divergent"
+        if math.log(abs(self.e32 / self.e21)) / math.log(self.r) < P_SLOW:
+            return "slow"
         return ""
 
     @property
     def p(self) -> float:
-        """Observed order (nan when flagged)."""
-        if self.flag:
+        """Observed order (nan when flagged, except ``slow``)."""
+        if self.flag not in ("", "slow"):
             return math.nan
         return math.log(abs(self.e32 / self.e21)) / math.log(self.r)
 
@@ -96,6 +101,8 @@ class GCI:
         if self.flag == "oscillatory":  # half the range of the three values (Stern et al. 2001)
             spread = max(self.f1, self.f2, self.f3) - min(self.f1, self.f2, self.f3)
             return self.Fs * 0.5 * spread / abs(self.f1) if self.f1 else math.nan
+        if self.flag == "slow":  # bound with the floor order, never extrapolated
+            return self.Fs * abs(self.e21 / self.f1) / (self.r**P_SLOW - 1)
         if self.flag:
             return math.nan
         return self.Fs * abs(self.e21 / self.f1) / (self.r**self.p - 1)

@@ -33,6 +33,9 @@ def test_flags():
     assert GCI(5.0, 5.0, 5.0).flag == "converged" and GCI(5.0, 5.0, 5.0).gci_fine == 0.0
     tiny = GCI(5.0, 5.0 + 1e-9, 5.1)  # fine-grid change at solver round-off
     assert tiny.flag == "converged" and tiny.gci_fine == pytest.approx(1.25 * 1e-9 / 5.0)
+    slow = GCI(10.0, 10.01, 10.0201)  # differences 0.01 and 0.0101: p = 0.014
+    assert slow.flag == "slow" and math.isnan(slow.extrapolated)
+    assert slow.gci_fine == pytest.approx(1.25 * 0.01 / 10.0 / (2**0.5 - 1))
     # oscillatory: Fs times half the range of the three values
     assert GCI(1.0, 1.1, 0.9).gci_fine == pytest.approx(1.25 * 0.5 * 0.2 / 1.0)
     assert math.isnan(GCI(1.0, 1.2, 1.3).gci_fine)
