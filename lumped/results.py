@@ -12,6 +12,7 @@ import numpy as np
 
 from spindle import plots
 from spindle.outputs import write_csv, write_json
+from spindle.results import SteadyTable, TransientTable
 
 KELVIN = 273.15
 
@@ -21,7 +22,7 @@ def _model_info(model) -> dict:
 
 
 @dataclass
-class LumpedSteadyResult:
+class LumpedSteadyResult(SteadyTable):
     """Steady mass temperatures with virtual sensors, growth and energy balance."""
 
     model: object
@@ -39,43 +40,12 @@ class LumpedSteadyResult:
         """Temperature at each temperature sensor [K], interpolated from the masses."""
         return dict(zip(self.model.sensor_names, (self.model.S @ self.T).tolist(), strict=True))
 
-    @property
-    def energy(self) -> dict[str, float]:
-        out = sum(self.heat_out_W.values())
-        imbalance = self.heat_in_W - out
-        scale = max(abs(self.heat_in_W), abs(out), 1e-300)
-        return {"heat_in_W": self.heat_in_W, "heat_out_W": out, "imbalance_W": imbalance,
-                "relative_imbalance": abs(imbalance) / scale,
-                **{f"out_{k}_W": v for k, v in self.heat_out_W.items()}}
-
-    def sensor_table(self) -> dict[str, list]:
-        T_amb = float(self.case.T_ambient_K(self.time_s))
-        sensors, values = self.model.spec.temperature_sensors(), self.sensors
-        return {"sensor": [s.name for s in sensors], "array": [s.array or "" for s in sensors],
-                "z_m": [s.z for s in sensors], "r_m": [s.r for s in sensors],
-                "T_C": [values[s.name] - KELVIN for s in sensors],
-                "rise_K": [values[s.name] - T_amb for s in sensors]}
-
     def mass_table(self) -> dict[str, list]:
         table = self.model.mass_table()
         return {**table, "T_C": [float(self.T[i]) - KELVIN for i in range(len(self.T))]}
 
-    def to_pandas(self):
-        """The sensor table as a DataFrame (needs pandas: pip install 'spindle-verify[data]')."""
-        import pandas as pd
-
-        return pd.DataFrame(self.sensor_table())
-
     def summary(self) -> dict:
-        table = self.sensor_table()
-        return {"spec": self.model.spec.name, "kind": "steady", "model": _model_info(self.model),
-                "speed_rpm": self.speed_rpm,
-                "T_ambient_C": float(self.case.T_ambient_K(self.time_s)) - KELVIN,
-                "T_coolant_C": float(self.case.T_coolant_K(self.time_s)) - KELVIN,
-                "relative_residual": self.residual, "energy": self.energy,
-                "T_max_C": float(self.T.max() - KELVIN),
-                "sensors_C": dict(zip(table["sensor"], table["T_C"], strict=True)),
-                "growth_um": {k: v * 1e6 for k, v in self.growth_m.items()}}
+        return self.steady_summary({"model": _model_info(self.model)})
 
     def _title(self) -> str:
         return (f"{self.model.spec.name}: steady, {self.speed_rpm:g} rpm, "
@@ -122,7 +92,7 @@ class LumpedSteadyResult:
 
 
 @dataclass
-class LumpedTransientResult:
+class LumpedTransientResult(TransientTable):
     """Sensor and mass histories of a zero-order-hold run, growth, energy balance."""
 
     model: object
@@ -137,60 +107,18 @@ class LumpedTransientResult:
     energy_out_by_J: dict[str, float]
     growth_m: dict[str, np.ndarray] = field(default_factory=dict)
 
-    @property
-    def energy(self) -> dict[str, float]:
-        imb = self.energy_in_J - self.energy_out_J - self.energy_stored_J
-        scale = max(abs(self.energy_in_J), abs(self.energy_out_J),
-                    abs(self.energy_stored_J), 1e-300)
-        return {"energy_in_J": self.energy_in_J, "energy_out_J": self.energy_out_J,
-                "energy_stored_J": self.energy_stored_J, "imbalance_J": imb,
-                "relative_imbalance": abs(imb) / scale}
-
-    def sensor(self, name: str) -> np.ndarray:
-        """History of one sensor [K]."""
-        return self.sensor_K[:, self.names.index(name)]
-
-    def to_pandas(self):
-        import pandas as pd
-
-        df = pd.DataFrame(self.sensor_K - KELVIN, columns=[f"{n}_C" for n in self.names])
-        df.insert(0, "time_s", self.times_s)
-        for k, v in self.growth_m.items():
-            df[f"{k}_um"] = v * 1e6
-        return df
-
     def summary(self) -> dict:
-        peak = self.sensor_K.max(axis=0) - KELVIN
         return {"spec": self.model.spec.name, "kind": "transient", "case": self.case.name,
                 "model": _model_info(self.model), "duration_s": float(self.times_s[-1]),
                 "steps": len(self.times_s) - 1, "energy": self.energy,
-                "peak_C": dict(zip(self.names, peak.tolist(), strict=True)),
-                "final_C": dict(zip(self.names, (self.sensor_K[-1] - KELVIN).tolist(),
-                                    strict=True)),
-                "peak_growth_um": {k: float(v.max() * 1e6) for k, v in self.growth_m.items()},
-                "final_growth_um": {k: float(v[-1] * 1e6) for k, v in self.growth_m.items()}}
-
-    def plot(self, ax=None):
-        plt = plots.pyplot()
-        if ax is None:
-            _, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
-        for j, n in enumerate(self.names):
-            ax.plot(self.times_s / 3600, self.sensor_K[:, j] - KELVIN, label=n)
-        ax.set_xlabel("time [h]")
-        ax.set_ylabel("temperature [°C]")
-        return ax
+                **self.peaks()}
 
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         """Summary JSON, sensor time series CSV, PNGs (sensors; T1 and P1 with the band)."""
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         write_json(out / "summary.json", self.summary())
-        growth = np.array(list(self.growth_m.values())).T * 1e6 if self.growth_m else \
-            np.zeros((len(self.times_s), 0))
-        write_csv(out / "sensors_timeseries.csv",
-                  ["time_s"] + [f"{n}_C" for n in self.names] + [f"{k}_um" for k in self.growth_m],
-                  ([t, *row, *g] for t, row, g in zip(self.times_s, self.sensor_K - KELVIN,
-                                                       growth, strict=True)))
+        write_csv(out / "sensors_timeseries.csv", *self.timeseries_rows())
         files = ["summary.json", "sensors_timeseries.csv"]
         if pictures:
             title = f"{self.model.spec.name}: {self.case.name}, lumped {self.model.nodes} nodes"

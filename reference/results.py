@@ -14,6 +14,7 @@ from spindle import plots as shared_plots
 from spindle.outputs import atomic_write
 from spindle.outputs import write_csv as _write_csv
 from spindle.outputs import write_json as _write_json
+from spindle.results import SteadyTable, TransientTable
 
 KELVIN = 273.15
 
@@ -25,7 +26,7 @@ def _mesh_info(model) -> dict:
 
 
 @dataclass
-class SteadyResult:
+class SteadyResult(SteadyTable):
     """A steady FEM temperature field with its sensors and energy balance."""
 
     model: object
@@ -46,40 +47,8 @@ class SteadyResult:
         names, pts = self.model.sensor_points()
         return dict(zip(names, (self.model.probe_matrix(pts) @ self.T).tolist(), strict=True))
 
-    @property
-    def energy(self) -> dict[str, float]:
-        """Global balance [W]: heat in - heat out (no storage at steady state)."""
-        out = sum(self.heat_out_W.values())
-        imbalance = self.heat_in_W - out
-        scale = max(abs(self.heat_in_W), abs(out), 1e-300)
-        return {"heat_in_W": self.heat_in_W, "heat_out_W": out, "imbalance_W": imbalance,
-                "relative_imbalance": abs(imbalance) / scale,
-                **{f"out_{k}_W": v for k, v in self.heat_out_W.items()}}
-
-    def sensor_table(self) -> dict[str, list]:
-        T_amb = float(self.case.T_ambient_K(self.time_s))
-        sensors, values = self.model.spec.temperature_sensors(), self.sensors
-        return {"sensor": [s.name for s in sensors], "array": [s.array or "" for s in sensors],
-                "z_m": [s.z for s in sensors], "r_m": [s.r for s in sensors],
-                "T_C": [values[s.name] - KELVIN for s in sensors],
-                "rise_K": [values[s.name] - T_amb for s in sensors]}
-
-    def to_pandas(self):
-        """The sensor table as a DataFrame (needs pandas: pip install 'spindle-verify[data]')."""
-        import pandas as pd
-
-        return pd.DataFrame(self.sensor_table())
-
     def summary(self) -> dict:
-        table = self.sensor_table()
-        return {"spec": self.model.spec.name, "kind": "steady", "mesh": _mesh_info(self.model),
-                "speed_rpm": self.speed_rpm,
-                "T_ambient_C": float(self.case.T_ambient_K(self.time_s)) - KELVIN,
-                "T_coolant_C": float(self.case.T_coolant_K(self.time_s)) - KELVIN,
-                "relative_residual": self.residual, "energy": self.energy,
-                "T_max_C": float(self.T.max() - KELVIN),
-                "sensors_C": dict(zip(table["sensor"], table["T_C"], strict=True)),
-                "growth_um": {k: v * 1e6 for k, v in self.growth_m.items()}}
+        return self.steady_summary({"mesh": _mesh_info(self.model)})
 
     def plot(self, ax=None):
         from reference.plots import plot_section
@@ -118,7 +87,7 @@ class SteadyResult:
 
 
 @dataclass
-class TransientResult:
+class TransientResult(TransientTable):
     """Sensor histories and saved fields of a theta-method run, with its energy balance."""
 
     model: object
@@ -139,54 +108,12 @@ class TransientResult:
     U_fields: np.ndarray | None = None  # displacement DOFs at field_times_s [m]
     elastic: object = None
 
-    @property
-    def energy(self) -> dict[str, float]:
-        """Cumulative balance [J]: in - out - stored, and its size relative to the flows."""
-        imb = self.energy_in_J - self.energy_out_J - self.energy_stored_J
-        scale = max(abs(self.energy_in_J), abs(self.energy_out_J),
-                    abs(self.energy_stored_J), 1e-300)
-        return {"energy_in_J": self.energy_in_J, "energy_out_J": self.energy_out_J,
-                "energy_stored_J": self.energy_stored_J, "imbalance_J": imb,
-                "relative_imbalance": abs(imb) / scale}
-
-    def sensor(self, name: str) -> np.ndarray:
-        """History of one sensor [K]."""
-        return self.sensor_K[:, self.names.index(name)]
-
-    def to_pandas(self):
-        import pandas as pd
-
-        df = pd.DataFrame(self.sensor_K - KELVIN, columns=[f"{n}_C" for n in self.names])
-        df.insert(0, "time_s", self.times_s)
-        for k, v in self.growth_m.items():
-            df[f"{k}_um"] = v * 1e6
-        return df
-
     def summary(self) -> dict:
-        peak = self.sensor_K.max(axis=0) - KELVIN
         return {"spec": self.model.spec.name, "kind": "transient", "case": self.case.name,
                 "mesh": _mesh_info(self.model), "theta": self.theta,
                 "duration_s": float(self.times_s[-1]), "steps": len(self.times_s) - 1,
                 "energy": self.energy,
-                "peak_C": dict(zip(self.names, peak.tolist(), strict=True)),
-                "final_C": dict(zip(self.names, (self.sensor_K[-1] - KELVIN).tolist(),
-                                    strict=True)),
-                "peak_growth_um": {k: float(v.max() * 1e6) for k, v in self.growth_m.items()},
-                "final_growth_um": {k: float(v[-1] * 1e6) for k, v in self.growth_m.items()}}
-
-    def plot(self, ax=None):
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        if ax is None:
-            _, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
-        for j, n in enumerate(self.names):
-            ax.plot(self.times_s / 3600, self.sensor_K[:, j] - KELVIN, label=n)
-        ax.set_xlabel("time [h]")
-        ax.set_ylabel("temperature [°C]")
-        return ax
+                **self.peaks()}
 
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         """Summary JSON, sensor time series CSV, VTU per saved time with a PVD, PNGs."""
@@ -196,12 +123,7 @@ class TransientResult:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         _write_json(out / "summary.json", self.summary())
-        growth = np.array(list(self.growth_m.values())).T * 1e6 if self.growth_m else \
-            np.zeros((len(self.times_s), 0))
-        _write_csv(out / "sensors_timeseries.csv",
-                   ["time_s"] + [f"{n}_C" for n in self.names] + [f"{k}_um" for k in self.growth_m],
-                   ([t, *row, *g] for t, row, g in zip(self.times_s, self.sensor_K - KELVIN,
-                                                        growth, strict=True)))
+        _write_csv(out / "sensors_timeseries.csv", *self.timeseries_rows())
         (out / "fields").mkdir(exist_ok=True)
         entries = []
         for i, (t, T) in enumerate(zip(self.field_times_s, self.fields_K, strict=True)):

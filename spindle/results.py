@@ -1,0 +1,107 @@
+"""What the result objects of both models share: energy balances, the sensor table and the
+DataFrame views. The models' result classes (reference.results, lumped.results) add their
+own fields, pictures and files. Temperatures in K; tables name their unit (``T_C``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+KELVIN = 273.15
+
+
+class SteadyTable:
+    """Needs ``model.spec``, ``case``, ``time_s``, ``speed_rpm``, ``T``, ``sensors``,
+    ``heat_in_W``, ``heat_out_W``, ``residual`` and ``growth_m``."""
+
+    @property
+    def energy(self) -> dict[str, float]:
+        """Global balance [W]: heat in - heat out (no storage at steady state)."""
+        out = sum(self.heat_out_W.values())
+        imbalance = self.heat_in_W - out
+        scale = max(abs(self.heat_in_W), abs(out), 1e-300)
+        return {"heat_in_W": self.heat_in_W, "heat_out_W": out, "imbalance_W": imbalance,
+                "relative_imbalance": abs(imbalance) / scale,
+                **{f"out_{k}_W": v for k, v in self.heat_out_W.items()}}
+
+    def sensor_table(self) -> dict[str, list]:
+        T_amb = float(self.case.T_ambient_K(self.time_s))
+        sensors, values = self.model.spec.temperature_sensors(), self.sensors
+        return {"sensor": [s.name for s in sensors], "array": [s.array or "" for s in sensors],
+                "z_m": [s.z for s in sensors], "r_m": [s.r for s in sensors],
+                "T_C": [values[s.name] - KELVIN for s in sensors],
+                "rise_K": [values[s.name] - T_amb for s in sensors]}
+
+    def steady_summary(self, about: dict) -> dict:
+        """The JSON summary; ``about`` describes the model (mesh, or lumped nodes)."""
+        table = self.sensor_table()
+        return {"spec": self.model.spec.name, "kind": "steady", **about,
+                "speed_rpm": self.speed_rpm,
+                "T_ambient_C": float(self.case.T_ambient_K(self.time_s)) - KELVIN,
+                "T_coolant_C": float(self.case.T_coolant_K(self.time_s)) - KELVIN,
+                "relative_residual": self.residual, "energy": self.energy,
+                "T_max_C": float(self.T.max() - KELVIN),
+                "sensors_C": dict(zip(table["sensor"], table["T_C"], strict=True)),
+                "growth_um": {k: v * 1e6 for k, v in self.growth_m.items()}}
+
+    def to_pandas(self):
+        """The sensor table as a DataFrame (needs pandas: pip install 'spindle-verify[data]')."""
+        import pandas as pd
+
+        return pd.DataFrame(self.sensor_table())
+
+
+class TransientTable:
+    """Needs ``times_s``, ``names``, ``sensor_K``, ``growth_m`` and the energy totals."""
+
+    @property
+    def energy(self) -> dict[str, float]:
+        """Cumulative balance [J]: in - out - stored, and its size relative to the flows."""
+        imb = self.energy_in_J - self.energy_out_J - self.energy_stored_J
+        scale = max(abs(self.energy_in_J), abs(self.energy_out_J),
+                    abs(self.energy_stored_J), 1e-300)
+        return {"energy_in_J": self.energy_in_J, "energy_out_J": self.energy_out_J,
+                "energy_stored_J": self.energy_stored_J, "imbalance_J": imb,
+                "relative_imbalance": abs(imb) / scale}
+
+    def sensor(self, name: str) -> np.ndarray:
+        """History of one sensor [K]."""
+        return self.sensor_K[:, self.names.index(name)]
+
+    def to_pandas(self):
+        import pandas as pd
+
+        df = pd.DataFrame(self.sensor_K - KELVIN, columns=[f"{n}_C" for n in self.names])
+        df.insert(0, "time_s", self.times_s)
+        for k, v in self.growth_m.items():
+            df[f"{k}_um"] = v * 1e6
+        return df
+
+    def peaks(self) -> dict:
+        """Peak and final sensor temperatures [degC] and growth readings [µm]."""
+        peak = self.sensor_K.max(axis=0) - KELVIN
+        return {"peak_C": dict(zip(self.names, peak.tolist(), strict=True)),
+                "final_C": dict(zip(self.names, (self.sensor_K[-1] - KELVIN).tolist(),
+                                    strict=True)),
+                "peak_growth_um": {k: float(v.max() * 1e6) for k, v in self.growth_m.items()},
+                "final_growth_um": {k: float(v[-1] * 1e6) for k, v in self.growth_m.items()}}
+
+    def timeseries_rows(self) -> tuple[list[str], object]:
+        """Header and rows of the sensor and growth history CSV."""
+        growth = np.array(list(self.growth_m.values())).T * 1e6 if self.growth_m else \
+            np.zeros((len(self.times_s), 0))
+        header = ["time_s"] + [f"{n}_C" for n in self.names] + [f"{k}_um" for k in self.growth_m]
+        rows = ([t, *row, *g] for t, row, g in zip(self.times_s, self.sensor_K - KELVIN, growth,
+                                                   strict=True))
+        return header, rows
+
+    def plot(self, ax=None):
+        from spindle.plots import pyplot
+
+        plt = pyplot()
+        if ax is None:
+            _, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
+        for j, n in enumerate(self.names):
+            ax.plot(self.times_s / 3600, self.sensor_K[:, j] - KELVIN, label=n)
+        ax.set_xlabel("time [h]")
+        ax.set_ylabel("temperature [°C]")
+        return ax
