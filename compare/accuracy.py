@@ -271,6 +271,15 @@ def _meets(row: dict[str, float], tol_T: float, tol_P: float) -> bool:
 
 
 # ---------------------------------------------------------------------- running the models
+def _read_outs(model, case: LoadCase, dt_s: float | None, T0: float | None) -> tuple[dict, dict]:
+    """Sensors [K] and growth [m] of a steady (dt_s None) or transient run of either model."""
+    if dt_s is None:
+        res = model.steady(case)
+        return res.sensors, res.growth_m
+    res = model.transient(case, dt_s, T0=T0)
+    return {k: res.sensor(k) for k in res.names}, res.growth_m
+
+
 def lumped_entries(spec: Spec, case: LoadCase, nodes: Sequence[int], dt_s: float | None,
                    T0: float | None, progress: Callable[[str], None] | None = None
                    ) -> list[Entry]:
@@ -283,13 +292,7 @@ def lumped_entries(spec: Spec, case: LoadCase, nodes: Sequence[int], dt_s: float
             progress(f"lumped {n} nodes")
         t = time.perf_counter()
         model = build(spec, n)
-        if dt_s is None:
-            res = model.steady(case)
-            sensors, growth = res.sensors, res.growth_m
-        else:
-            res = model.transient(case, dt_s, T0=T0)
-            sensors = {k: res.sensor(k) for k in res.names}
-            growth = res.growth_m
+        sensors, growth = _read_outs(model, case, dt_s, T0)
         out.append(Entry(f"lumped {n}", "lumped", model.n_states, time.perf_counter() - t,
                          sensors, growth, PRESET_NODES.get(n, ""), nodes=n))
     return out
@@ -337,12 +340,6 @@ def fem_entry(spec: Spec, level: int, case: LoadCase, dt_s: float | None, T0: fl
 
     t = time.perf_counter()
     model = ReferenceModel(spec, level, order)
-    if dt_s is None:
-        res = model.steady(case)
-        sensors, growth = res.sensors, res.growth_m
-    else:
-        res = model.transient(case, dt_s, T0=T0)
-        sensors = {k: res.sensor(k) for k in res.names}
-        growth = res.growth_m
+    sensors, growth = _read_outs(model, case, dt_s, T0)
     return Entry(f"FEM level {level}", "fem", int(model.thermal.basis.N),
                  time.perf_counter() - t, sensors, growth, level=level)
