@@ -347,6 +347,10 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("file", metavar="FILE")
     cp.add_argument("--quiet", action="store_true", help="no progress on stderr")
     cp.set_defaults(func=_cmd_check)
+
+    from compare import calculix
+
+    calculix.register(sub)
     return p
 
 

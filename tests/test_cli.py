@@ -159,3 +159,8 @@ def test_bad_node_count_exits_2(tmp_path, nodes):
             str(tmp_path / "x"))
     assert r.returncode == 2 and "--nodes" in r.stderr and "fix:" in r.stderr
     assert "Traceback" not in r.stderr and not (tmp_path / "x").exists()
+
+
+def test_crosscheck_is_a_command():
+    r = run("crosscheck", "--help")
+    assert r.returncode == 0 and "CalculiX" in r.stdout and "--keep-deck" in r.stdout
