@@ -996,7 +996,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``crosscheck SPEC [--level N] [--case CYCLE] [--out DIR] [--keep-deck]``."""
     cp = subparsers.add_parser(
         "crosscheck", help="cross-check the FEM reference with CalculiX (ccx) on the same P2 "
-                           "mesh: sensor temperatures and axial growth (P1, TCP)")
+                           "mesh: sensor temperatures and axial growth (P1, TCP)",
+        description="Cross-check the FEM reference with CalculiX (ccx, Debian package "
+                    "calculix-ccx) on the same P2 mesh: sensor temperatures and axial growth "
+                    "(P1, TCP) from both codes and their differences.")
     cp.add_argument("spec", metavar="SPEC")
     cp.add_argument("--level", type=int, default=1, help="mesh level (default 1)")
     cp.add_argument("--case", metavar="CYCLE",
