@@ -82,7 +82,7 @@ class ThermoelasticModel:
         """Map from free reduced DOFs to all DOFs: ties across contact joints, u_r = 0 on the
         axis, and the axial support."""
         b, sm, n = self.basis, self.smesh, self.basis.N
-        rep = np.arange(n)
+        pairs = []
         for li, fa, fb in sm.contacts:
             if not isinstance(self.spec.links[li], ContactLink) or not len(fa):
                 continue
@@ -92,8 +92,17 @@ class ThermoelasticModel:
                 a, bb = np.intersect1d(da, comp), np.intersect1d(db, comp)
                 d, j = cKDTree(b.doflocs[:, a].T).query(b.doflocs[:, bb].T)
                 assert d.max(initial=0.0) < 1e-9
-                rep[bb] = a[j]
-        rep = rep[rep]  # a DOF tied twice (two joints) resolves to the first representative
+                pairs.append(np.vstack([a[j], bb]))
+        # every group of DOFs tied together (a chain of joints too) shares one representative,
+        # its lowest DOF: connected components of the tie graph
+        from scipy.sparse.csgraph import connected_components
+
+        ties = np.hstack(pairs) if pairs else np.zeros((2, 0), dtype=np.int64)
+        graph = sp.csr_matrix((np.ones(ties.shape[1]), (ties[0], ties[1])), shape=(n, n))
+        _, label = connected_components(graph, directed=False)
+        first = np.full(label.max() + 1, n)
+        np.minimum.at(first, label, np.arange(n))
+        rep = first[label]
         fixed = np.zeros(n, dtype=bool)
         fixed[self.ir[np.abs(b.doflocs[1, self.ir]) < 1e-12]] = True
         if fixed_axial:
