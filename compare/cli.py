@@ -348,8 +348,9 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("--quiet", action="store_true", help="no progress on stderr")
     cp.set_defaults(func=_cmd_check)
 
-    from compare import calculix
+    from compare import calculix, sensors
 
+    sensors.register(sub)
     calculix.register(sub)
     return p
 

@@ -164,3 +164,12 @@ def test_bad_node_count_exits_2(tmp_path, nodes):
 def test_crosscheck_is_a_command():
     r = run("crosscheck", "--help")
     assert r.returncode == 0 and "CalculiX" in r.stdout and "--keep-deck" in r.stdout
+
+
+def test_sensors_command(tmp_path, capsys):
+    out = tmp_path / "s"
+    assert main(["sensors", "fin-shaft", "--nodes", "3", "11", "--level", "1", "--tol-temp",
+                 "30", "--quiet", "--no-pictures", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "N = 3 is the smallest node count" in text  # 22.6 K on the warm-up < 30 K
+    assert (out / "nodes.csv").exists()
