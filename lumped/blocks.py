@@ -125,9 +125,14 @@ class FixedTemperature(OnePort):
 @dataclass(eq=False)
 class PrescribedHeatFlow(OnePort):
     """Heat [W] into the port: ``share`` of the input series ``source`` (a heat-source name
-    of the load case) or of a constant [W], times (1 + tc_1_K (T - T_ref_K))."""
+    of the load case) or of a constant [W], times (1 + tc_1_K (T - T_ref_K)).
+
+    With ``across`` = (port_a, port_b) the factor is (1 + tc_1_K (T_a - T_b)) instead: heat that
+    rises with a temperature difference elsewhere (bearing friction rising with the
+    shaft-housing difference as thermal expansion raises the preload)."""
 
     source: str | float = 0.0
     share: float = 1.0
     tc_1_K: float = 0.0
     T_ref_K: float = 293.15
+    across: tuple[HeatPort, HeatPort] | None = None

@@ -204,11 +204,19 @@ def _radial_R(spec: Spec, sec: Section, r_face: float, dz: float) -> float:
     return abs(np.log(max(r_face, 1e-12) / rc)) / (2 * np.pi * k * dz)
 
 
-def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = True
+def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = True,
+                  coolant_advection_W_K: float | None = None, bearing_tc_1_K: float = 0.0
                   ) -> LumpedNetwork:
     """The function-block network of ``spec`` with ``nodes`` masses along shaft and housing
     (an int >= 2, or a preset name of :data:`PRESETS`). ``radial_conduction=False`` drops the
-    conduction from a mass to its faces (film and contact resistances only), as eq. 7 does."""
+    conduction from a mass to its faces (film and contact resistances only), as eq. 7 does.
+
+    Extensions (off by default; the measured-data loop switches them on):
+    ``coolant_advection_W_K`` = 2 m_dot c_p [W/K] lets the coolant warm along the jacket with
+    the heat it carries (its mean temperature is the supply plus Q / (2 m_dot c_p)), instead of
+    staying at the supply temperature; ``bearing_tc_1_K`` makes each bearing's friction heat
+    rise with the inner-outer ring temperature difference, Q (1 + tc (T_inner - T_outer)), as
+    thermal expansion raises the preload."""
     if isinstance(nodes, str):
         if nodes not in PRESETS:
             raise SpecError([Problem("command line", "--nodes", f"unknown preset '{nodes}'",
@@ -258,6 +266,14 @@ def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = T
     def fixed(ref: str):
         if ports[ref] is None:
             ports[ref] = net.add(FixedTemperature(ref, source=ref))
+            if ref == "coolant" and coolant_advection_W_K is not None:
+                # the films see the coolant's mean temperature: a junction behind the
+                # advection conductance 2 m_dot c_p
+                adv = net.add(ThermalConductor("coolant_advection", G_W_K=coolant_advection_W_K))
+                net.connect(ports[ref].port, adv.port_b)
+                ports["coolant_mean"] = adv
+        if ref == "coolant" and "coolant_mean" in ports:
+            return ports["coolant_mean"].port_a
         return ports[ref].port
 
     # ------------------------------------------------------------------ axial chains
@@ -438,9 +454,14 @@ def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = T
                             weights[m.name] = weights.get(m.name, 0.0) + v
             total = sum(weights.values())
             shares = {k: v / total for k, v in weights.items()}
+        preload = None
+        if bearing_tc_1_K and src.part is not None and parts[src.part].ring:
+            inner_m, outer_m = parts[src.part].masses
+            preload = (inner_m.block.port, outer_m.block.port)
         for mname, share in shares.items():
             q = net.add(PrescribedHeatFlow(f"source:{src.name}:{mname}", source=src.name,
-                                           share=share))
+                                           share=share, tc_1_K=bearing_tc_1_K if preload else 0.0,
+                                           across=preload))
             net.connect(by_name[mname].block.port, q.port)
 
     return LumpedNetwork(spec, nodes, net, parts, masses)

@@ -141,6 +141,8 @@ class Network:
             elif isinstance(b, Convection):
                 edges.append((node(b.port_a), node(b.port_b), b.Gc_W_K, b.name))
         flows = [(node(b.port), b) for b in self.blocks if isinstance(b, PrescribedHeatFlow)]
+        across = {id(b): (node(b.across[0]), node(b.across[1])) for _, b in flows
+                  if b.across is not None}
 
         # every group of unknown nodes joined by conductances needs a fixed temperature
         adj: dict[int, set[int]] = {i: set() for i in range(n_all)}
@@ -175,7 +177,7 @@ class Network:
         return ThermalSystem(
             name=self.name, n_all=n_all, free=free, fixed_nodes=fixed_nodes,
             fixed_sources=fixed_sources, capacity=capacity, labels=labels, where=where,
-            edges=edges, flows=flows, source_names=source_names)
+            edges=edges, flows=flows, source_names=source_names, across=across)
 
 
 def _may_conduct(G: Conductance) -> bool:
@@ -206,6 +208,7 @@ class ThermalSystem:
     edges: list[tuple[int, int, Conductance, str]]
     flows: list[tuple[int, PrescribedHeatFlow]]
     source_names: list[str | float]
+    across: dict[int, tuple[int, int]] = field(default_factory=dict)  # flow -> (node a, node b)
     _cache: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -249,6 +252,17 @@ class ThermalSystem:
         for n, f in self.flows:
             if n not in pos:
                 continue  # heat into a fixed temperature leaves the network at once
+            if id(f) in self.across:
+                # Q = share q (1 + tc (T_a - T_b)): linear in T_a and T_b
+                B[pos[n], col[f.source]] += f.share
+                if f.tc_1_K and q is not None:
+                    g = f.share * f.tc_1_K * q[col[f.source]]
+                    for node_, sign in zip(self.across[id(f)], (1.0, -1.0), strict=True):
+                        if node_ in pos:
+                            K[pos[n], pos[node_]] -= sign * g
+                        else:
+                            raise ValueError("a heat flow across a fixed temperature")
+                continue
             # Q = share q (1 + tc (T - T_ref)) = share q (1 - tc T_ref) + share q tc T
             B[pos[n], col[f.source]] += f.share * (1.0 - f.tc_1_K * f.T_ref_K)
             if f.tc_1_K and q is not None:
@@ -313,8 +327,14 @@ class ThermalSystem:
     def heat_in(self, T_all: np.ndarray, q: np.ndarray) -> float:
         """Heat [W] from the prescribed heat flows at node temperatures T_all."""
         col = {s: k for k, s in enumerate(self.source_names)}
-        return float(sum(f.share * q[col[f.source]] * (1 + f.tc_1_K * (T_all[n] - f.T_ref_K))
-                         for n, f in self.flows))
+        total = 0.0
+        for n, f in self.flows:
+            if id(f) in self.across:
+                a, b = self.across[id(f)]
+                total += f.share * q[col[f.source]] * (1 + f.tc_1_K * (T_all[a] - T_all[b]))
+            else:
+                total += f.share * q[col[f.source]] * (1 + f.tc_1_K * (T_all[n] - f.T_ref_K))
+        return float(total)
 
     # ------------------------------------------------------------------ solves
     def steady(self, u: np.ndarray, speed_rpm: float) -> np.ndarray:

@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from lumped.build import build_network
+from lumped.build import LumpedNetwork, build_network
 from lumped.elastic import GrowthChain, KelvinVoigt
 from lumped.results import LumpedSteadyResult, LumpedTransientResult
 from spindle.errors import SolverError
@@ -30,9 +30,11 @@ class LumpedModel:
     """
 
     def __init__(self, spec: Spec, nodes: int | str = 11, radial_conduction: bool = True,
-                 lags: dict[str, KelvinVoigt] | None = None):
+                 lags: dict[str, KelvinVoigt] | None = None, network: LumpedNetwork | None = None):
         self.spec = spec
-        self.net = build_network(spec, nodes, radial_conduction)
+        # a prebuilt (possibly extended) network of the spec may be given instead
+        self.net = network if network is not None else build_network(spec, nodes,
+                                                                     radial_conduction)
         self.nodes = self.net.nodes
         self.system = self.net.network.assemble()
         sys = self.system

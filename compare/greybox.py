@@ -1,0 +1,317 @@
+"""The grey-box model of a bench run: the lumped model with declared, bounded uncertain
+parameters and a library of candidate effects it does not contain.
+
+Base parameters (issue 6: bearing friction factor, loss split, film coefficients, contact
+conductances, effective expansion coefficient), each a bounded factor or value:
+
+======================  =====================================================  ===========
+name                    meaning                                                bounds
+======================  =====================================================  ===========
+``f0``                  Palmgren bearing friction factor (all pairs)           0.05 .. 3
+``rotor_share``         rotor share of the motor losses                        0.01 .. 0.5
+``h_coolant``           factor on the coolant-jacket film conductances         0.2 .. 5
+``h_air``               factor on the housing-to-air film conductances         0.2 .. 5
+``h_rotating``          factor on the rotating surfaces' film conductances     0.2 .. 5
+``contact``             factor on the interface conductances of contact links  0.2 .. 5
+``alpha_eff``           factor on the expansion coefficients of the growth     0.5 .. 2
+======================  =====================================================  ===========
+
+Candidate effects (:data:`EFFECTS`, names fixed: users' scripts read them), each a physical
+extension with its own parameters and explanation; see :class:`Effect`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lumped.blocks import Convection, FixedTemperature, PrescribedHeatFlow, ThermalConductor
+from lumped.build import build_network
+from lumped.simulation import LumpedModel
+from spindle.drive import Drive
+from spindle.spec import Spec
+
+ROTATING = ("shaft", "tool", "rotor")
+CHANNELS = ("T1", "T2", "T_stator", "P1")
+
+
+@dataclass(frozen=True)
+class Param:
+    """A fitted parameter: default, bounds, unit; ``log`` fits it on a log scale."""
+
+    name: str
+    unit: str
+    default: float
+    lo: float
+    hi: float
+    doc: str
+    log: bool = True
+
+
+BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
+    Param("f0", "-", 0.30, 0.05, 3.0, "Palmgren bearing friction factor of all pairs"),
+    Param("rotor_share", "-", 0.06, 0.01, 0.5, "rotor share of the motor losses"),
+    Param("h_coolant", "x", 1.0, 0.2, 5.0, "factor on the coolant-jacket film conductances"),
+    Param("h_air", "x", 1.0, 0.2, 5.0, "factor on the housing-to-air film conductances"),
+    Param("h_rotating", "x", 1.0, 0.2, 5.0, "factor on the rotating surfaces' films"),
+    Param("contact", "x", 1.0, 0.2, 5.0, "factor on the contact-link interface conductances"),
+    Param("alpha_eff", "x", 1.0, 0.5, 2.0, "factor on the expansion coefficients of the "
+          "thermoelastic chain (effective expansion coefficient)"),
+)}
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A candidate physical effect: name, explanation, its parameters (their zero / neutral
+    value is the base model, so the base is nested in the extended model)."""
+
+    name: str
+    explanation: str
+    params: tuple[Param, ...]
+    channels: tuple[str, ...] = CHANNELS  # channels whose signature it shapes
+
+
+EFFECTS: dict[str, Effect] = {e.name: e for e in (
+    Effect("centrifugal_shortening",
+           "At speed the rotating shaft is stretched radially by the centrifugal load and, by "
+           "Poisson's ratio, shortens axially; the shortening follows n^2 at once, with no "
+           "thermal lag, so P1 drops at every speed-up and recovers at every slow-down.",
+           (Param("c_cf_um_krpm2", "um/krpm^2", 0.0, 0.0, 1.0,
+                  "axial shortening at P1 per (1000 rpm)^2", log=False),), ("P1",)),
+    Effect("bearing_preload",
+           "The inner ring runs warmer than the outer ring; the difference expands the inner "
+           "ring more and raises the preload of the angular-contact pairs, so the friction "
+           "heat rises with the shaft-housing temperature difference (a thermal feedback).",
+           (Param("k_preload_1_K", "1/K", 0.0, 0.0, 0.2,
+                  "relative rise of the bearing friction per K of inner-outer ring difference",
+                  log=False),)),
+    Effect("fixture_expansion",
+           "The eddy-current sensor's holder is fixed to the housing's outside and moves with "
+           "the air temperature, so P1 carries a term proportional to the ambient change.",
+           (Param("k_fix_um_K", "um/K", 0.0, -5.0, 5.0,
+                  "P1 change per K of ambient change", log=False),), ("P1",)),
+    Effect("coolant_dynamics",
+           "The coolant warms along the jacket with the heat it carries: the films see the "
+           "supply temperature plus Q / (2 m_dot c_p), not the supply temperature.",
+           (Param("R_adv_K_W", "K/W", 0.0, 0.0, 0.02,
+                  "1 / (2 m_dot c_p) of the coolant flow", log=False),)),
+    Effect("sensor_lag",
+           "A sensor reads with a first-order lag: a PT100 in a bore with poor contact, or a "
+           "filtered displacement channel.",
+           (Param("tau_s", "s", 0.0, 0.0, 3600.0, "time constant of the lag", log=False),)),
+    Effect("windage_loss",
+           "Air friction of the rotor in the air gap and of the shaft surfaces, rising roughly "
+           "with n^3, heats the rotor beyond what the electrical balance assigns to it.",
+           (Param("c_w_W_krpm3", "W/krpm^3", 0.0, 0.0, 5.0,
+                  "windage heat per (1000 rpm)^3 into the rotor", log=False),)),
+    Effect("mount_conduction",
+           "Heat leaves the housing through its mounting flange into the machine structure, "
+           "which stays near the room temperature.",
+           (Param("G_mount_W_K", "W/K", 0.0, 0.0, 20.0,
+                  "conductance from the housing's front face to the structure", log=False),)),
+)}
+
+
+@dataclass
+class Inputs:
+    """Model inputs on a time grid (interval k runs from grid[k] to grid[k + 1]): speed
+    [rpm], electrical power [kW], load torque [N m], ambient and coolant [K], per interval."""
+
+    grid_s: np.ndarray
+    speed_rpm: np.ndarray
+    power_kW: np.ndarray
+    load_torque_Nm: np.ndarray
+    T_env_K: np.ndarray
+    T_coolant_K: np.ndarray
+
+
+def inputs_from_cycle(cycle, grid_s: np.ndarray) -> Inputs:
+    """Inputs of a shipped or user cycle (spindle.cycles.Cycle) on ``grid_s``: each
+    interval takes the step, ambient and coolant at its middle; power unknown (nan)."""
+    mid = 0.5 * (grid_s[1:] + grid_s[:-1])
+    idx = np.clip(np.searchsorted(np.asarray(cycle.boundaries_s), mid, side="right") - 1, 0,
+                  len(cycle.steps) - 1)
+    steps = [cycle.steps[i] for i in idx]
+    power = np.array([np.nan if s.power_kW is None else s.power_kW for s in steps])
+    return Inputs(grid_s, np.array([s.speed_rpm for s in steps]), power,
+                  np.array([s.load_torque_Nm for s in steps]),
+                  np.asarray(cycle.T_ambient_K(mid), dtype=float),
+                  np.asarray(cycle.T_coolant_K(mid), dtype=float))
+
+
+@dataclass
+class GreyBox:
+    """The lumped model of ``spec`` with parameters and effects, simulated on ``inputs``."""
+
+    spec: Spec
+    drive: Drive
+    inputs: Inputs
+    nodes: int = 11
+    effects: tuple[str, ...] = ()
+    lag_channel: str | None = None  # the channel of a sensor_lag effect
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def parameters(self) -> dict[str, Param]:
+        out = dict(BASE_PARAMS)
+        for e in self.effects:
+            for p in EFFECTS[e].params:
+                out[p.name] = p
+        return out
+
+    # ------------------------------------------------------------------ sources
+    def _sources(self, f0: float, rotor_share: float) -> dict[str, np.ndarray]:
+        key = ("src", round(f0, 12), round(rotor_share, 12))
+        if key not in self._cache:
+            d = self.drive.with_f0(f0).with_rotor_share(rotor_share)
+            inp = self.inputs
+            memo: dict[tuple, dict[str, float]] = {}
+            rows = []
+            for n, M, P in zip(inp.speed_rpm, inp.load_torque_Nm, inp.power_kW, strict=True):
+                k = (round(float(n), 3), round(float(M), 4),
+                     None if np.isnan(P) else round(float(P), 4))
+                if k not in memo:  # P unknown (nan): the motor model gives the losses
+                    memo[k] = d.heat_W(k[0], k[1], None if k[2] is None else max(k[2], 0.0))
+                rows.append(memo[k])
+            self._cache = {k2: v for k2, v in self._cache.items() if k2[0] != "src"}
+            self._cache[key] = {s: np.array([r[s] for r in rows]) for s in rows[0]}
+        return self._cache[key]
+
+    # ------------------------------------------------------------------ model
+    def _model(self, theta: dict[str, float]) -> LumpedModel:
+        R_adv = theta.get("R_adv_K_W", 0.0)
+        net = build_network(self.spec, self.nodes,
+                            coolant_advection_W_K=1.0 / R_adv if R_adv > 0 else None,
+                            bearing_tc_1_K=theta.get("k_preload_1_K", 0.0))
+        groups = _film_groups(self.spec)
+        for b in net.network.blocks:
+            if isinstance(b, Convection) and b.name.startswith("film:"):
+                f = theta[groups[b.name.split(":")[1]]]
+                if f != 1.0:
+                    b.Gc_W_K = _scaled(b.Gc_W_K, f)
+            elif isinstance(b, ThermalConductor) and b.name.startswith("contact:"):
+                if theta["contact"] != 1.0 and _is_contact_link(self.spec, b.name):
+                    b.G_W_K *= theta["contact"]
+        if "windage_loss" in self.effects:
+            rotor = [p for p in net.parts.values() if p.part.role == "rotor"]
+            masses = rotor[0].masses if rotor else net.parts[self.spec.parts[0].name].masses
+            total = sum(m.block.C_J_K for m in masses)
+            for m in masses:
+                q = net.network.add(PrescribedHeatFlow(f"source:windage:{m.name}",
+                                                       source="windage",
+                                                       share=m.block.C_J_K / total))
+                net.network.connect(m.block.port, q.port)
+        if "mount_conduction" in self.effects and theta.get("G_mount_W_K", 0.0) > 0:
+            hous = [p for p in net.parts.values() if p.part.role == "housing"][0]
+            front = hous.masses[-1]
+            amb = next(b for b in net.network.blocks if isinstance(b, FixedTemperature)
+                       and b.source == "ambient")
+            c = net.network.add(Convection("mount", Gc_W_K=theta["G_mount_W_K"]))
+            net.network.connect(front.block.port, c.port_a)
+            net.network.connect(c.port_b, amb.port)
+        return LumpedModel(self.spec, network=net)
+
+    def simulate(self, theta: dict[str, float], x0_K: float | None = None
+                 ) -> dict[str, np.ndarray]:
+        """Channel values at the grid points [K; m for P1] for parameters ``theta`` (missing
+        names take their defaults). Zero-order hold over each interval, exact."""
+        params = self.parameters()
+        th = {k: theta.get(k, p.default) for k, p in params.items()}
+        model = self._model(th)
+        sys = model.system
+        inp = self.inputs
+        src = self._sources(th["f0"], th["rotor_share"])
+        n_int = len(inp.grid_s) - 1
+        cols = []
+        for name in sys.source_names:
+            if name == "windage":
+                cols.append(th.get("c_w_W_krpm3", 0.0) * (inp.speed_rpm / 1000.0) ** 3)
+            else:
+                cols.append(src[name] if name in src else np.zeros(n_int))
+        for f in sys.fixed_sources:
+            cols.append(inp.T_env_K if f == "ambient" else inp.T_coolant_K)
+        U = np.column_stack(cols)
+        m = len(sys.source_names)
+        x = np.full(sys.n_states, inp.T_env_K[0] if x0_K is None else x0_K)
+        X = np.empty((n_int + 1, sys.n_states))
+        X[0] = x
+        dts = np.diff(inp.grid_s)
+        for k in range(n_int):
+            Phi, Gam = sys.discretize(float(dts[k]), float(inp.speed_rpm[k]),
+                                      U[k, :m] if sys.temperature_dependent else None)
+            x = Phi @ x + Gam @ U[k]
+            X[k + 1] = x
+        out: dict[str, np.ndarray] = {}
+        for j, name in enumerate(model.sensor_names):
+            if name in CHANNELS:
+                out[name] = X @ model.S[j]
+        if "P1" in model.chain.rows:
+            p1 = th["alpha_eff"] * ((X - model.chain.T_ref) @ model.chain.rows["P1"])
+            n_end = np.concatenate([[inp.speed_rpm[0]], inp.speed_rpm])  # speed over the step
+            if "centrifugal_shortening" in self.effects:
+                p1 = p1 - th["c_cf_um_krpm2"] * 1e-6 * (n_end / 1000.0) ** 2
+            if "fixture_expansion" in self.effects:
+                T_env = np.concatenate([[inp.T_env_K[0]], inp.T_env_K])
+                p1 = p1 + th["k_fix_um_K"] * 1e-6 * (T_env - T_env[0])
+            out["P1"] = p1 - p1[0]  # relative to the start, as the bench zeroes P1
+        if "sensor_lag" in self.effects and self.lag_channel in out and th["tau_s"] > 0:
+            out[self.lag_channel] = first_order_lag(inp.grid_s, out[self.lag_channel],
+                                                    th["tau_s"])
+        return out
+
+
+def first_order_lag(t: np.ndarray, x: np.ndarray, tau_s: float) -> np.ndarray:
+    """Response of tau y' + y = x for x linear between samples, from y(0) = x(0); exact."""
+    y = np.empty_like(x)
+    y[0] = x[0]
+    for k in range(1, len(x)):
+        h = t[k] - t[k - 1]
+        a = math.exp(-h / tau_s)
+        slope = (x[k] - x[k - 1]) / h
+        y[k] = a * y[k - 1] + (1 - a) * x[k - 1] + slope * (h - tau_s * (1 - a))
+    return y
+
+
+def _film_groups(spec: Spec) -> dict[str, str]:
+    """Surface name -> its film parameter: coolant, rotating or housing air."""
+    roles = {p.name: p.role for p in spec.parts}
+    out = {}
+    for s in spec.surfaces:
+        if s.T_ref == "coolant":
+            out[s.name] = "h_coolant"
+        elif any(roles[p] in ROTATING for p in s.parts):
+            out[s.name] = "h_rotating"
+        else:
+            out[s.name] = "h_air"
+    return out
+
+
+def _is_contact_link(spec: Spec, block_name: str) -> bool:
+    from spindle.spec import ContactLink
+
+    a, b = block_name.split(":", 1)[1].split("-", 1)
+    pa, pb = a.split("[")[0].split(".")[0], b.split("[")[0].split(".")[0]
+    return any(isinstance(lk, ContactLink) and set(lk.parts) == {pa, pb} for lk in spec.links)
+
+
+def _scaled(G, factor: float):
+    if callable(G) and not isinstance(G, int | float):
+        return _Scaled(G, factor)
+    return float(G) * factor
+
+
+@dataclass(frozen=True)
+class _Scaled:
+    G: object
+    factor: float
+
+    def __call__(self, speed_rpm: float) -> float:
+        from lumped.blocks import conductance_at
+
+        return self.factor * conductance_at(self.G, speed_rpm)
+
+
+def default_theta(params: dict[str, Param], names: Sequence[str] | None = None) -> dict:
+    return {k: p.default for k, p in params.items() if names is None or k in names}

@@ -1,0 +1,236 @@
+"""Synthetic bench runs from the FEM reference, with one effect injected (issue 6 §5).
+
+``spindle-verify synth --cycle spl-16h --effect NAME --seed S --out RUN.csv`` solves the FEM
+reference (not the lumped model the fit uses) over the cycle with the effect built into the
+physics or the measurement, then samples it the way a bench logs: irregular times (about 1 Hz),
+sensor noise and quantisation, a gap, empty cells, comment metadata and an extra column, in
+the bench format (../shared/bench-format.md). The truth (effect, its parameters, the seed) goes
+to ``RUN.truth.json`` beside the CSV; ``fit`` never reads it.
+
+How each effect enters the reference:
+
+- ``centrifugal_shortening``: the FEM's own centrifugal load (rho omega^2 r on the rotating
+  parts), scaled by a factor (the spl2782 shaft at 4300 rpm shortens only 0.26 µm; the scale
+  stands for a more compliant rotor so that the effect is worth detecting);
+- ``bearing_preload``: bearing heat times (1 + k (T_inner - T_outer)) from the FEM's own ring
+  temperatures, by fixed-point iteration;
+- ``fixture_expansion``: P1 + k (T_env - T_env(0));
+- ``coolant_dynamics``: coolant temperature = supply + R Q_coolant(t) from the FEM's own heat
+  into the coolant, by fixed-point iteration;
+- ``sensor_lag``: a first-order lag on T1 or P1;
+- ``windage_loss``: c (n / 1000)^3 W more into the rotor;
+- ``mount_conduction``: a conductance G from the housing's front face to ambient;
+- ``clean``: none; ``electronics_drift`` (outside the library, for the tests): a slow
+  sinusoidal drift of the P1 electronics.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from compare.greybox import EFFECTS, first_order_lag
+from spindle.loads import LoadCase, SpeedTable, TimeSeries
+from spindle.spec import Spec
+
+KELVIN = 273.15
+OUTSIDE = ("electronics_drift",)
+#: noise (standard deviation) and quantisation of the bench channels
+NOISE = {"T1_C": (0.03, 0.01), "T2_C": (0.03, 0.01), "T_stator_C": (0.1, 0.1),
+         "P1_um": (0.05, 0.1), "T_env_C": (0.05, 0.01), "T_coolant_C": (0.02, 0.01)}
+
+
+def draw_truth(effect: str, rng: np.random.Generator) -> dict:
+    """The injected effect's parameters for this seed (magnitudes a bench could show)."""
+    if effect == "centrifugal_shortening":
+        return {"scale": float(rng.uniform(8.0, 15.0))}
+    if effect == "bearing_preload":
+        return {"k_preload_1_K": float(rng.uniform(0.03, 0.08))}
+    if effect == "fixture_expansion":
+        return {"k_fix_um_K": float(rng.choice([-1, 1]) * rng.uniform(0.8, 2.0))}
+    if effect == "coolant_dynamics":
+        return {"R_adv_K_W": float(rng.uniform(0.002, 0.005))}
+    if effect == "sensor_lag":
+        return {"channel": str(rng.choice(["T1", "P1"])), "tau_s": float(rng.uniform(400, 900))}
+    if effect == "windage_loss":
+        return {"c_w_W_krpm3": float(rng.uniform(0.6, 1.5))}
+    if effect == "mount_conduction":
+        return {"G_mount_W_K": float(rng.uniform(2.0, 5.0))}
+    if effect == "electronics_drift":
+        return {"amplitude_um": float(rng.uniform(1.0, 2.0)), "period_h": 5.0}
+    return {}
+
+
+def _with_mount(spec: Spec, G_W_K: float) -> Spec:
+    """The housing's front-face film raised by G / A (A its area)."""
+    from spindle.faces import exposed_faces, surface_faces
+
+    faces = exposed_faces(spec)
+    front = [s for s in spec.surfaces if s.side == "front" and s.h_W_m2K is not None
+             and any(spec.part(p).role == "housing" for p in s.parts)]
+    if not front:
+        raise ValueError("mount_conduction needs a convective front face of the housing")
+    s = front[0]
+    area = sum(f.area_m2 for f in surface_faces(s, faces))
+    h = SpeedTable(s.h_W_m2K.speed_rpm, tuple(v + G_W_K / area for v in s.h_W_m2K.values))
+    surfaces = tuple(replace(x, h_W_m2K=h) if x is s else x for x in spec.surfaces)
+    return replace(spec, surfaces=surfaces)
+
+
+def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: int = 1,
+                  dt_s: float = 60.0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Times [s] and the channels T1, T2, T_stator [K], P1 [m] of the FEM with the effect."""
+    from reference import ReferenceModel
+
+    T0 = float(case.T_ambient_K(0.0))
+    if effect == "mount_conduction":
+        spec = _with_mount(spec, truth["G_mount_W_K"])
+    if effect == "windage_loss":
+        rotor = [h.name for h in spec.heat_sources if h.part and spec.part(h.part).role == "rotor"]
+        src = case.sources[rotor[0]]
+        t = np.asarray(src.time_s)
+        extra = truth["c_w_W_krpm3"] * (np.asarray(case.speed_rpm(t + 1e-6)) / 1000.0) ** 3
+        case = case.with_sources({rotor[0]: TimeSeries(tuple(t), tuple(np.asarray(src.values)
+                                                                       + extra),
+                                                       src.interpolation)})
+    ref = ReferenceModel(spec, level, centrifugal=effect == "centrifugal_shortening")
+    if effect in ("coolant_dynamics", "bearing_preload"):
+        res = _fixed_point(ref, case, effect, truth, dt_s, T0)
+    else:
+        res = ref.transient(case, dt_s, T0=T0)
+    ch = {n: res.sensor(n) for n in ("T1", "T2", "T_stator") if n in res.names}
+    P1 = res.growth_m["P1"].copy()
+    if effect == "centrifugal_shortening":  # scale the centrifugal part only
+        plain = ReferenceModel(spec, level).transient(case, dt_s, T0=T0).growth_m["P1"]
+        P1 = plain + truth["scale"] * (P1 - plain)
+    ch["P1"] = P1
+    t = res.times_s
+    if effect == "fixture_expansion":
+        env = np.asarray(case.T_ambient_K(t))
+        ch["P1"] = ch["P1"] + truth["k_fix_um_K"] * 1e-6 * (env - env[0])
+    if effect == "sensor_lag":
+        ch[truth["channel"]] = first_order_lag(t, ch[truth["channel"]], truth["tau_s"])
+    if effect == "electronics_drift":
+        ch["P1"] = ch["P1"] + truth["amplitude_um"] * 1e-6 * np.sin(
+            2 * np.pi * t / (truth["period_h"] * 3600.0))
+    return t, ch
+
+
+def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0: float,
+                 iterations: int = 3):
+    """Transients repeated with inputs updated from the previous run's own temperatures."""
+    th = ref.thermal
+    spec = th.spec
+    if effect == "coolant_dynamics":
+        from reference.thermal import TWO_PI
+
+        # coolant films do not depend on speed (Dittus-Boelter on the flow)
+        rows = [TWO_PI * s.h_W_m2K(0.0) * b for s, _, b in th.op.films if s.T_ref == "coolant"]
+        g = np.sum(rows, axis=0)
+        functionals = {"coolant_bT": g}
+    else:
+        pts, names = [], []
+        for p in spec.parts:
+            if p.role not in ("front_bearing", "rear_bearing"):
+                continue
+            for sec in p.sections:
+                if sec.name in ("inner_ring", "outer_ring"):
+                    z = 0.5 * (sec.z_start + sec.z_end)
+                    pts.append((z, 0.5 * float(sec.r_in(z) + sec.r_out(z))))
+                    names.append(f"{p.name}.{sec.name}")
+        P = th.probe_matrix(np.array(pts).T).toarray()
+        functionals = {n: P[i] for i, n in enumerate(names)}
+    base = case
+    res = None
+    for _ in range(iterations):
+        res = th.solve_transient(case, dt_s, 1.0, T0, 0, None, functionals)
+        t = res.times_s
+        if effect == "coolant_dynamics":
+            Tc = np.asarray(base.T_coolant_K(t))
+            Q = res.functionals["coolant_bT"] - Tc * float(functionals["coolant_bT"].sum())
+            case = replace(case, T_coolant_K=TimeSeries(tuple(t), tuple(Tc + truth["R_adv_K_W"] * Q)))
+        else:
+            new = {}
+            for h in spec.heat_sources:
+                if h.part and spec.part(h.part).role in ("front_bearing", "rear_bearing"):
+                    dT = res.functionals[f"{h.part}.inner_ring"] - \
+                        res.functionals[f"{h.part}.outer_ring"]
+                    q0 = np.asarray(base.sources[h.name](t))
+                    new[h.name] = TimeSeries(tuple(t), tuple(q0 * (1 + truth["k_preload_1_K"] * dT)))
+            case = base.with_sources(new)
+    return ref.transient(case, dt_s, T0=T0)
+
+
+def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, power_W,
+               rng: np.random.Generator, rate_hz: float = 1.0) -> tuple[list[str], np.ndarray]:
+    """Sample like a bench: irregular times, a 20 min gap, noise, quantisation, empty cells."""
+    dur = float(t_model[-1])
+    n = int(dur * rate_hz * 1.05) + 10
+    t = np.cumsum(rng.uniform(0.5, 1.5, n) / rate_hz)
+    t = t[t < dur]
+    gap0 = rng.uniform(0.3, 0.5) * dur  # a logging gap of 20 min
+    t = t[(t < gap0) | (t > gap0 + 1200.0)]
+    cols: dict[str, np.ndarray] = {"time_s": t}
+    cols["speed_rpm"] = np.asarray(case.speed_rpm(t), dtype=float)
+    cols["power_kW"] = np.asarray(power_W(t), dtype=float) / 1e3 * (1 + rng.normal(0, 0.01, len(t)))
+    cols["T_env_C"] = np.asarray(case.T_ambient_K(t)) - KELVIN
+    cols["T_coolant_C"] = np.asarray(case.T_coolant_K(t)) - KELVIN
+    for name, y in ch.items():
+        v = np.interp(t, t_model, y)
+        cols[f"{name}_um" if name == "P1" else f"{name}_C"] = v * 1e6 if name == "P1" else v - KELVIN
+    cols["P1_um"] = cols["P1_um"] - cols["P1_um"][0]
+    for key, (sd, q) in NOISE.items():
+        if key in cols:
+            cols[key] = np.round((cols[key] + rng.normal(0, sd, len(t))) / q) * q
+    cols["vibration_mm_s"] = np.abs(rng.normal(0.3, 0.05, len(t)))  # an extra bench channel
+    header = list(cols)
+    data = np.column_stack([cols[h] for h in header])
+    for j, h in enumerate(header):  # 0.5 % of the measured cells are empty
+        if h.startswith(("T1", "T2", "T_stator", "P1")):
+            data[rng.random(len(t)) < 0.005, j] = np.nan
+    return header, data
+
+
+def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, level: int = 1,
+          dt_s: float = 60.0) -> dict:
+    """Write the synthetic run and its truth sidecar; returns the truth."""
+    from spindle.cycles import load_cycle
+    from spindle.drive import cycle_load_case, drive_for
+    from spindle.outputs import atomic_write
+
+    if effect not in (*EFFECTS, "clean", *OUTSIDE):
+        raise ValueError(effect)
+    rng = np.random.default_rng(seed)
+    truth = {"effect": effect, "parameters": draw_truth(effect, rng), "seed": seed,
+             "cycle": cycle_name, "fem_level": level, "spec": spec.name}
+    cycle = load_cycle(cycle_name)
+    drive = drive_for(spec)
+    case = cycle_load_case(spec, cycle, drive)
+    t_model, ch = reference_run(spec, case, effect, truth["parameters"], level, dt_s)
+    # electrical power: losses plus mechanical output, per step (no-load cycles: losses)
+    starts = np.asarray(cycle.boundaries_s[:-1])
+    p_el = []
+    for s in cycle.steps:
+        heat = sum(drive.heat_W(s.speed_rpm, s.load_torque_Nm, s.power_kW).values())
+        p_el.append(heat + s.load_torque_Nm * s.speed_rpm * np.pi / 30.0)
+
+    def power_W(t: np.ndarray) -> np.ndarray:
+        i = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(p_el) - 1)
+        return np.asarray(p_el)[i]
+
+    header, data = bench_rows(t_model, ch, case, power_W, rng)
+    lines = [f"# spindle: {spec.name}", "# bench: synthetic run (spindle-verify synth)",
+             f"# cycle: {cycle_name}", f"# rows: {len(data)}", ",".join(header)]
+    fmt = {h: ("{:.2f}" if h in ("time_s", "speed_rpm") else "{:.4f}") for h in header}
+    for row in data:
+        lines.append(",".join("" if np.isnan(v) else fmt[h].format(v)
+                              for h, v in zip(header, row, strict=True)))
+    out_csv = Path(out_csv)
+    out_csv.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(out_csv, lambda tmp: tmp.write_text("\n".join(lines) + "\n", "utf-8"))
+    sidecar = out_csv.with_suffix(".truth.json")
+    atomic_write(sidecar, lambda tmp: tmp.write_text(json.dumps(truth, indent=2) + "\n", "utf-8"))
+    return truth
