@@ -254,6 +254,42 @@ def _cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_fit(args: argparse.Namespace) -> int:
+    from compare.fitrun import report_summary_text, run_fit, save_report
+    from spindle.outputs import output_dir
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)
+    rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
+                  candidates=args.candidates, min_gain=args.min_gain / 100.0,
+                  progress=_progress(args.quiet))
+    out = Path(args.out or f"results/{spec.name}/fit-{Path(args.run).stem}")
+    with output_dir(out, inputs=[spec.path, args.run]) as tmp:
+        save_report(rep, tmp, pictures=not args.no_pictures)
+    print(report_summary_text(rep))
+    print(f"wrote {out}/report.json, {out}/report.html")
+    return 0
+
+
+def _cmd_synth(args: argparse.Namespace) -> int:
+    from compare.greybox import EFFECTS
+    from compare.synth import OUTSIDE, synth
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)
+    known = [*EFFECTS, "clean", *OUTSIDE]
+    if args.effect not in known:
+        raise InputError("command line", "--effect", f"unknown effect '{args.effect}'",
+                         f"use one of {', '.join(known)}")
+    out = Path(args.out)
+    if out.suffix.lower() != ".csv":
+        raise InputError(str(out), "--out", "is not a .csv file name", "give e.g. run.csv")
+    truth = synth(spec, args.cycle, args.effect, args.seed, out, level=args.level)
+    print(f"wrote {out} and {out.with_suffix('.truth.json')} (effect {truth['effect']}, "
+          f"seed {truth['seed']})")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="spindle-verify",
@@ -347,6 +383,33 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("file", metavar="FILE")
     cp.add_argument("--quiet", action="store_true", help="no progress on stderr")
     cp.set_defaults(func=_cmd_check)
+
+    fp = sub.add_parser("fit", help="fit a bench run: calibrate, diagnose the residual, add the "
+                        "effects it supports, report the error before and after")
+    fp.add_argument("run", metavar="RUN.csv", help="bench export (format: docs/bench.md)")
+    fp.add_argument("--spec", default="spl2782", help="the spindle (default spl2782)")
+    fp.add_argument("--out", help="output folder (default results/<spec>/fit-<run>)")
+    fp.add_argument("--fit-fraction", type=float, default=0.6,
+                    help="fraction of the run used for fitting; the rest validates (0.6)")
+    fp.add_argument("--alpha", type=float, default=0.01,
+                    help="level of the likelihood-ratio test for adding an effect (0.01)")
+    fp.add_argument("--min-gain", type=float, default=10.0,
+                    help="validation error must fall by at least this [%%] (default 10)")
+    fp.add_argument("--nodes", type=int, default=11, help="lumped model nodes (default 11)")
+    fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
+    fp.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
+    fp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    fp.set_defaults(func=_cmd_fit)
+
+    sy = sub.add_parser("synth", help="a synthetic bench run from the FEM reference with one "
+                        "effect injected; the truth goes to RUN.truth.json")
+    sy.add_argument("--spec", default="spl2782")
+    sy.add_argument("--cycle", default="spl-16h", help="cycle (default spl-16h)")
+    sy.add_argument("--effect", default="clean", help="effect to inject (default clean)")
+    sy.add_argument("--seed", type=int, default=0)
+    sy.add_argument("--level", type=int, default=1, help="FEM level (default 1)")
+    sy.add_argument("--out", required=True, help="the CSV to write")
+    sy.set_defaults(func=_cmd_synth)
 
     from compare import calculix, sensors
 

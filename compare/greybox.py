@@ -31,6 +31,7 @@ import numpy as np
 from lumped.blocks import Convection, FixedTemperature, PrescribedHeatFlow, ThermalConductor
 from lumped.build import build_network
 from lumped.simulation import LumpedModel
+from spindle.bench import interval_heat_W
 from spindle.drive import Drive
 from spindle.spec import Spec
 
@@ -173,7 +174,10 @@ class GreyBox:
                 k = (round(float(n), 3), round(float(M), 4),
                      None if np.isnan(P) else round(float(P), 4))
                 if k not in memo:  # P unknown (nan): the motor model gives the losses
-                    memo[k] = d.heat_W(k[0], k[1], None if k[2] is None else max(k[2], 0.0))
+                    if k[2] is None:
+                        memo[k] = d.heat_W(k[0], k[1], None)
+                    else:  # measured P: standstill and P < P_mech handled as the bench does
+                        memo[k] = interval_heat_W(d, k[0], k[1], k[2])[0]
                 rows.append(memo[k])
             self._cache = {k2: v for k2, v in self._cache.items() if k2[0] != "src"}
             self._cache[key] = {s: np.array([r[s] for r in rows]) for s in rows[0]}

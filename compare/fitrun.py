@@ -1,0 +1,390 @@
+"""``spindle-verify fit RUN.csv --spec SPEC --out DIR``: confront the model with a bench run.
+
+1. Ingest the run (spindle.bench), map its channels to the spec's sensors, build the inputs
+   through the power balance on a 60 s grid.
+2. Calibrate the declared parameters on the fit window (default the first 60 %), validate on
+   the rest (compare.fit).
+3. Diagnose the residual (compare.residuals), select effects forward (likelihood-ratio test at
+   ``alpha``, validation must improve), and say ``unexplained`` when the final residual is still
+   structured beyond the tolerances and no candidate explains it.
+4. Write ``report.json`` (the stable contract of issue 6) and ``report.html``.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from compare.fit import (
+    TOLERANCE,
+    Calibrator,
+    Fit,
+    Measured,
+    Selection,
+    forward_selection,
+    parameters_table,
+    resample,
+)
+from compare.greybox import EFFECTS, GreyBox, Inputs
+from spindle.bench import BenchRun, bench_grid, cell_means, check_against_spec, held, read_bench
+from spindle.drive import drive_for
+from spindle.errors import InputError
+from spindle.spec import Spec
+
+KELVIN = 273.15
+REPORT_FORMAT = "spindle-verify-fit/1"
+
+
+def greybox_inputs(run: BenchRun, grid_s: float = 60.0) -> Inputs:
+    """Per-interval inputs of the grey box: speed held at the interval start, power, torque,
+    ambient and coolant averaged over the interval (spindle.bench's helpers)."""
+    grid = bench_grid(run, grid_s)
+    mids = 0.5 * (grid[:-1] + grid[1:])
+
+    def valid(col: str) -> tuple[np.ndarray, np.ndarray]:
+        y = run.columns[col]
+        ok = ~np.isnan(y)
+        return run.time_s[ok], y[ok]
+
+    speed = held(*valid("speed_rpm"), grid[:-1])
+    power = cell_means(*valid("power_kW"), grid, mids)
+    torque = cell_means(*valid("load_torque_Nm"), grid, mids) if run.load_torque_measured \
+        else np.zeros(len(mids))
+    T_env = cell_means(*valid("T_env_C"), grid, mids) + KELVIN
+    T_cool = cell_means(*valid("T_coolant_C"), grid, mids) + KELVIN
+    return Inputs(grid, speed, power, torque, T_env, T_cool)
+
+
+@dataclass
+class FitReport:
+    run: BenchRun
+    spec: Spec
+    channels: list[str]
+    measured: Measured
+    inputs: Inputs
+    selection: Selection
+    diagnostics_before: object
+    diagnostics_after: object
+    unexplained: bool
+    unexplained_text: str
+    signatures: dict[str, dict[str, np.ndarray]]
+    runtime_s: float
+    alpha: float
+
+    def to_dict(self) -> dict:
+        sel = self.selection
+        final = sel.final
+        effects = []
+        for st in sel.steps:
+            e = EFFECTS[st.effect]
+            params = {p.name: st.fit.theta[p.name] for p in e.params}
+            if st.effect == "sensor_lag":
+                params["channel"] = st.fit.lag_channel
+            effects.append({"name": st.effect, "parameters": params,
+                            "confidence_intervals": {p.name: list(st.fit.ci95[p.name])
+                                                     for p in e.params},
+                            "p_value": st.p_value, "delta_bic": st.delta_bic,
+                            "explanation": e.explanation,
+                            "validation_error_before": st.validation_before,
+                            "validation_error_after": st.validation_after})
+        return _clean({
+            "format": REPORT_FORMAT, "run": str(self.run.path), "spec": self.spec.name,
+            "channels": self.channels, "run_summary": self.run.summary(),
+            "windows": {"fit": [float(self.measured.grid_s[0]), self.measured.split_s],
+                        "validation": [self.measured.split_s, float(self.measured.grid_s[-1])]},
+            "tolerances": {"temperature_K": 1.0, "growth_um": 1.5},
+            "alpha": self.alpha,
+            "effects": effects,
+            "unexplained": {"unexplained": self.unexplained, "description": self.unexplained_text},
+            "error_before": _errors(sel.base), "error_after": _errors(final),
+            "parameters": parameters_table(final),
+            "parameters_before": parameters_table(sel.base),
+            "correlation": {"names": final.free, "matrix": final.correlation.tolist()},
+            "not_identifiable": [k for k, ok in final.identifiable.items() if not ok],
+            "candidates_tried": sel.tried,
+            "diagnostics_before": self.diagnostics_before.to_dict(),
+            "diagnostics_after": self.diagnostics_after.to_dict(),
+            "runtime_s": self.runtime_s})
+
+
+def _errors(fit: Fit) -> dict:
+    out = {}
+    for window, chans in fit.errors.items():
+        out[window] = {}
+        for c, e in chans.items():
+            if not e.get("n"):
+                continue
+            unit = "um" if c == "P1" else "K"
+            out[window][c] = {"rmse": e[f"rmse_{unit}"], "max": e[f"max_{unit}"],
+                              "bias": e[f"bias_{unit}"], "unit": unit,
+                              "within_tolerance": e["within_tolerance"], "n": e["n"]}
+    return out
+
+
+def _clean(x):
+    if isinstance(x, dict):
+        return {str(k): _clean(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_clean(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _clean(x.tolist())
+    if isinstance(x, np.bool_ | bool):
+        return bool(x)
+    if isinstance(x, np.integer):
+        return int(x)
+    if isinstance(x, float | np.floating):
+        return float(x) if math.isfinite(x) else None
+    return x
+
+
+def _residuals(measured: Measured, model: dict[str, np.ndarray], channels) -> dict:
+    return {c: (measured.values[c] - model[c]) / TOLERANCE[c] for c in channels}
+
+
+def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
+            nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
+            min_gain: float = 0.10, progress: Callable[[str], None] | None = None) -> FitReport:
+    """The whole loop (module docstring)."""
+    from compare.residuals import diagnose
+
+    t0 = time.perf_counter()
+    say = progress or (lambda _m: None)
+    if not 0.2 <= fit_fraction <= 0.9:
+        raise InputError("command line", "--fit-fraction", f"{fit_fraction} is outside 0.2..0.9",
+                         "fit on 20 % to 90 % of the run, e.g. 0.6")
+    say(f"reading {path}")
+    run = read_bench(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        channels = check_against_spec(run, spec)
+    drive = drive_for(spec)
+    if drive is None:
+        raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
+                         "add [power_balance] preset to the spec")
+    inputs = greybox_inputs(run, grid_s)
+    values = {}
+    for c in channels:
+        t, y = run.channel(c)
+        values[c] = resample(t, y, inputs.grid_s)
+    measured = Measured(inputs.grid_s, values, fit_fraction)
+    for c in channels:
+        if measured.mask(c, "fit").sum() < 10 or measured.mask(c, "validation").sum() < 5:
+            raise InputError(str(path), c, "has too few samples in the fit or validation window",
+                             "export a run that measures this channel throughout, or drop it")
+    cal = Calibrator(GreyBox(spec, drive, inputs, nodes), measured, channels, progress=say)
+    sel = forward_selection(cal, candidates, alpha, min_gain=min_gain)
+    final = sel.final
+    ins = {"speed": np.concatenate([[inputs.speed_rpm[0]], inputs.speed_rpm]),
+           "power": np.concatenate([[inputs.power_kW[0]], inputs.power_kW]),
+           "T_env": np.concatenate([[inputs.T_env_K[0]], inputs.T_env_K])}
+    # each candidate's signature: what it would add to the final model (a third of its range)
+    signatures: dict[str, dict[str, np.ndarray]] = {}
+    gb_final = GreyBox(spec, drive, inputs, nodes, final.effects, final.lag_channel, cal.gb._cache)
+    for name, e in EFFECTS.items():
+        if name in final.effects or name == "sensor_lag":
+            continue
+        g = GreyBox(spec, drive, inputs, nodes, final.effects + (name,), final.lag_channel,
+                    cal.gb._cache)
+        th = dict(final.theta)
+        th.update({p.name: p.lo + (p.hi - p.lo) / 3 if p.lo >= 0 else p.hi / 3 for p in e.params})
+        with_e, without = g.simulate(th), gb_final.simulate(final.theta)
+        signatures[name] = {c: with_e[c] - without[c] for c in channels}
+    res_b = _residuals(measured, sel.base.model, channels)
+    res_a = _residuals(measured, final.model, channels)
+    sig_flat = {f"{n}:{c}": s[c] for n, s in signatures.items() for c in channels
+                if np.nanstd(s[c]) > 1e-12 * max(np.nanmax(np.abs(s[c])), 1e-300)
+                and np.nanmax(np.abs(s[c])) > 0}
+    dt = float(np.median(np.diff(inputs.grid_s)))
+    diag_b = diagnose(res_b, dt, ins, sig_flat, alpha=alpha)
+    diag_a = diagnose(res_a, dt, ins, sig_flat, alpha=alpha)
+    # unexplained: the final residual is structured AND beyond the tolerance somewhere
+    errs = final.errors["validation"]
+    beyond = [c for c in channels if errs[c].get("n") and errs[c]["within_tolerance"] < 0.95]
+    structured = [c for c in channels if not diag_a.channels[c].whiteness.white]
+    unexplained = bool(beyond and structured)
+    text = ""
+    if unexplained:
+        text = ("no candidate effect explains the remaining residual: "
+                + diag_a.unexplained_description())
+    elif structured:
+        text = ("the residual is still serially correlated in " + ", ".join(structured)
+                + " but within the tolerances on the validation window (model-form error of "
+                "the lumped model below the tolerances); no effect is named for it")
+    return FitReport(run, spec, channels, measured, inputs, sel, diag_b, diag_a, unexplained,
+                     text, signatures, time.perf_counter() - t0, alpha)
+
+
+# ---------------------------------------------------------------------- report files
+def save_report(rep: FitReport, out: Path, pictures: bool = True) -> list[Path]:
+    from spindle.outputs import atomic_write, write_json
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = rep.to_dict()
+    write_json(out / "report.json", doc)
+    files = [out / "report.json"]
+    pngs: list[tuple[str, str]] = []
+    if pictures:
+        pngs = _pictures(rep, out)
+        files += [out / name for name, _ in pngs]
+    atomic_write(out / "report.html", lambda tmp: tmp.write_text(_html(rep, doc, out, pngs),
+                                                                   "utf-8"))
+    files.append(out / "report.html")
+    return files
+
+
+def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
+    from compare.residuals import plot_acf, plot_cumulated_periodogram
+    from spindle.outputs import atomic_write
+    from spindle.plots import pyplot
+
+    plt = pyplot()
+    g = rep.measured.grid_s / 3600
+    sel = rep.selection
+    made = []
+    n = len(rep.channels)
+    fig, axes = plt.subplots(n, 2, figsize=(13, 2.8 * n), layout="constrained", squeeze=False)
+    for i, c in enumerate(rep.channels):
+        scale, off, unit = (1e6, 0.0, "µm") if c == "P1" else (1.0, KELVIN, "°C")
+        tol = TOLERANCE[c] * scale
+        meas = rep.measured.values[c] * scale - off
+        for j, (fit, label) in enumerate(((sel.base, "before"), (sel.final, "after"))):
+            ax = axes[i, j]
+            model = fit.model[c] * scale - off
+            ax.fill_between(g, model - tol, model + tol, color="tab:blue", alpha=0.15,
+                            label=f"model ±{tol:g} {unit}")
+            ax.plot(g, model, color="tab:blue", ls="--", lw=1, label="model")
+            ax.plot(g, meas, color="black", lw=0.8, label="measured")
+            ax.axvline(rep.measured.split_s / 3600, color="tab:red", lw=0.8, ls=":")
+            ax.set_ylabel(f"{c} [{unit}]")
+            ax.set_title(f"{c} {label}" + (f" (+ {', '.join(fit.effects)})" if fit.effects
+                                            else " (base model)"), fontsize=9)
+            ax.grid(alpha=0.3)
+            if i == 0:
+                ax.legend(fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [h] (dotted: end of the fit window)")
+    atomic_write(out / "fit_channels.png", lambda tmp: fig.savefig(tmp, dpi=110))
+    plt.close(fig)
+    made.append(("fit_channels.png", "measured against the model, before and after, with the "
+                 "tolerance bands (paper Fig. 13)"))
+    fig, axes = plt.subplots(n, 3, figsize=(14, 2.6 * n), layout="constrained", squeeze=False)
+    dt = float(np.median(np.diff(rep.measured.grid_s)))
+    for i, c in enumerate(rep.channels):
+        rb = (rep.measured.values[c] - sel.base.model[c]) / TOLERANCE[c]
+        ra = (rep.measured.values[c] - sel.final.model[c]) / TOLERANCE[c]
+        ax = axes[i, 0]
+        ax.plot(g, rb, lw=0.8, label="before")
+        ax.plot(g, ra, lw=0.8, label="after")
+        ax.axhspan(-1, 1, color="0.9")
+        ax.set_ylabel(f"{c} residual / tol")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+        for r in (rb, ra):
+            if (~np.isnan(r)).sum() > 20:
+                plot_acf(axes[i, 1], r, 40, 0.01, dt)
+                plot_cumulated_periodogram(axes[i, 2], r, 0.01, dt)
+        axes[i, 1].set_title(f"{c}: ACF (before, after)", fontsize=9)
+        axes[i, 2].set_title(f"{c}: cumulated periodogram (before, after)", fontsize=9)
+    atomic_write(out / "fit_residuals.png", lambda tmp: fig.savefig(tmp, dpi=110))
+    plt.close(fig)
+    made.append(("fit_residuals.png", "residuals before and after (in tolerance units), their "
+                 "autocorrelation and cumulated periodograms"))
+    if sel.steps:
+        st = sel.steps[0]
+        fig, axes = plt.subplots(1, n, figsize=(4.5 * n, 3.2), layout="constrained",
+                                 squeeze=False)
+        before_it = sel.base
+        with_it = st.fit
+        for i, c in enumerate(rep.channels):
+            ax = axes[0, i]
+            scale = 1e6 if c == "P1" else 1.0
+            ax.plot(g, (rep.measured.values[c] - before_it.model[c]) * scale, lw=0.8,
+                    label="residual of the base model")
+            ax.plot(g, (with_it.model[c] - before_it.model[c]) * scale, lw=1.2,
+                    label=f"{st.effect} signature")
+            ax.set_title(c, fontsize=9)
+            ax.grid(alpha=0.3)
+        axes[0, 0].legend(fontsize=7)
+        atomic_write(out / "fit_signature.png", lambda tmp: fig.savefig(tmp, dpi=110))
+        plt.close(fig)
+        made.append(("fit_signature.png", f"the base model's residual against the accepted "
+                     f"effect's signature ({st.effect})"))
+    return made
+
+
+def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> str:
+    def img(name: str, caption: str) -> str:
+        data = base64.b64encode((out / name).read_bytes()).decode("ascii")
+        return (f'<figure><img style="max-width:100%" src="data:image/png;base64,{data}">'
+                f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+    def err_table(block: dict) -> str:
+        rows = []
+        for window in ("fit", "validation"):
+            for c, e in block.get(window, {}).items():
+                rows.append(f"<tr><td>{window}</td><td>{c}</td><td>{e['rmse']:.3f}</td>"
+                            f"<td>{e['max']:.3f}</td><td>{e['bias']:+.3f}</td><td>{e['unit']}</td>"
+                            f"<td>{100 * e['within_tolerance']:.1f} %</td></tr>")
+        return ("<table><tr><th>window</th><th>channel</th><th>RMSE</th><th>max</th>"
+                "<th>bias</th><th>unit</th><th>within tolerance</th></tr>" + "".join(rows)
+                + "</table>")
+
+    eff = "".join(f"<li><b>{html.escape(e['name'])}</b> ({html.escape(str(e['parameters']))}; "
+                  f"p = {e['p_value']:.2g}, ΔBIC = {e['delta_bic']:.1f}): "
+                  f"{html.escape(e['explanation'])}</li>" for e in doc["effects"]) \
+        or "<li>none accepted</li>"
+    params = "".join(f"<tr><td>{html.escape(p['name'])}</td><td>{p['value']:.4g}</td>"
+                     f"<td>{p['ci95'][0]:.4g} .. {p['ci95'][1]:.4g}</td><td>{p['unit']}</td>"
+                     f"<td>{'yes' if p['identifiable'] else 'NO'}</td>"
+                     f"<td>{html.escape(p['meaning'])}</td></tr>" for p in doc["parameters"])
+    unexpl = doc["unexplained"]
+    return "\n".join([
+        "<!doctype html><html><head><meta charset='utf-8'><title>spindle-verify fit</title>",
+        "<style>body{font-family:sans-serif;max-width:1300px;margin:2em auto}table{border-"
+        "collapse:collapse;font-size:12px}td,th{border:1px solid #ccc;padding:2px 6px}</style>",
+        "</head><body>",
+        f"<h1>Fit of {html.escape(str(rep.run.path))} to {html.escape(rep.spec.name)}</h1>",
+        f"<p>Channels {rep.channels}; fit window up to {rep.measured.split_s / 3600:.2f} h, "
+        f"validation after; likelihood-ratio level {rep.alpha:g}; {rep.runtime_s:.1f} s.</p>",
+        "<h2>Effects accepted (in order)</h2><ul>" + eff + "</ul>",
+        f"<p><b>Unexplained:</b> {'yes' if unexpl['unexplained'] else 'no'}. "
+        f"{html.escape(unexpl['description'])}</p>",
+        "<h2>Error before</h2>" + err_table(doc["error_before"]),
+        "<h2>Error after</h2>" + err_table(doc["error_after"]),
+        "<h2>Calibrated parameters (95 % intervals)</h2><table><tr><th>name</th><th>value</th>"
+        "<th>95 %</th><th>unit</th><th>identifiable</th><th>meaning</th></tr>" + params
+        + "</table>",
+        *[img(n, c) for n, c in pngs],
+        "</body></html>\n"])
+
+
+def report_summary_text(rep: FitReport) -> str:
+    doc = rep.to_dict()
+    lines = [f"{rep.run.path}: {len(rep.run.time_s)} rows, {rep.run.duration_s / 3600:.2f} h, "
+             f"channels {', '.join(rep.channels)}; {rep.runtime_s:.1f} s"]
+    for e in doc["effects"]:
+        lines.append(f"  effect {e['name']}: {json.dumps(e['parameters'])} "
+                     f"(p = {e['p_value']:.2g}, delta BIC {e['delta_bic']:.1f})")
+    if not doc["effects"]:
+        lines.append("  no effect accepted")
+    lines.append(f"  unexplained: {doc['unexplained']['unexplained']}"
+                 + (f" - {doc['unexplained']['description']}"
+                    if doc["unexplained"]["description"] else ""))
+    for key, label in (("error_before", "before"), ("error_after", "after")):
+        v = doc[key].get("validation", {})
+        lines.append(f"  validation error {label}: " + ", ".join(
+            f"{c} {e['rmse']:.3f} {e['unit']} rms / {e['max']:.3f} max" for c, e in v.items()))
+    bad = doc["not_identifiable"]
+    if bad:
+        lines.append(f"  not identifiable from this run: {', '.join(bad)}")
+    return "\n".join(lines)

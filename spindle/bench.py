@@ -1,0 +1,695 @@
+"""Test-bench runs (issue 6, section 1): read a bench export and build the model's inputs.
+
+A motor-spindle test bench exports one run as a CSV file (the shared bench-format document;
+rules, errors and decisions in docs/bench.md). This module reads it as it is:
+
+* :func:`read_bench` parses and checks the file into a :class:`BenchRun` (file units: s, rpm,
+  kW, °C, µm, N m; NaN where a cell is empty). Every problem raises
+  :class:`~spindle.errors.InputError` naming the file, the column and/or the file line
+  (comments and blank lines counted) and the fix; the command line turns it into exit status 2.
+* :func:`check_against_spec` maps the measured channels (T1, T2, T_stator, P1) to the spec's
+  sensors of the same name and kind.
+* :func:`inputs` turns the run into a :class:`~spindle.loads.LoadCase` on a time grid: speed
+  held, ambient and coolant averaged, heat sources from the drive's power balance per grid
+  interval.
+
+SI inside (K, m, W, s); °C and µm appear only in the file's column names and in
+:attr:`BenchRun.columns` (which keeps the file's units).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from spindle.drive import Drive, drive_for
+from spindle.errors import InputError
+from spindle.loads import LoadCase, TimeSeries
+from spindle.power import power_balance
+from spindle.spec import Spec
+
+#: 0 °C in K.
+ZERO_C_K = 273.15
+#: µm -> m
+UM_TO_M = 1e-6
+
+#: Columns every run must have, in the order of the format's table.
+REQUIRED_COLUMNS: tuple[str, ...] = ("time_s", "speed_rpm", "power_kW", "T_env_C", "T_coolant_C")
+#: Measured model channels and their columns, in the order :attr:`BenchRun.channels` lists them.
+CHANNEL_COLUMNS: dict[str, str] = {"T1": "T1_C", "T2": "T2_C", "T_stator": "T_stator_C",
+                                   "P1": "P1_um"}
+#: Sensor kind of the spec that each channel maps to.
+CHANNEL_KINDS: dict[str, str] = {"T1": "temperature", "T2": "temperature",
+                                 "T_stator": "temperature", "P1": "axial_displacement"}
+#: Optional inputs.
+OPTIONAL_COLUMNS: tuple[str, ...] = ("load_torque_Nm",)
+#: Every column the format defines.
+KNOWN_COLUMNS: tuple[str, ...] = REQUIRED_COLUMNS + tuple(CHANNEL_COLUMNS.values()) + OPTIONAL_COLUMNS
+#: Temperature columns [°C] (plausibility: kelvin check and lower limit).
+TEMPERATURE_COLUMNS: tuple[str, ...] = ("T_env_C", "T_coolant_C", "T1_C", "T2_C", "T_stator_C")
+
+#: Plausibility limits (file units).
+T_MIN_C = -60.0
+T_KELVIN_MEDIAN_C = 150.0
+T_KELVIN_MAX_C = 250.0
+SPEED_MAX_RPM = 100_000.0
+POWER_LIMIT_KW = 1000.0
+#: What a fit needs: rows with at least one measured channel, and their time span [s].
+MIN_ROWS = 50
+MIN_SPAN_S = 1800.0
+#: Default spacing of the model's input grid [s].
+DEFAULT_GRID_S = 60.0
+#: Below this speed [rpm] the spindle stands still: the power balance gives no losses.
+STANDSTILL_RPM = 1.0
+#: A step between samples longer than this many median steps counts as a gap in the summary.
+GAP_FACTOR = 10.0
+
+
+class BenchWarning(UserWarning):
+    """Something in a bench run was skipped or clipped (not an error): the message says what."""
+
+
+# ============================================================================ the run
+
+
+@dataclass(frozen=True)
+class BenchRun:
+    """One test-bench run as read from its CSV export.
+
+    ``time_s`` [s]: time since the start of the run, one value per data row, strictly
+    increasing. ``columns``: the known columns present (format table), in the FILE's units
+    (rpm, kW, °C, µm, N m), NaN where a cell was empty; ``P1_um`` is already zeroed at its
+    first valid sample (the raw reading there is ``P1_reference_um``); ``load_torque_Nm`` is
+    all zeros when the file has no such column (a no-load run, ``load_torque_measured`` False).
+    ``extra``: unknown columns by name, as float arrays (NaN where empty) or, if a cell is not
+    a number, as lists of the cell strings. ``channels``: the measured model channels present,
+    a subset of T1, T2, T_stator, P1 in that order. ``duration_s`` [s]: the last time_s (the
+    run starts at t = 0). ``lines``: the file line of each data row (for messages).
+    """
+
+    path: Path
+    metadata: dict[str, str]
+    time_s: np.ndarray
+    columns: dict[str, np.ndarray]
+    extra: dict[str, np.ndarray | list[str]]
+    unknown_columns: list[str]
+    channels: list[str]
+    duration_s: float
+    lines: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0, dtype=int))
+    P1_reference_um: float | None = None
+    load_torque_measured: bool = False
+
+    @property
+    def name(self) -> str:
+        """The file stem (the LoadCase's name)."""
+        return self.path.stem
+
+    def channel(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Valid samples of a measured channel, in SI: ``(t [s], y)`` with y in K for the
+        temperature channels T1, T2, T_stator and in m for P1 (axial growth of the shaft front
+        end against the bearing shield, zeroed at its first valid sample; positive toward the
+        tool). ``name`` is the channel (``"T1"``) or its column (``"T1_C"``). KeyError if the
+        run has no such channel."""
+        ch = next((c for c, col in CHANNEL_COLUMNS.items() if name in (c, col)), None)
+        if ch is None or ch not in self.channels:
+            raise KeyError(f"{self.path}: no measured channel {name!r}; the run has {self.channels}")
+        y = self.columns[CHANNEL_COLUMNS[ch]]
+        ok = ~np.isnan(y)
+        t, v = self.time_s[ok], y[ok]
+        return t, (v * UM_TO_M if ch == "P1" else v + ZERO_C_K)
+
+    def summary(self) -> dict[str, Any]:
+        """A plain dict for reports: rows, start/end/duration [s], sampling (median step, largest
+        step, the number of gaps longer than ``GAP_FACTOR`` median steps), the valid samples of
+        each channel, unknown columns and the metadata."""
+        dt = np.diff(self.time_s)
+        median = float(np.median(dt)) if len(dt) else float("nan")
+        return {
+            "file": str(self.path),
+            "rows": int(len(self.time_s)),
+            "start_s": float(self.time_s[0]),
+            "end_s": float(self.time_s[-1]),
+            "duration_s": float(self.duration_s),
+            "median_dt_s": median,
+            "max_gap_s": float(dt.max()) if len(dt) else 0.0,
+            "gaps": int(np.count_nonzero(dt > GAP_FACTOR * median)) if len(dt) else 0,
+            "gap_threshold_s": GAP_FACTOR * median,
+            "channels": {c: int(np.count_nonzero(~np.isnan(self.columns[CHANNEL_COLUMNS[c]])))
+                         for c in self.channels},
+            "load_torque_measured": self.load_torque_measured,
+            "P1_reference_um": self.P1_reference_um,
+            "unknown_columns": list(self.unknown_columns),
+            "metadata": dict(self.metadata),
+        }
+
+
+# ============================================================================ reading
+
+
+def _split_unit(column: str) -> tuple[str, str]:
+    """(quantity, unit) of a column name: the unit follows the LAST underscore."""
+    q, sep, u = column.rpartition("_")
+    return (q, u) if sep else (column, "")
+
+
+def _hint_for(column: str, header: list[str]) -> str:
+    """A hint when the header has the quantity of ``column`` under another unit or spelling."""
+    q, u = _split_unit(column)
+    for h in header:
+        hq, hu = _split_unit(h)
+        if h != column and (hq.lower() == q.lower() or h.lower() == column.lower()):
+            return f" (the header has '{h}'{f' with unit {hu!r}' if hu != u else ''}: the format " \
+                   f"wants '{column}')"
+    return ""
+
+
+def _decode(raw: bytes, name: str) -> str:
+    try:
+        return raw.decode("utf-8-sig")  # a byte-order mark (spreadsheet exports) is dropped
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        col = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        bad = raw[exc.start:exc.start + 1].hex()
+        raise InputError(name, f"line {line}", f"is not UTF-8 text (byte 0x{bad} at character {col})",
+                         "export the file as UTF-8 (a '°' or 'µ' saved as Latin-1/Windows-1252 "
+                         "does this)") from None
+
+
+def _parse_floats(cells: tuple[str, ...] | list[str]) -> tuple[np.ndarray | None, int]:
+    """Cells -> float array with NaN for empty cells (and 'nan'); (None, index) at the first
+    cell that is not a number."""
+    try:
+        return np.array(cells, dtype=float), -1
+    except ValueError:
+        pass
+    cleaned = [c.strip() or "nan" for c in cells]
+    try:
+        return np.array(cleaned, dtype=float), -1
+    except ValueError:
+        for k, c in enumerate(cleaned):
+            try:
+                float(c)
+            except ValueError:
+                return None, k
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+class _Table:
+    """The data rows of a bench file. Fast path (no quotes, every row with one cell per
+    column, every cell of the numeric columns a number or empty): numpy's C parser on the
+    text, text-valued unknown columns split off by hand. Otherwise the csv module, cell by
+    cell, which also finds the exact row or cell of a problem. ``line_no``: the file line
+    of each data row."""
+
+    def __init__(self, line_no: np.ndarray, body: list[str], ncol: int):
+        self.line_no, self.body, self.ncol = line_no, body, ncol
+        self.bad_row, self.row_lengths = -1, [ncol] * len(body)
+        self._values: np.ndarray | None = None  # (rows, ncol) floats; NaN in text columns
+        self._text: dict[int, list[str]] = {}  # text-valued columns of the fast path
+        self._cells: list[tuple[str, ...]] | None = None  # general path: cells by column
+
+    @classmethod
+    def parse(cls, lines: list[str], header_idx: int, header: list[str]) -> _Table:
+        ncol = len(header)
+        rest = lines[header_idx + 1:]
+        while rest and not rest[-1].strip():
+            rest.pop()
+        text = "\n".join(rest).replace("\r", "")
+        if not _has_skipped_line(text):  # no blank or comment lines: row k is line h + 2 + k
+            line_no = np.arange(header_idx + 2, header_idx + 2 + len(rest))
+            body = text.split("\n") if rest else []
+        else:
+            kept = [(k + 1, ln.rstrip("\r")) for k, ln in enumerate(rest, start=header_idx + 1)
+                    if ln.strip() and not ln.lstrip().startswith("#")]
+            line_no = np.array([k for k, _ in kept], dtype=int)
+            body = [ln for _, ln in kept]
+            text = "\n".join(body)
+        table = cls(line_no, body, ncol)
+        if body and table._fast(text, header):
+            return table
+        rows = list(csv.reader(body))
+        table.row_lengths = [len(r) for r in rows]
+        table.bad_row = next((k for k, n in enumerate(table.row_lengths) if n != ncol), -1)
+        if table.bad_row < 0:
+            table._cells = list(zip(*rows, strict=True)) if rows else [() for _ in range(ncol)]
+        return table
+
+    def _fast(self, text: str, header: list[str]) -> bool:
+        """Try the fast path; False leaves the table to the csv module."""
+        if '"' in text or any(ln.count(",") != self.ncol - 1 for ln in self.body):
+            return False
+        first = self.body[0].split(",")
+        text_cols = [j for j, c in enumerate(first) if c.strip() and not _is_number(c)]
+        if any(header[j] in KNOWN_COLUMNS for j in text_cols):
+            return False  # a known column holds text: the general path names the cell
+        numeric = [j for j in range(self.ncol) if j not in text_cols]
+        text = text.replace(",,", ",nan,").replace(",,", ",nan,")
+        text = text.replace("\n,", "\nnan,").replace(",\n", ",nan\n")
+        if text.startswith(","):
+            text = "nan" + text
+        if text.endswith(","):
+            text += "nan"
+        try:
+            values = np.loadtxt(io.StringIO(text), delimiter=",", dtype=float, ndmin=2,
+                                comments=None, usecols=numeric)
+        except ValueError:
+            return False
+        if values.shape != (len(self.body), len(numeric)):
+            return False
+        self._values = np.full((len(self.body), self.ncol), np.nan)
+        self._values[:, numeric] = values
+        self._text = {j: [ln.split(",")[j] for ln in self.body] for j in text_cols}
+        return True
+
+    def column(self, j: int) -> tuple[np.ndarray | None, int]:
+        """Column j as floats (NaN where empty), or (None, row of the first non-number)."""
+        if self._values is not None and j not in self._text:
+            return self._values[:, j].copy(), -1
+        if j in self._text:
+            return _parse_floats(self._text[j])
+        assert self._cells is not None
+        return _parse_floats(self._cells[j])
+
+    def cell(self, j: int, k: int) -> str:
+        """The text of column j in data row k (stripped)."""
+        if self._cells is not None:
+            return self._cells[j][k].strip()
+        return next(csv.reader([self.body[k]]))[j].strip()
+
+    def strings(self, j: int) -> list[str]:
+        """Column j as stripped strings."""
+        if j in self._text:
+            return [c.strip() for c in self._text[j]]
+        if self._cells is None:
+            self._cells = list(zip(*csv.reader(self.body), strict=True))
+        return [c.strip() for c in self._cells[j]]
+
+
+#: A blank line or a comment line (data rows: lines that are neither).
+_SKIPPED_LINE = re.compile(r"(?:^|\n)[ \t]*(?:#|\n|$)")
+
+
+def _has_skipped_line(text: str) -> bool:
+    """Whether ``text`` (lines joined by newlines, no carriage returns) has a blank or a
+    comment line; substring tests first, the regular expression only for indented lines."""
+    if not text or text[0] in "#\n" or "\n\n" in text or "\n#" in text:
+        return True
+    if text[0] in " \t" or "\n " in text or "\n\t" in text:
+        return bool(_SKIPPED_LINE.search(text))
+    return False
+
+
+def read_bench(path: str | Path) -> BenchRun:
+    """Read a test-bench run (CSV, format: docs/bench.md) into a :class:`BenchRun`.
+
+    Checks the structure (header, duplicate columns, required columns, one cell per column),
+    every cell of the known columns (numbers, finite), ``time_s`` (present in every row,
+    >= 0, strictly increasing), plausibility (°C not kelvin, >= -60 °C; speed 0..100 000 rpm;
+    power within ±1000 kW), no known column all empty, and that there is enough data to fit
+    (>= 50 rows with a measured channel over >= 30 min). Raises InputError naming the file,
+    the column and/or the file line, and the fix.
+    """
+    path = Path(path)
+    name = str(path)
+
+    def error(fld: str, message: str, fix: str) -> InputError:
+        return InputError(name, fld, message, fix)
+
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise error("file", f"cannot be read ({exc.strerror or exc})",
+                    "check the path of the bench export") from None
+    if not raw.strip():
+        raise error("file", "is empty", "export the bench run again (a header row and data rows)")
+    text = _decode(raw, name)
+    lines = text.split("\n")
+
+    # ------------------------------------------------------------- comments, header, rows
+    metadata: dict[str, str] = {}
+    header_idx = -1
+    for k, line in enumerate(lines):
+        s = line.strip()
+        if not s:
+            continue
+        if s.startswith("#"):
+            key, sep, value = s[1:].partition(":")
+            key = key.strip()
+            if sep and key and not any(ch.isspace() for ch in key):
+                metadata[key] = value.strip()
+            continue
+        header_idx = k
+        break
+    if header_idx < 0:
+        raise error("header", "the file has no header row (only comments)",
+                    "export the run with its header row, e.g. 'time_s,speed_rpm,power_kW,"
+                    "T_env_C,T_coolant_C,T1_C'")
+    hline = header_idx + 1
+    header = [h.strip() for h in next(csv.reader([lines[header_idx].rstrip("\r")]))]
+    if len(header) == 1 and any(sep in header[0] for sep in (";", "\t")):
+        sep_name = "';'" if ";" in header[0] else "tabs"
+        raise error(f"header (line {hline})", f"the columns are separated by {sep_name}, not commas",
+                    "export the file comma-separated with '.' as the decimal separator")
+    if not any(header):
+        raise error(f"header (line {hline})", "the header row has no column names",
+                    "put the header row (e.g. 'time_s,speed_rpm,...') before the data")
+    if all(_is_number(h) for h in header if h):
+        raise error(f"header (line {hline})", "the first non-comment line holds numbers, not column "
+                    "names", "put the header row (e.g. 'time_s,speed_rpm,...') before the data")
+    seen: dict[str, int] = {}
+    for j, h in enumerate(header):
+        if h and h in seen:
+            raise error(f"{h} (line {hline})", f"column name appears twice (columns {seen[h] + 1} "
+                        f"and {j + 1})", "keep one of the two columns or rename one")
+        seen[h] = j
+    for col in REQUIRED_COLUMNS:
+        if col not in seen:
+            raise error(col, f"required column is missing from the header (line {hline})"
+                        + _hint_for(col, header),
+                        f"export a '{col}' column (required: {', '.join(REQUIRED_COLUMNS)})")
+    if not any(col in seen for col in CHANNEL_COLUMNS.values()):
+        hints = "".join(_hint_for(c, header) for c in CHANNEL_COLUMNS.values())
+        raise error(f"header (line {hline})", "no measured channel: the run has none of the columns "
+                    f"{', '.join(CHANNEL_COLUMNS.values())}{hints}",
+                    "export at least one of the sensor columns the model is checked against")
+
+    ncol = len(header)
+    table = _Table.parse(lines, header_idx, header)
+    line_no = table.line_no
+    if table.bad_row >= 0:
+        raise error(f"line {line_no[table.bad_row]}", f"has {table.row_lengths[table.bad_row]} cells, "
+                    f"the header (line {hline}) has {ncol}", "give every row one cell per column (an "
+                    "empty cell for a value not measured)")
+    if not len(line_no):
+        raise error("rows", f"the file has a header (line {hline}) but no data rows",
+                    "export the run with its data")
+
+    # ------------------------------------------------------------------------- time
+    t, _ = table.column(seen["time_s"])
+    if t is None or np.isnan(t).any():
+        if t is None:  # the first cell that is empty or not a number
+            k = next(i for i, c in enumerate(table.strings(seen["time_s"]))
+                     if not _is_number(c) or c.lower() == "nan")
+        else:
+            k = int(np.flatnonzero(np.isnan(t))[0])
+        cell = table.cell(seen["time_s"], k)
+        what = "is empty" if not cell or cell.lower() == "nan" else f"'{cell}' is not a number"
+        raise error(f"time_s (line {line_no[k]})", f"{what}; every row needs its time",
+                    "give the time since the start of the run [s] in every row, or delete the row")
+    if not np.isfinite(t).all():
+        k = int(np.flatnonzero(~np.isfinite(t))[0])
+        raise error(f"time_s (line {line_no[k]})", "is not finite", "write a finite time [s]")
+    if t[0] < 0:
+        raise error(f"time_s (line {line_no[0]})", f"{t[0]:g} s is negative: time_s is the time since "
+                    "the start of the run", "export the time from the start of the run (>= 0 s)")
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if len(back):
+        k = int(back[0]) + 1
+        raise error(f"time_s (line {line_no[k]})", f"{t[k]:g} s is not after {t[k - 1]:g} s on line "
+                    f"{line_no[k - 1]}: time must increase strictly",
+                    "export the rows in time order without duplicate rows")
+
+    # ----------------------------------------------------------------- known columns
+    columns: dict[str, np.ndarray] = {}
+    for col in KNOWN_COLUMNS[1:]:
+        if col not in seen:
+            continue
+        arr, bad = table.column(seen[col])
+        if arr is None:
+            raise error(f"{col} (line {line_no[bad]})", f"'{table.cell(seen[col], bad)}' is not a "
+                        "number", "write a decimal number with '.' as the separator, or leave the "
+                        "cell empty when not measured")
+        inf = np.flatnonzero(np.isinf(arr))
+        if len(inf):
+            raise error(f"{col} (line {line_no[inf[0]]})", "is not finite",
+                        "write a finite number, or leave the cell empty when not measured")
+        if np.isnan(arr).all():
+            raise error(col, "the column is empty in every row",
+                        "export the measurement, or drop the column if it was not measured")
+        columns[col] = arr
+    _check_plausible(columns, line_no, error)
+
+    # --------------------------------------------------------------- unknown columns
+    extra: dict[str, np.ndarray | list[str]] = {}
+    for j, h in enumerate(header):
+        if h in KNOWN_COLUMNS:
+            continue
+        arr, _ = table.column(j)
+        if not h:
+            if arr is not None and np.isnan(arr).all():
+                continue  # a trailing separator: no column
+            h = f"(column {j + 1})"
+        extra[h] = arr if arr is not None else table.strings(j)
+    unknown = list(extra)
+    for h in unknown:
+        hint = next((_hint_for(k, [h]) for k in KNOWN_COLUMNS if _hint_for(k, [h])), "")
+        if hint:
+            warnings.warn(BenchWarning(f"{name}: {h}: kept as an unknown column{hint}"), stacklevel=2)
+
+    # ------------------------------------------------------------- channels and data
+    channels = [c for c, col in CHANNEL_COLUMNS.items() if col in columns]
+    p1_ref = None
+    if "P1_um" in columns:
+        p1 = columns["P1_um"]
+        p1_ref = float(p1[np.flatnonzero(~np.isnan(p1))[0]])
+        columns["P1_um"] = p1 - p1_ref
+    measured = np.zeros(len(t), dtype=bool)
+    for c in channels:
+        measured |= ~np.isnan(columns[CHANNEL_COLUMNS[c]])
+    tm = t[measured]
+    span = float(tm[-1] - tm[0]) if len(tm) else 0.0
+    if len(tm) < MIN_ROWS or span < MIN_SPAN_S:
+        raise error("rows", f"too little data to fit: {len(tm)} rows with a measured channel "
+                    f"({', '.join(channels)}) spanning {span / 60:.1f} min",
+                    f"export a run with at least {MIN_ROWS} rows with a measured channel over at "
+                    f"least {MIN_SPAN_S / 60:.0f} min")
+    torque_measured = "load_torque_Nm" in columns
+    if not torque_measured:
+        columns["load_torque_Nm"] = np.zeros(len(t))
+    return BenchRun(path=path, metadata=metadata, time_s=t, columns=columns, extra=extra,
+                    unknown_columns=unknown, channels=channels, duration_s=float(t[-1]),
+                    lines=line_no, P1_reference_um=p1_ref, load_torque_measured=torque_measured)
+
+
+def _is_number(s: str) -> bool:
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
+
+
+def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error: Any) -> None:
+    """Temperatures in °C (not kelvin, >= -60 °C), speed 0..100 000 rpm, power within
+    ±1000 kW; the first offending line is named."""
+
+    def first(mask: np.ndarray) -> int:
+        return int(line_no[np.flatnonzero(mask)[0]])
+
+    for col in TEMPERATURE_COLUMNS:
+        if col not in columns:
+            continue
+        y = columns[col]
+        v = y[~np.isnan(y)]
+        med, top = float(np.median(v)), float(v.max())
+        if med > T_KELVIN_MEDIAN_C or top > T_KELVIN_MAX_C:
+            over = y > (T_KELVIN_MAX_C if top > T_KELVIN_MAX_C else T_KELVIN_MEDIAN_C)
+            raise error(f"{col} (line {first(over)})", f"{top:g} (median {med:g}) looks like kelvin",
+                        "export °C (°C = K - 273.15)")
+        if v.min() < T_MIN_C:
+            raise error(f"{col} (line {first(y < T_MIN_C)})", f"{v.min():g} °C is below "
+                        f"{T_MIN_C:g} °C", "check the sensor and export temperatures in °C")
+    n = columns["speed_rpm"]
+    if (n < 0).any():
+        raise error(f"speed_rpm (line {first(n < 0)})", f"{n[n < 0][0]:g} rpm is negative",
+                    "export the speed magnitude |n| [rpm]")
+    if (n > SPEED_MAX_RPM).any():
+        raise error(f"speed_rpm (line {first(n > SPEED_MAX_RPM)})", f"{n[n > SPEED_MAX_RPM][0]:g} "
+                    f"rpm is above {SPEED_MAX_RPM:g} rpm", "export the speed in rpm (1/min); check "
+                    "the unit of the drive's speed channel")
+    p = columns["power_kW"]
+    big = np.abs(p) > POWER_LIMIT_KW
+    if big.any():
+        raise error(f"power_kW (line {first(big)})", f"{p[big][0]:g} kW is outside "
+                    f"±{POWER_LIMIT_KW:g} kW", "export the electrical power in kW (a value in W is "
+                    "1000 times too large)")
+
+
+# ============================================================================ spec
+
+
+def check_against_spec(run: BenchRun, spec: Spec) -> list[str]:
+    """The measured channels of ``run`` that map to a sensor of ``spec`` with the same name
+    and kind (T1, T2, T_stator: ``temperature``; P1: ``axial_displacement``), in the order of
+    :attr:`BenchRun.channels`.
+
+    A channel without such a sensor is skipped with a :class:`BenchWarning` naming the column
+    and the fix; if no channel maps, InputError.
+    """
+    sensors = {s.name: s for s in spec.sensors}
+    mapped: list[str] = []
+    for ch in run.channels:
+        col, kind = CHANNEL_COLUMNS[ch], CHANNEL_KINDS[ch]
+        s = sensors.get(ch)
+        if s is not None and s.kind == kind:
+            mapped.append(ch)
+            continue
+        why = (f"the spec '{spec.name}' has no sensor '{ch}'" if s is None
+               else f"sensor '{ch}' of spec '{spec.name}' is of kind '{s.kind}', not '{kind}'")
+        warnings.warn(BenchWarning(
+            f"{run.path}: {col}: {why}; the column is skipped; fix: add a [[sensors]] entry "
+            f"name = \"{ch}\" (kind {kind}) to {spec.path} to compare it"), stacklevel=2)
+    if not mapped:
+        cols = ", ".join(CHANNEL_COLUMNS[c] for c in run.channels)
+        raise InputError(str(run.path), cols, f"no measured channel has a sensor of the same name "
+                         f"and kind in the spec '{spec.name}' ({spec.path})",
+                         f"add [[sensors]] named {', '.join(run.channels)} to the spec (T1, T2, "
+                         "T_stator: temperature; P1: kind = \"axial_displacement\"), or use the "
+                         "spec of the spindle on the bench")
+    return mapped
+
+
+# ============================================================================ model inputs
+
+
+def bench_grid(run: BenchRun, grid_s: float | None = None) -> np.ndarray:
+    """Times of the model's inputs [s]: every ``grid_s`` (default 60 s) from 0 to the end of
+    the run, plus the run's first and last sample times; strictly increasing (points closer
+    than 1e-6 grid_s to the run's start or end are dropped in their favour)."""
+    step = DEFAULT_GRID_S if grid_s is None else float(grid_s)
+    if not math.isfinite(step) or step <= 0:
+        raise InputError(str(run.path), "grid_s", f"{grid_s!r} is not a time step > 0 s",
+                         "give the grid spacing in seconds, e.g. 60")
+    t0, t1 = float(run.time_s[0]), float(run.time_s[-1])
+    pts = np.arange(0.0, t1, step)
+    tol = 1e-6 * step
+    pts = pts[(np.abs(pts - t0) > tol) & (np.abs(pts - t1) > tol)]
+    return np.unique(np.concatenate([pts, [t0, t1]]))
+
+
+def _valid(run: BenchRun, col: str) -> tuple[np.ndarray, np.ndarray]:
+    y = run.columns[col]
+    ok = ~np.isnan(y)
+    return run.time_s[ok], y[ok]
+
+
+def held(t_samples: np.ndarray, y_samples: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Zero-order hold: at each ``t`` the last sample at or before it; before the first
+    sample, the first value (units of y)."""
+    idx = np.searchsorted(t_samples, t, side="right") - 1
+    return y_samples[np.clip(idx, 0, len(y_samples) - 1)]
+
+
+def cell_means(t_samples: np.ndarray, y_samples: np.ndarray, edges: np.ndarray,
+               centres: np.ndarray) -> np.ndarray:
+    """Mean of the samples in each cell [edges[i], edges[i+1]) (the last cell closed), one per
+    cell; a cell without samples gets the samples interpolated linearly at ``centres[i]``
+    (the first or last value held outside them). Units of y."""
+    n = len(edges) - 1
+    k = np.searchsorted(edges, t_samples, side="right") - 1
+    k[t_samples == edges[-1]] = n - 1
+    inside = (k >= 0) & (k < n)
+    count = np.bincount(k[inside], minlength=n)
+    total = np.bincount(k[inside], weights=y_samples[inside], minlength=n)
+    out = np.interp(centres, t_samples, y_samples)
+    has = count > 0
+    out[has] = total[has] / count[has]
+    return out
+
+
+def interval_heat_W(drive: Drive, speed_rpm: float, load_torque_Nm: float,
+                    power_kW: float) -> tuple[dict[str, float], bool]:
+    """Heat per source [W] at one bench operating point, and whether the power was clipped.
+
+    ``drive.heat_W(speed, torque, P)`` with the measured electrical power P [kW] clipped at
+    >= 0. Below ``STANDSTILL_RPM`` the spindle stands: every source is 0 W. If P is below the
+    mechanical power (bearing friction plus load torque) at this speed, as a noisy no-load
+    reading or an interval that straddles a speed step can be, the motor losses are set to 0
+    (P = P_mech) and the bool is True."""
+    if speed_rpm < STANDSTILL_RPM:
+        return {k: 0.0 for k in drive.heat_W(0.0, 0.0, 0.0)}, False
+    P = max(float(power_kW), 0.0)
+    try:
+        return drive.heat_W(speed_rpm, load_torque_Nm, P), False
+    except ValueError:
+        pb = power_balance(drive.motor, drive.bearings, speed_rpm, load_torque_Nm, drive.T_winding_K)
+        return drive.heat_W(speed_rpm, load_torque_Nm, pb.motor.P_mech_W / 1e3), True
+
+
+def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
+           grid_s: float | None = None) -> tuple[LoadCase, np.ndarray]:
+    """The model inputs of a bench run on a time grid: ``(LoadCase, grid [s])``.
+
+    Grid: :func:`bench_grid` (every ``grid_s``, default 60 s, from 0 to the end, plus the run's
+    first and last sample). Speed [rpm]: the bench logs it on change, so it is held (the last
+    valid sample at or before each grid point; before the first, the first value), a
+    'previous' series on the grid. Ambient and coolant [K]: the mean of the valid samples in
+    the cell around each grid point (half-way to its neighbours), linear between grid points.
+    Power [kW] and load torque [N m] (0 when not measured): the mean of the valid samples in
+    each grid interval [t_i, t_i+1); where an interval or cell has no sample (a gap) the
+    samples are interpolated linearly at its centre. Heat sources [W]: per interval,
+    :func:`interval_heat_W` (the power balance ``drive.heat_W(speed at t_i, torque, power)``),
+    held over the interval ('previous' series at t_i); the spec's sources the power balance
+    does not feed get 0 W. ``drive`` defaults to the spec's ``[power_balance] preset``; without
+    one, InputError. A :class:`BenchWarning` reports intervals where the power was below the
+    mechanical power (motor losses set to 0 there). ``duration_s`` = the run's duration.
+    """
+    drive = drive if drive is not None else drive_for(spec)
+    if drive is None:
+        raise InputError(spec.path, "power_balance.preset", "the spec names no drive, so the bench "
+                         "run's electrical power cannot be turned into heat sources",
+                         "add [power_balance] preset = \"spl2782\" (or the preset of this spindle) to "
+                         "the spec, or pass drive=")
+    grid = bench_grid(run, grid_s)
+    mids = 0.5 * (grid[:-1] + grid[1:])
+    dual = np.concatenate([[grid[0]], mids, [grid[-1]]])
+
+    ts, ys = _valid(run, "speed_rpm")
+    speed = held(ts, ys, grid)
+    T_env = cell_means(*_valid(run, "T_env_C"), dual, grid) + ZERO_C_K
+    T_cool = cell_means(*_valid(run, "T_coolant_C"), dual, grid) + ZERO_C_K
+    power = cell_means(*_valid(run, "power_kW"), grid, mids)
+    torque = (cell_means(*_valid(run, "load_torque_Nm"), grid, mids) if run.load_torque_measured
+              else np.zeros(len(mids)))
+
+    heats: list[dict[str, float]] = []
+    clipped: list[float] = []
+    for i, (n, M, P) in enumerate(zip(speed[:-1], torque, power, strict=True)):
+        h, was_clipped = interval_heat_W(drive, float(n), float(M), float(P))
+        heats.append(h)
+        if was_clipped:
+            clipped.append(float(grid[i]))
+    if clipped:
+        warnings.warn(BenchWarning(
+            f"{run.path}: power_kW: in {len(clipped)} of {len(mids)} intervals (first at "
+            f"t = {clipped[0]:g} s) the mean electrical power is below the mechanical power of the "
+            "bearing friction and load torque at the held speed; the motor losses are 0 there"),
+            stacklevel=2)
+    names = [h.name for h in spec.heat_sources]
+    missing = sorted(set(heats[0]) - set(names))
+    if missing:
+        raise InputError(spec.path, "heat_sources", f"the power balance feeds sources {missing} "
+                         "that the spec does not have",
+                         "name the spec's heat sources stator, rotor, front_bearing, rear_bearing")
+    starts = tuple(float(x) for x in grid[:-1])
+    sources = {k: TimeSeries.constant(0.0) for k in names}
+    sources.update({k: TimeSeries(starts, tuple(float(h[k]) for h in heats), "previous")
+                    for k in heats[0]})
+    times = tuple(float(x) for x in grid)
+    case = LoadCase(
+        name=run.name,
+        speed_rpm=TimeSeries(times, tuple(float(x) for x in speed), "previous"),
+        T_ambient_K=TimeSeries(times, tuple(float(x) for x in T_env), "linear"),
+        T_coolant_K=TimeSeries(times, tuple(float(x) for x in T_cool), "linear"),
+        sources=sources,
+        duration_s=run.duration_s,
+    )
+    return case, grid

@@ -1,0 +1,407 @@
+"""Test-bench runs (spindle.bench): the format's rules, its errors, and the model inputs."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spindle.bench import (
+    BenchRun,
+    BenchWarning,
+    bench_grid,
+    check_against_spec,
+    inputs,
+    read_bench,
+)
+from spindle.drive import drive_for
+from spindle.errors import InputError
+from spindle.power import power_balance
+from spindle.spec import load_spec
+
+HEADER = "time_s,speed_rpm,power_kW,T_env_C,T_coolant_C,T1_C,T2_C,T_stator_C,P1_um"
+
+
+@pytest.fixture(scope="module")
+def spec():
+    return load_spec("spl2782")
+
+
+def row(t: float, speed: str = "", power: str = "1.2", env: str = "20.0", cool: str = "20.0",
+        t1: str = "22.0", t2: str = "21.5", ts: str = "30.0", p1: str = "1.0") -> str:
+    return f"{t:g},{speed},{power},{env},{cool},{t1},{t2},{ts},{p1}"
+
+
+def good_rows(n: int = 61, dt: float = 60.0) -> list[str]:
+    """n rows every dt s (61 x 60 s = one hour): speed 4300 rpm logged once at the start."""
+    return [row(i * dt, speed="4300" if i == 0 else "") for i in range(n)]
+
+
+def write(tmp_path: Path, lines: list[str], name: str = "run.csv", header: str = HEADER,
+          comments: tuple[str, ...] = ()) -> Path:
+    path = tmp_path / name
+    path.write_text("\n".join([*comments, header, *lines]) + "\n", encoding="utf-8")
+    return path
+
+
+def problem(path: Path) -> tuple[str, str, str]:
+    """(field, message, fix) of the InputError that reading ``path`` raises."""
+    with pytest.raises(InputError) as info:
+        read_bench(path)
+    p = info.value.problem
+    assert p.file == str(path) and p.fix  # every error names the file and gives a fix
+    assert str(info.value).startswith(f"{path}: ") and "; fix: " in str(info.value)
+    return p.field, p.message, p.fix
+
+
+# =============================================================================== reading
+
+
+def test_metadata_comments_column_order_and_unknown_columns(tmp_path):
+    header = "P1_um,humidity_pct,T2_C,operator,T_coolant_C,time_s,T_env_C,power_kW,speed_rpm,T1_C"
+    lines = [f"{2.0 + i},45,21.5,anna,19.0,{60.0 * i:g},20.5,1.5,{'4300' if i == 0 else ''},"
+             f"{22 + 0.1 * i:.1f}" for i in range(61)]
+    path = write(tmp_path, lines, header=header, comments=(
+        "# spindle: spl2782", "# bench: SPL test stand 2", "# started: 2026-03-02T07:10:00",
+        "# exported by the stand software", "# two words: not metadata", "#"))
+    run = read_bench(path)
+    assert run.metadata == {"spindle": "spl2782", "bench": "SPL test stand 2",
+                            "started": "2026-03-02T07:10:00"}
+    assert run.channels == ["T1", "T2", "P1"]  # the model's order, not the file's
+    assert run.unknown_columns == ["humidity_pct", "operator"]
+    np.testing.assert_array_equal(run.extra["humidity_pct"], np.full(61, 45.0))
+    assert run.extra["operator"] == ["anna"] * 61  # text kept as text
+    assert run.columns["T_coolant_C"][0] == 19.0 and run.columns["T1_C"][10] == pytest.approx(23.0)
+    assert run.lines[0] == 8  # file lines, comments and header counted
+    assert not run.load_torque_measured
+    np.testing.assert_array_equal(run.columns["load_torque_Nm"], np.zeros(61))  # no-load run
+    s = run.summary()
+    assert s["unknown_columns"] == ["humidity_pct", "operator"]
+    assert s["metadata"]["bench"] == "SPL test stand 2"
+    assert s["channels"] == {"T1": 61, "T2": 61, "P1": 61}
+    assert run.duration_s == 3600.0 and s["rows"] == 61
+
+
+def test_fast_and_general_parsers_agree(tmp_path):
+    """Unquoted files go through numpy's parser (text-valued unknown columns split off by
+    hand), quoted ones through the csv module; all give the same numbers."""
+    lines = good_rows()
+    lines[5] = row(300, speed="", t1="")
+    a = read_bench(write(tmp_path, lines, "a.csv"))
+    b = read_bench(write(tmp_path, [ln + ',"x"' for ln in lines], "b.csv", header=HEADER + ",note_txt"))
+    for col, v in a.columns.items():
+        np.testing.assert_array_equal(v, b.columns[col])
+    assert b.extra["note_txt"] == ["x"] * 61
+    c = read_bench(write(tmp_path, [ln + ",anna" for ln in lines], "c.csv", header=HEADER + ",operator"))
+    for col, v in a.columns.items():
+        np.testing.assert_array_equal(v, c.columns[col])
+    assert c.extra["operator"] == ["anna"] * 61
+    assert np.isnan(a.columns["T1_C"][5]) and a.summary()["channels"]["T1"] == 60
+
+
+def test_bom_crlf_blank_lines_and_comments_between_rows(tmp_path):
+    lines = good_rows()
+    text = ("\ufeff# spindle: spl2782\r\n" + HEADER + "\r\n" + "\r\n".join(lines[:10])
+            + "\r\n\r\n# pause\r\n" + "\r\n".join(lines[10:]) + "\r\n")
+    path = tmp_path / "crlf.csv"
+    path.write_bytes(text.encode("utf-8"))
+    run = read_bench(path)
+    assert run.metadata == {"spindle": "spl2782"}
+    assert len(run.time_s) == 61
+    assert run.lines[9] == 12 and run.lines[10] == 15  # the blank and the comment line counted
+
+
+def test_trailing_separators_make_no_column(tmp_path):
+    run = read_bench(write(tmp_path, [ln + "," for ln in good_rows()], header=HEADER + ","))
+    assert run.unknown_columns == [] and run.channels == ["T1", "T2", "T_stator", "P1"]
+    filled = [ln + ",7" for ln in good_rows()]
+    unnamed = read_bench(write(tmp_path, filled, "b.csv", header=HEADER + ","))
+    assert unnamed.unknown_columns == ["(column 10)"]
+
+
+def test_irregular_sampling_and_gaps_in_summary(tmp_path):
+    times = [0, 1, 3, 4, 5, 6, 8, 9, 10] + [10 + 2 * k for k in range(1, 50)] + [2000, 2001, 2003]
+    run = read_bench(write(tmp_path, [row(t, speed="1000" if t == 0 else "") for t in times]))
+    s = run.summary()
+    assert s["rows"] == len(times)
+    assert s["median_dt_s"] == pytest.approx(2.0)
+    assert s["max_gap_s"] == pytest.approx(2000 - 108)
+    assert s["gaps"] == 1 and s["gap_threshold_s"] == pytest.approx(20.0)
+
+
+def test_p1_is_zeroed_at_its_first_valid_sample_and_channels_are_si(tmp_path):
+    lines = good_rows()
+    lines[0] = row(0, speed="4300", p1="", t1="21.0")
+    lines[1] = row(60, p1="12.5")
+    lines[2] = row(120, p1="14.0")
+    run = read_bench(write(tmp_path, lines))
+    assert run.P1_reference_um == 12.5
+    assert np.isnan(run.columns["P1_um"][0]) and run.columns["P1_um"][1] == 0.0
+    assert run.columns["P1_um"][2] == pytest.approx(1.5)
+    t, y = run.channel("P1")
+    assert t[0] == 60.0 and len(t) == 60  # valid samples only
+    assert y[1] == pytest.approx(1.5e-6)  # metres
+    t, y = run.channel("T1_C")
+    assert y[0] == pytest.approx(21.0 + 273.15)  # kelvin
+    with pytest.raises(KeyError):
+        read_bench(write(tmp_path, good_rows(), "b.csv", header=HEADER.replace("T2_C", "T9_C"))).channel("T2")
+
+
+def test_big_file_parses(tmp_path):
+    """16 h at 1 s (57,600 rows), as a bench exports it; the parse time is in docs/bench.md."""
+    n = 57_600
+    t = np.arange(n, dtype=float)
+    speed = np.where(t < 40_000, 4300.0, 0.0)
+    lines = [f"{t[i]:g},{'' if i and speed[i] == speed[i - 1] else f'{speed[i]:g}'},1.2,20.0,20.0,"
+             f"{22 + i * 1e-4:.4f},21.5,30.0,{'' if i % 7 == 3 else f'{i * 1e-4:.4f}'}" for i in range(n)]
+    run = read_bench(write(tmp_path, lines, comments=("# spindle: spl2782",)))
+    assert len(run.time_s) == n and run.duration_s == n - 1
+    assert run.columns["T1_C"][-1] == pytest.approx(22 + (n - 1) * 1e-4)
+    assert np.count_nonzero(~np.isnan(run.columns["speed_rpm"])) == 2
+    assert run.summary()["channels"]["P1"] == n - len(range(3, n, 7))
+
+
+# ================================================================================ errors
+
+ERRORS = [
+    # (name, header, change(lines) -> lines, field contains, message contains)
+    ("missing required", HEADER.replace("power_kW", "power_W"), None,
+     "power_kW", "required column is missing from the header (line 1) (the header has 'power_W'"),
+    ("no channel", "time_s,speed_rpm,power_kW,T_env_C,T_coolant_C,T1_K",
+     lambda ls: [ln.rsplit(",", 3)[0] for ln in ls], "header (line 1)", "no measured channel"),
+    ("time empty", HEADER, lambda ls: ls[:5] + [",," + ls[5].split(",", 2)[2]] + ls[6:],
+     "time_s (line 7)", "is empty"),
+    ("time text", HEADER, lambda ls: ls[:5] + ["5 min" + ls[5][3:]] + ls[6:],
+     "time_s (line 7)", "'5 min' is not a number"),
+    ("time empty before text", HEADER,
+     lambda ls: ls[:5] + [",," + ls[5].split(",", 2)[2]] + ls[6:9] + ["x" + ls[9]] + ls[10:],
+     "time_s (line 7)", "is empty"),
+    ("time back", HEADER, lambda ls: ls[:10] + [row(500)] + ls[11:], "time_s (line 12)",
+     "500 s is not after 540 s on line 11"),
+    ("time repeated", HEADER, lambda ls: ls[:10] + [row(540)] + ls[11:], "time_s (line 12)",
+     "is not after"),
+    ("time negative", HEADER, lambda ls: [row(-1, speed="4300")] + ls[1:], "time_s (line 2)",
+     "is negative"),
+    ("cell text", HEADER, lambda ls: ls[:20] + [row(1200, t2="n/a")] + ls[21:], "T2_C (line 22)",
+     "'n/a' is not a number"),
+    ("cell decimal comma", HEADER, lambda ls: ls[:20] + ['1200,,"1,2",20,20,22,21,30,1'] + ls[21:],
+     "power_kW (line 22)", "'1,2' is not a number"),
+    ("cell inf", HEADER, lambda ls: ls[:3] + [row(180, power="inf")] + ls[4:], "power_kW (line 5)",
+     "is not finite"),
+    ("column empty", HEADER, lambda ls: [ln.rsplit(",", 1)[0] + "," for ln in ls], "P1_um",
+     "empty in every row"),
+    ("kelvin median", HEADER, lambda ls: [ln.replace(",22.0,", ",295.15,") for ln in ls],
+     "T1_C (line 2)", "looks like kelvin"),
+    ("kelvin one", HEADER, lambda ls: ls[:30] + [row(1800, ts="300")] + ls[31:], "T_stator_C (line 32)",
+     "300 (median 30) looks like kelvin"),
+    ("too cold", HEADER, lambda ls: ls[:7] + [row(420, cool="-80")] + ls[8:], "T_coolant_C (line 9)",
+     "-80 °C is below -60 °C"),
+    ("speed high", HEADER, lambda ls: ls[:7] + [row(420, speed="258000")] + ls[8:], "speed_rpm (line 9)",
+     "above 100000 rpm"),
+    ("speed negative", HEADER, lambda ls: ls[:7] + [row(420, speed="-4300")] + ls[8:],
+     "speed_rpm (line 9)", "is negative"),
+    ("power in W", HEADER, lambda ls: ls[:7] + [row(420, power="1200")] + ls[8:], "power_kW (line 9)",
+     "outside ±1000 kW"),
+    ("power very negative", HEADER, lambda ls: ls[:7] + [row(420, power="-1500")] + ls[8:],
+     "power_kW (line 9)", "outside ±1000 kW"),
+    ("too few rows", HEADER, lambda ls: [row(i * 60.0, speed="1") for i in range(40)], "rows",
+     "40 rows with a measured channel"),
+    ("too short", HEADER, lambda ls: [row(i * 10.0, speed="1") for i in range(100)], "rows",
+     "spanning 16.5 min"),
+    ("duplicate column", HEADER + ",T1_C", lambda ls: [ln + ",1" for ln in ls], "T1_C (line 1)",
+     "column name appears twice (columns 6 and 10)"),
+    ("cells missing", HEADER, lambda ls: ls[:12] + [ls[12].rsplit(",", 1)[0]] + ls[13:], "line 14",
+     "has 8 cells, the header (line 1) has 9"),
+    ("cells extra", HEADER, lambda ls: ls[:12] + [ls[12] + ",7"] + ls[13:], "line 14", "has 10 cells"),
+    ("semicolons", HEADER.replace(",", ";"), lambda ls: [ln.replace(",", ";") for ln in ls],
+     "header (line 1)", "separated by ';'"),
+    ("no header", "0,4300,1.2,20,20,22,21,30,1", None, "header (line 1)", "holds numbers"),
+    ("no rows", HEADER, lambda ls: [], "rows", "no data rows"),
+]
+
+
+@pytest.mark.parametrize(("header", "change", "fld", "msg"), [e[1:] for e in ERRORS],
+                         ids=[e[0] for e in ERRORS])
+def test_errors_name_line_or_column_and_give_a_fix(tmp_path, header, change, fld, msg):
+    lines = good_rows()
+    if change is not None:
+        lines = change(lines)
+    got_field, got_msg, _ = problem(write(tmp_path, lines, header=header))
+    assert fld in got_field
+    assert msg in got_msg
+
+
+def test_kelvin_fix_says_export_celsius(tmp_path):
+    lines = [ln.replace(",20.0,20.0,", ",293.15,20.0,") for ln in good_rows()]
+    fld, msg, fix = problem(write(tmp_path, lines))
+    assert fld == "T_env_C (line 2)" and "looks like kelvin" in msg and fix.startswith("export °C")
+
+
+def test_file_level_errors(tmp_path):
+    empty = tmp_path / "empty.csv"
+    empty.write_text("\n  \n", encoding="utf-8")
+    assert problem(empty)[:2] == ("file", "is empty")
+    comments = tmp_path / "comments.csv"
+    comments.write_text("# spindle: spl2782\n# bench: 2\n", encoding="utf-8")
+    assert "no header row" in problem(comments)[1]
+    assert "cannot be read" in problem(tmp_path / "missing.csv")[1]
+    assert "cannot be read" in problem(tmp_path)[1]  # a folder
+    latin = tmp_path / "latin1.csv"
+    latin.write_bytes(("# unit: °C\n" + HEADER + "\n" + "\n".join(good_rows())).encode("latin-1"))
+    fld, msg, fix = problem(latin)
+    assert fld == "line 1" and "not UTF-8" in msg and "0xb0" in msg and "UTF-8" in fix
+
+
+def test_look_alike_unknown_column_is_kept_with_a_warning(tmp_path):
+    lines = [ln + ",295.0" for ln in good_rows()]
+    with pytest.warns(BenchWarning, match=r"T2_K: kept as an unknown column .*'T2_C'"):
+        run = read_bench(write(tmp_path, lines, header=HEADER + ",T2_K"))
+    assert run.unknown_columns == ["T2_K"] and "T2" in run.channels
+
+
+# ================================================================================ spec
+
+
+def test_channels_map_to_the_shipped_spec(tmp_path, spec):
+    run = read_bench(write(tmp_path, good_rows()))
+    assert check_against_spec(run, spec) == ["T1", "T2", "T_stator", "P1"]
+
+
+def test_channel_without_sensor_is_skipped_and_reported(tmp_path, spec):
+    run = read_bench(write(tmp_path, good_rows()))
+    no_p1 = dataclasses.replace(spec, sensors=tuple(s for s in spec.sensors if s.name != "P1"))
+    with pytest.warns(BenchWarning, match=r"P1_um: the spec 'spl2782' has no sensor 'P1'.*fix: add"):
+        assert check_against_spec(run, no_p1) == ["T1", "T2", "T_stator"]
+    wrong_kind = dataclasses.replace(spec, sensors=tuple(
+        dataclasses.replace(s, kind="temperature") if s.name == "P1" else s for s in spec.sensors))
+    with pytest.warns(BenchWarning, match="of kind 'temperature', not 'axial_displacement'"):
+        assert "P1" not in check_against_spec(run, wrong_kind)
+
+
+def test_no_channel_maps_is_an_error(tmp_path, spec):
+    run = read_bench(write(tmp_path, good_rows()))
+    bare = dataclasses.replace(spec, sensors=())
+    with pytest.warns(BenchWarning), pytest.raises(InputError) as info:
+        check_against_spec(run, bare)
+    p = info.value.problem
+    assert p.field == "T1_C, T2_C, T_stator_C, P1_um" and "no measured channel" in p.message
+    assert "[[sensors]]" in p.fix
+
+
+# ========================================================================= model inputs
+
+
+def test_grid_every_60_s_plus_the_runs_start_and_end(tmp_path):
+    lines = [row(5 + i * 60.0, speed="4300" if i == 0 else "") for i in range(60)] + [row(3570), row(3630)]
+    run = read_bench(write(tmp_path, lines))
+    grid = bench_grid(run)
+    assert grid[:3].tolist() == [0.0, 5.0, 60.0] and grid[-2:].tolist() == [3600.0, 3630.0]
+    assert (np.diff(grid) > 0).all() and len(grid) == 63
+    assert bench_grid(run, 600.0).tolist() == [0.0, 5.0, 600.0, 1200.0, 1800.0, 2400.0, 3000.0,
+                                               3600.0, 3630.0]
+    with pytest.raises(InputError, match="grid_s"):
+        bench_grid(run, 0.0)
+
+
+def test_speed_is_held_and_leading_gaps_take_the_first_value(tmp_path, spec):
+    lines = good_rows()
+    lines[0] = row(0, speed="")
+    lines[1] = row(60, speed="")
+    lines[2] = row(90 + 30, speed="2000")  # at 120 s
+    lines[10] = row(600, speed="4300")
+    lines[40] = row(2400, speed="0")
+    run = read_bench(write(tmp_path, lines))
+    case, grid = inputs(run, spec)
+    speed = np.array([case.speed_rpm(t) for t in grid])
+    assert case.speed_rpm.interpolation == "previous"
+    np.testing.assert_array_equal(speed[:10], 2000.0)  # before 120 s: the first logged value
+    np.testing.assert_array_equal(speed[10:40], 4300.0)
+    np.testing.assert_array_equal(speed[40:], 0.0)
+    assert case.speed_rpm(659.0) == 4300.0
+
+
+def test_interval_averages_by_hand(tmp_path, spec):
+    # samples at 0, 60, 75, 100, then every 60 s from 180 s (no sample in [120, 180))
+    times = [0.0, 60.0, 75.0, 100.0] + [180.0 + 60.0 * k for k in range(58)]
+    power = {0.0: "1.0", 60.0: "1.0", 75.0: "2.0", 100.0: "4.5", 180.0: "3.0"}
+    env = {60.0: "20.0", 75.0: "21.0", 100.0: "23.0", 180.0: "26.0"}
+    lines = [row(t, speed="4300" if t == 0 else "", power=power.get(t, "3.0"), env=env.get(t, "26.0"))
+             for t in times]
+    lines[3] = row(100.0, power="4.5", env="23.0", t1="")  # a row without T1 is still used
+    lines += [row(3600.0 + k, power="") for k in range(1, 3)]  # power not measured at the end
+    run = read_bench(write(tmp_path, lines, header=HEADER))
+    drive = drive_for(spec)
+    case, grid = inputs(run, spec)
+    assert grid[:4].tolist() == [0.0, 60.0, 120.0, 180.0]
+    # power over [60, 120): mean of 1.0, 2.0, 4.5; over [120, 180): no sample -> linear
+    # interpolation of the samples at the interval centre 150 s: 4.5 + (3.0 - 4.5) * 50 / 80
+    p_60, p_120 = (1.0 + 2.0 + 4.5) / 3, 4.5 + (3.0 - 4.5) * 50.0 / 80.0
+    for t0, p in ((60.0, p_60), (120.0, p_120)):
+        expect = drive.heat_W(4300.0, 0.0, p)
+        for name, w in expect.items():
+            assert case.sources[name](t0 + 1.0) == pytest.approx(w, rel=1e-12)
+    # ambient at the grid point 60 s: mean over the cell [30, 90) = (20 + 21) / 2, in K
+    assert case.T_ambient_K(60.0) == pytest.approx(20.5 + 273.15)
+    # at 120 s: cell [90, 150) holds only the 100 s sample
+    assert case.T_ambient_K(120.0) == pytest.approx(23.0 + 273.15)
+    assert case.T_ambient_K(90.0) == pytest.approx(0.5 * (20.5 + 23.0) + 273.15)  # linear between
+    assert case.T_ambient_K.interpolation == "linear" and case.T_coolant_K(0.0) == pytest.approx(293.15)
+    assert case.name == "run" and case.duration_s == 3602.0 and grid[-1] == 3602.0
+
+
+def test_no_load_heat_is_the_power_balance_at_each_interval(tmp_path, spec):
+    lines = [row(i * 60.0, speed="3000" if i == 0 else ("6000" if i == 30 else ""),
+                 power=f"{0.9 + 0.01 * (i % 5):.2f}") for i in range(61)]
+    power = [float(f"{0.9 + 0.01 * (i % 5):.2f}") for i in range(61)]
+    run = read_bench(write(tmp_path, lines))
+    case, grid = inputs(run, spec)
+    drive = drive_for(spec)
+    assert set(case.sources) == {h.name for h in spec.heat_sources}
+    for i in (0, 7, 29, 30, 59):
+        # the last interval [3540, 3600] is closed: it holds the samples at both ends
+        n, p = 3000.0 if i < 30 else 6000.0, power[i] if i < 59 else (power[59] + power[60]) / 2
+        expect = drive.heat_W(n, 0.0, p)
+        got = {k: case.sources[k](grid[i]) for k in expect}
+        assert got == pytest.approx(expect, rel=1e-12)
+        assert case.sources["stator"].interpolation == "previous"
+
+
+def test_load_torque_is_averaged_into_the_power_balance(tmp_path, spec):
+    lines = [f"{row(i * 60.0, speed='4300' if i == 0 else '', power='40')},{80.0 + (i % 2) * 4:g}"
+             for i in range(61)]
+    run = read_bench(write(tmp_path, lines, header=HEADER + ",load_torque_Nm"))
+    assert run.load_torque_measured
+    case, grid = inputs(run, spec, grid_s=120.0)
+    expect = drive_for(spec).heat_W(4300.0, 82.0, 40.0)  # mean of 80 and 84 N m in each 120 s
+    assert {k: case.sources[k](grid[3]) for k in expect} == pytest.approx(expect, rel=1e-12)
+
+
+def test_standstill_and_noisy_power_do_not_crash(tmp_path, spec):
+    """Standstill: no losses, even with a slightly negative power; a running interval whose
+    power is below the friction power: motor losses 0, bearings keep their friction heat."""
+    lines = [row(i * 60.0, speed="0" if i == 0 else ("12000" if i == 30 else ""),
+                 power="-0.02" if i < 30 else "0.1") for i in range(61)]
+    run = read_bench(write(tmp_path, lines))
+    with pytest.warns(BenchWarning, match=r"power_kW: in 30 of 60 intervals \(first at t = 1800 s\)"):
+        case, grid = inputs(run, spec)
+    assert all(case.sources[k](600.0) == 0.0 for k in case.sources)
+    drive = drive_for(spec)
+    pb = power_balance(drive.motor, drive.bearings, 12000.0, 0.0, drive.T_winding_K)
+    assert case.sources["stator"](2000.0) == pytest.approx(0.0, abs=1e-6)
+    assert case.sources["front_bearing"](2000.0) == pytest.approx(pb.bearings["front_bearing"].heat_W)
+
+
+def test_spec_without_drive_is_an_error(tmp_path, spec):
+    run = read_bench(write(tmp_path, good_rows()))
+    with pytest.raises(InputError) as info:
+        inputs(run, dataclasses.replace(spec, power_preset=None))
+    assert info.value.problem.field == "power_balance.preset"
+    assert "[power_balance] preset" in info.value.problem.fix
+
+
+def test_benchrun_is_a_plain_record(tmp_path):
+    run = read_bench(write(tmp_path, good_rows()))
+    assert isinstance(run, BenchRun) and run.path == tmp_path / "run.csv" and run.name == "run"
+    assert run.time_s.dtype == float and np.isnan(run.columns["speed_rpm"][1])
