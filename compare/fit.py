@@ -300,7 +300,8 @@ def lr_test(before: Fit, after: Fit) -> tuple[float, float]:
 
 def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                       alpha: float = 0.01, base: Fit | None = None,
-                      min_gain: float = 0.10) -> Selection:
+                      min_gain: float = 0.10, refit_top: int = 3,
+                      screen_nfev: int = 20) -> Selection:
     """Bacher-Madsen forward selection over the candidate effects."""
     say = cal.progress or (lambda _m: None)
     candidates = list(candidates or EFFECTS)
@@ -311,7 +312,7 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
     steps: list[Step] = []
     tried: list[dict] = []
     while True:
-        best = None
+        screens = []
         for name in candidates:
             if name in current.effects:
                 continue
@@ -320,24 +321,33 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                 label = name + (f"({lag_ch})" if lag_ch else "")
                 say(f"trying {label}")
                 effects = current.effects + (name,)
-                new = [p.name for p in EFFECTS[name].params]
-                # screen: the candidate's parameters, the others held at the current fit
-                screen = cal.fit(effects, free=new, start=current.theta,
-                                 lag_channel=lag_ch or current.lag_channel, max_nfev=25)
+                # screen: a short joint fit (the base parameters may already have absorbed
+                # part of the effect, so holding them would hide it), started inside the
+                # candidate's range (a start on the neutral bound can stall there)
+                start = dict(current.theta)
+                for p in EFFECTS[name].params:
+                    start[p.name] = p.lo + 0.1 * (p.hi - p.lo) if p.lo >= 0 else 0.1 * p.hi
+                screen = cal.fit(effects, start=start,
+                                 lag_channel=lag_ch or current.lag_channel, max_nfev=screen_nfev)
                 lr, pv = lr_test(current, screen)
                 tried.append({"effect": name, "channel": lag_ch, "round": len(steps) + 1,
                               "p_value_screen": pv, "loglik": screen.loglik,
                               "validation": screen.validation_score()})
-                if best is None or screen.loglik > best[1].loglik:
-                    best = (name, screen, lag_ch)
-        if best is None:
+                screens.append((name, screen, lag_ch))
+        if not screens:
             break
-        name, screen, lag_ch = best
-        say(f"refitting with {name}")
-        full = cal.fit(current.effects + (name,), start=screen.theta,
-                       lag_channel=lag_ch or current.lag_channel)
-        if full.loglik < screen.loglik:  # the joint fit may stop early; keep the better one
-            full = screen
+        # the screen holds the other parameters, which may already have absorbed part of an
+        # effect: refit the best few jointly and take the best joint likelihood
+        best = None
+        for name, screen, lag_ch in sorted(screens, key=lambda s: -s[1].loglik)[:refit_top]:
+            say(f"refitting with {name}" + (f" ({lag_ch})" if lag_ch else ""))
+            full = cal.fit(current.effects + (name,), start=screen.theta,
+                           lag_channel=lag_ch or current.lag_channel)
+            if full.loglik < screen.loglik:  # the joint fit may stop early; keep the better
+                full = screen
+            if best is None or full.loglik > best[1].loglik:
+                best = (name, full, lag_ch)
+        name, full, lag_ch = best
         lr, pv = lr_test(current, full)
         v0, v1 = current.validation_score(), full.validation_score()
         accepted = pv < alpha and v1 < (1.0 - min_gain) * v0

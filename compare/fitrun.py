@@ -213,7 +213,9 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     unexplained = bool(beyond and structured)
     text = ""
     if unexplained:
-        text = ("no candidate effect explains the remaining residual: "
+        worst = ", ".join(f"{c} ({100 * (1 - errs[c]['within_tolerance']):.0f} % of the "
+                          "validation samples outside the tolerance)" for c in beyond)
+        text = (f"no candidate effect explains the remaining residual in {worst}: "
                 + diag_a.unexplained_description())
     elif structured:
         text = ("the residual is still serially correlated in " + ", ".join(structured)

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lumped.blocks import Convection, FixedTemperature, PrescribedHeatFlow, ThermalConductor
+from lumped.blocks import Convection, FixedTemperature, PrescribedHeatFlow
 from lumped.build import build_network
 from lumped.simulation import LumpedModel
 from spindle.bench import interval_heat_W
@@ -184,20 +184,16 @@ class GreyBox:
         return self._cache[key]
 
     # ------------------------------------------------------------------ model
-    def _model(self, theta: dict[str, float]) -> LumpedModel:
-        R_adv = theta.get("R_adv_K_W", 0.0)
+    def _structure(self) -> tuple:
+        """The network of this effect set, built and assembled once: (model, edge groups,
+        preload flows, index of the coolant-advection edge, index of the mount edge)."""
+        key = ("structure", self.nodes, self.effects)
+        if key in self._cache:
+            return self._cache[key]
+        coolant = "coolant_dynamics" in self.effects
         net = build_network(self.spec, self.nodes,
-                            coolant_advection_W_K=1.0 / R_adv if R_adv > 0 else None,
-                            bearing_tc_1_K=theta.get("k_preload_1_K", 0.0))
-        groups = _film_groups(self.spec)
-        for b in net.network.blocks:
-            if isinstance(b, Convection) and b.name.startswith("film:"):
-                f = theta[groups[b.name.split(":")[1]]]
-                if f != 1.0:
-                    b.Gc_W_K = _scaled(b.Gc_W_K, f)
-            elif isinstance(b, ThermalConductor) and b.name.startswith("contact:"):
-                if theta["contact"] != 1.0 and _is_contact_link(self.spec, b.name):
-                    b.G_W_K *= theta["contact"]
+                            coolant_advection_W_K=1.0 if coolant else None,
+                            bearing_tc_1_K=1.0 if "bearing_preload" in self.effects else 0.0)
         if "windage_loss" in self.effects:
             rotor = [p for p in net.parts.values() if p.part.role == "rotor"]
             masses = rotor[0].masses if rotor else net.parts[self.spec.parts[0].name].masses
@@ -207,15 +203,55 @@ class GreyBox:
                                                        source="windage",
                                                        share=m.block.C_J_K / total))
                 net.network.connect(m.block.port, q.port)
-        if "mount_conduction" in self.effects and theta.get("G_mount_W_K", 0.0) > 0:
+        if "mount_conduction" in self.effects:
             hous = [p for p in net.parts.values() if p.part.role == "housing"][0]
-            front = hous.masses[-1]
             amb = next(b for b in net.network.blocks if isinstance(b, FixedTemperature)
                        and b.source == "ambient")
-            c = net.network.add(Convection("mount", Gc_W_K=theta["G_mount_W_K"]))
-            net.network.connect(front.block.port, c.port_a)
+            c = net.network.add(Convection("mount", Gc_W_K=1.0))  # set per parameter set
+            net.network.connect(hous.masses[-1].block.port, c.port_a)
             net.network.connect(c.port_b, amb.port)
-        return LumpedModel(self.spec, network=net)
+        model = LumpedModel(self.spec, network=net)
+        groups = _film_groups(self.spec)
+        edge_group: list[str | None] = []
+        adv = mount = None
+        for k, (_, _, _, name) in enumerate(model.system.edges):
+            if name.startswith("film:"):
+                edge_group.append(groups[name.split(":")[1]])
+            elif name.startswith("contact:") and _is_contact_link(self.spec, name):
+                edge_group.append("contact")
+            else:
+                edge_group.append(None)
+            adv = k if name == "coolant_advection" else adv
+            mount = k if name == "mount" else mount
+        preload = [f for _, f in model.system.flows if f.across is not None]
+        self._cache[key] = (model, edge_group, preload, adv, mount)
+        return self._cache[key]
+
+    def _model(self, theta: dict[str, float]) -> LumpedModel:
+        """The structure's model with this parameter set's conductances (a new
+        ThermalSystem over the same network; nothing is rebuilt)."""
+        from dataclasses import replace as dc_replace
+
+        model, edge_group, preload, adv, mount = self._structure()
+        base = model.system
+        edges = []
+        for k, (i, j, G, name) in enumerate(base.edges):
+            g = edge_group[k]
+            if g is not None and theta[g] != 1.0:
+                G = _scaled(G, theta[g])
+            if k == adv:
+                R = theta.get("R_adv_K_W", 0.0)
+                G = 1.0 / R if R > 0 else 1e9  # R = 0: the films see the supply
+            if k == mount:
+                G = theta.get("G_mount_W_K", 0.0)
+            edges.append((i, j, G, name))
+        for f in preload:
+            f.tc_1_K = theta.get("k_preload_1_K", 0.0)
+        system = dc_replace(base, edges=edges, _cache={})
+        out = LumpedModel.__new__(LumpedModel)
+        out.__dict__.update(model.__dict__)
+        out.system = system
+        return out
 
     def simulate(self, theta: dict[str, float], x0_K: float | None = None
                  ) -> dict[str, np.ndarray]:

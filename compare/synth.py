@@ -120,7 +120,7 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
 
 
 def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0: float,
-                 iterations: int = 3):
+                 iterations: int = 4):
     """Transients repeated with inputs updated from the previous run's own temperatures."""
     th = ref.thermal
     spec = th.spec
@@ -149,9 +149,13 @@ def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0:
         res = th.solve_transient(case, dt_s, 1.0, T0, 0, None, functionals)
         t = res.times_s
         if effect == "coolant_dynamics":
-            Tc = np.asarray(base.T_coolant_K(t))
-            Q = res.functionals["coolant_bT"] - Tc * float(functionals["coolant_bT"].sum())
-            case = replace(case, T_coolant_K=TimeSeries(tuple(t), tuple(Tc + truth["R_adv_K_W"] * Q)))
+            # the films see the mean coolant temperature Tm, with sum g (T - Tm) = (Tm - Ts) / R
+            # (Ts the supply): Tm = (Ts + R g.T) / (1 + R sum g), solved with this run's g.T
+            # (a plain update Tm = Ts + R Q would diverge: R sum g is above 1)
+            Ts = np.asarray(base.T_coolant_K(t))
+            R, G = truth["R_adv_K_W"], float(functionals["coolant_bT"].sum())
+            Tm = (Ts + R * res.functionals["coolant_bT"]) / (1.0 + R * G)
+            case = replace(case, T_coolant_K=TimeSeries(tuple(t), tuple(Tm)))
         else:
             new = {}
             for h in spec.heat_sources:

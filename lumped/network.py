@@ -221,8 +221,17 @@ class ThermalSystem:
         self.input_names = [f"{s} W" if not isinstance(s, str) else s for s in self.source_names] \
             + [f"{s} K" if not isinstance(s, str) else s for s in self.fixed_sources]
         self.temperature_dependent = any(f.tc_1_K != 0 for _, f in self.flows)
+        col = {s: k for k, s in enumerate(self.source_names)}
+        self._tc_columns = sorted({col[f.source] for _, f in self.flows if f.tc_1_K != 0})
 
     # ------------------------------------------------------------------ matrices
+    def _q_key(self, q: np.ndarray | None) -> tuple | None:
+        """Cache key of the source powers that enter K (those of temperature-dependent flows
+        only: the others change B u, not the matrices)."""
+        if not self.temperature_dependent or q is None:
+            return None
+        return tuple(np.round(np.asarray(q)[self._tc_columns], 12))
+
     @property
     def n_states(self) -> int:
         return len(self.state)
@@ -273,8 +282,7 @@ class ThermalSystem:
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(K, B, R, S) at a speed: C dT/dt + K T = B u for the masses; the junction
         temperatures follow as T_j = R T + S u (static condensation)."""
-        key = (float(speed_rpm), None if not self.temperature_dependent or q is None
-               else tuple(np.round(q, 12)))
+        key = (float(speed_rpm), self._q_key(q))
         if key in self._cache:
             return self._cache[key]
         Kf, Bf = self._full(speed_rpm, q)
@@ -348,14 +356,23 @@ class ThermalSystem:
         (matrix exponential of the augmented system, scipy.linalg.expm). With ``integrals``
         also (Psi, Lambda) with integral_0^dt x dt = Psi x + Lambda u, for exact energy
         bookkeeping."""
-        from scipy.linalg import expm
-
         key = ("zoh", round(float(dt_s), 9), float(speed_rpm), integrals,
-               None if not self.temperature_dependent or q is None else tuple(np.round(q, 12)))
+               self._q_key(q))
         if key in self._cache:
             return self._cache[key]
         K, B, _, _ = self.matrices(speed_rpm, q)
         n, m = K.shape[0], B.shape[1]
+        if not integrals and np.allclose(K, K.T, rtol=1e-12, atol=0.0):
+            # symmetric network: exact through the eigenvectors of C^-1/2 K C^-1/2
+            s = 1.0 / np.sqrt(self.C)
+            lam, V = np.linalg.eigh(s[:, None] * K * s[None, :])
+            left, right = s[:, None] * V, V.T * (1.0 / s)[None, :]
+            Phi = (left * np.exp(-lam * dt_s)) @ right
+            Gam = (left * (-np.expm1(-lam * dt_s) / lam)) @ (V.T * s[None, :]) @ B
+            self._cache[key] = (Phi, Gam)
+            return self._cache[key]
+        from scipy.linalg import expm
+
         size = 2 * n + m if integrals else n + m
         M = np.zeros((size, size))
         M[:n, :n] = -K / self.C[:, None] * dt_s
