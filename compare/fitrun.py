@@ -61,7 +61,8 @@ def greybox_inputs(run: BenchRun, grid_s: float = 60.0) -> Inputs:
         else np.zeros(len(mids))
     T_env = cell_means(*valid("T_env_C"), grid, mids) + KELVIN
     T_cool = cell_means(*valid("T_coolant_C"), grid, mids) + KELVIN
-    return Inputs(grid, speed, power, torque, T_env, T_cool)
+    _, y_env = valid("T_env_C")
+    return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + KELVIN)
 
 
 @dataclass

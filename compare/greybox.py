@@ -127,6 +127,7 @@ class Inputs:
     load_torque_Nm: np.ndarray
     T_env_K: np.ndarray
     T_coolant_K: np.ndarray
+    T_start_K: float | None = None  # uniform initial temperature [K] (default: T_env_K[0])
 
 
 def inputs_from_cycle(cycle, grid_s: np.ndarray) -> Inputs:
@@ -140,7 +141,8 @@ def inputs_from_cycle(cycle, grid_s: np.ndarray) -> Inputs:
     return Inputs(grid_s, np.array([s.speed_rpm for s in steps]), power,
                   np.array([s.load_torque_Nm for s in steps]),
                   np.asarray(cycle.T_ambient_K(mid), dtype=float),
-                  np.asarray(cycle.T_coolant_K(mid), dtype=float))
+                  np.asarray(cycle.T_coolant_K(mid), dtype=float),
+                  float(cycle.T_ambient_K(grid_s[0])))
 
 
 @dataclass
@@ -274,7 +276,8 @@ class GreyBox:
             cols.append(inp.T_env_K if f == "ambient" else inp.T_coolant_K)
         U = np.column_stack(cols)
         m = len(sys.source_names)
-        x = np.full(sys.n_states, inp.T_env_K[0] if x0_K is None else x0_K)
+        start = inp.T_start_K if inp.T_start_K is not None else inp.T_env_K[0]
+        x = np.full(sys.n_states, start if x0_K is None else x0_K)
         X = np.empty((n_int + 1, sys.n_states))
         X[0] = x
         dts = np.diff(inp.grid_s)
