@@ -30,6 +30,7 @@ import numpy as np
 
 from lumped.blocks import Convection, FixedTemperature, PrescribedHeatFlow
 from lumped.build import build_network
+from lumped.realtime import modal_recursion
 from lumped.simulation import LumpedModel
 from spindle.bench import interval_heat_W
 from spindle.drive import Drive
@@ -278,20 +279,37 @@ class GreyBox:
         m = len(sys.source_names)
         start = inp.T_start_K if inp.T_start_K is not None else inp.T_env_K[0]
         x = np.full(sys.n_states, start if x0_K is None else x0_K)
-        X = np.empty((n_int + 1, sys.n_states))
-        X[0] = x
+        names = [n for n in model.sensor_names if n in CHANNELS]
+        rows = [model.S[model.sensor_names.index(n)] for n in names]
+        has_p1 = "P1" in model.chain.rows
+        if has_p1:
+            rows.append(model.chain.rows["P1"])
+        readout = np.array(rows)
+        Y = np.empty((n_int + 1, len(rows)))
+        Y[0] = readout @ x
         dts = np.diff(inp.grid_s)
-        for k in range(n_int):
-            Phi, Gam = sys.discretize(float(dts[k]), float(inp.speed_rpm[k]),
-                                      U[k, :m] if sys.temperature_dependent else None)
-            x = Phi @ x + Gam @ U[k]
-            X[k + 1] = x
-        out: dict[str, np.ndarray] = {}
-        for j, name in enumerate(model.sensor_names):
-            if name in CHANNELS:
-                out[name] = X @ model.S[j]
-        if "P1" in model.chain.rows:
-            p1 = th["alpha_eff"] * ((X - model.chain.T_ref) @ model.chain.rows["P1"])
+        k = 0
+        while k < n_int:  # runs of equal (dt, speed): one modal recursion each
+            j = k + 1
+            while j < n_int and dts[j] == dts[k] and inp.speed_rpm[j] == inp.speed_rpm[k]:
+                j += 1
+            modal = None if sys.temperature_dependent else sys.modes(float(dts[k]),
+                                                                      float(inp.speed_rpm[k]))
+            if modal is not None:
+                a, Bm, to_modal, from_modal = modal
+                Yseg, z = modal_recursion(a, Bm, U[k:j], to_modal @ x, readout @ from_modal)
+                Y[k + 1:j + 1] = Yseg
+                x = from_modal @ z
+            else:
+                for i in range(k, j):
+                    Phi, Gam = sys.discretize(float(dts[i]), float(inp.speed_rpm[i]),
+                                              U[i, :m] if sys.temperature_dependent else None)
+                    x = Phi @ x + Gam @ U[i]
+                    Y[i + 1] = readout @ x
+            k = j
+        out: dict[str, np.ndarray] = {n: Y[:, i] for i, n in enumerate(names)}
+        if has_p1:
+            p1 = th["alpha_eff"] * (Y[:, -1] - model.chain.T_ref * model.chain.rows["P1"].sum())
             n_end = np.concatenate([[inp.speed_rpm[0]], inp.speed_rpm])  # speed over the step
             if "centrifugal_shortening" in self.effects:
                 p1 = p1 - th["c_cf_um_krpm2"] * 1e-6 * (n_end / 1000.0) ** 2

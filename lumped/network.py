@@ -350,6 +350,23 @@ class ThermalSystem:
         K, B, _, _ = self.matrices(speed_rpm, u[:len(self.source_names)])
         return np.linalg.solve(K, B @ u)
 
+    def modes(self, dt_s: float, speed_rpm: float) -> tuple | None:
+        """Modal form of the exact zero-order-hold step for a symmetric network (None
+        otherwise): (a, Bm, to_modal, from_modal) with z = to_modal x, z+ = a z + Bm u and
+        x = from_modal z (eigenvectors of C^-1/2 K C^-1/2)."""
+        key = ("modes", round(float(dt_s), 9), float(speed_rpm))
+        if key not in self._cache:
+            K, B, _, _ = self.matrices(speed_rpm, None)
+            if self.temperature_dependent or not np.allclose(K, K.T, rtol=1e-12, atol=0.0):
+                self._cache[key] = None
+            else:
+                s = 1.0 / np.sqrt(self.C)
+                lam, V = np.linalg.eigh(s[:, None] * K * s[None, :])
+                g = -np.expm1(-lam * dt_s) / lam
+                self._cache[key] = (np.exp(-lam * dt_s), (V.T * s[None, :]) @ B * g[:, None],
+                                    V.T * (1.0 / s)[None, :], s[:, None] * V)
+        return self._cache[key]
+
     def discretize(self, dt_s: float, speed_rpm: float, q: np.ndarray | None = None,
                    integrals: bool = False) -> tuple[np.ndarray, ...]:
         """Exact zero-order-hold step: x+ = Phi x + Gamma u for inputs held over dt_s [s]

@@ -119,7 +119,7 @@ class RealTimePredictor:
             z = to_modal @ x
             for c0 in range(a0, b0, _CHUNK):  # chunks stay in cache
                 c1 = min(c0 + _CHUNK, b0)
-                Y[c0:c1], z = _modal_recursion(a, Bm, U[c0:c1], z, out)
+                Y[c0:c1], z = modal_recursion(a, Bm, U[c0:c1], z, out)
             x = from_modal @ z
         self.xu[:self.n] = x
         Y += self._offset
@@ -129,7 +129,7 @@ class RealTimePredictor:
 _CHUNK = 16384
 
 
-def _modal_recursion(a: np.ndarray, Bm: np.ndarray, U: np.ndarray, z0: np.ndarray,
+def modal_recursion(a: np.ndarray, Bm: np.ndarray, U: np.ndarray, z0: np.ndarray,
                      out: np.ndarray) -> np.ndarray:
     """Outputs out @ z_k (samples x outputs) of z_k = a z_(k-1) + Bm u_k for every mode.
 
