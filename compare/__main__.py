@@ -1,5 +1,7 @@
+"""``python -m compare``: the same as the ``spindle-verify`` command."""
+
 import sys
 
-from compare.cli import main
+from compare.entry import main
 
 sys.exit(main())

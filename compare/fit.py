@@ -301,7 +301,7 @@ def lr_test(before: Fit, after: Fit) -> tuple[float, float]:
 def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                       alpha: float = 0.01, base: Fit | None = None,
                       min_gain: float = 0.10, refit_top: int = 3,
-                      screen_nfev: int = 20) -> Selection:
+                      screen_nfev: int = 12) -> Selection:
     """Bacher-Madsen forward selection over the candidate effects."""
     say = cal.progress or (lambda _m: None)
     candidates = list(candidates or EFFECTS)

@@ -37,6 +37,9 @@ from spindle.drive import Drive
 from spindle.spec import Spec
 
 ROTATING = ("shaft", "tool", "rotor")
+#: the parameters that change the conductance matrix K (the others change sources or read-outs)
+_K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "R_adv_K_W", "G_mount_W_K",
+             "k_preload_1_K")
 CHANNELS = ("T1", "T2", "T_stator", "P1")
 
 
@@ -174,15 +177,19 @@ class GreyBox:
             memo: dict[tuple, dict[str, float]] = {}
             rows = []
             for n, M, P in zip(inp.speed_rpm, inp.load_torque_Nm, inp.power_kW, strict=True):
-                k = (round(float(n), 3), round(float(M), 4),
-                     None if np.isnan(P) else round(float(P), 4))
+                # measured power to 10 W: below the losses' own uncertainty, and it keeps
+                # the number of distinct operating points (power-balance calls) small
+                k = (round(float(n), 3), round(float(M), 2),
+                     None if np.isnan(P) else round(float(P), 2))
                 if k not in memo:  # P unknown (nan): the motor model gives the losses
                     if k[2] is None:
                         memo[k] = d.heat_W(k[0], k[1], None)
                     else:  # measured P: standstill and P < P_mech handled as the bench does
                         memo[k] = interval_heat_W(d, k[0], k[1], k[2])[0]
                 rows.append(memo[k])
-            self._cache = {k2: v for k2, v in self._cache.items() if k2[0] != "src"}
+            srcs = [k2 for k2 in self._cache if isinstance(k2, tuple) and k2[:1] == ("src",)]
+            for k2 in srcs[:-7]:  # keep the last few: a Jacobian visits f0 and the split
+                del self._cache[k2]
             self._cache[key] = {s: np.array([r[s] for r in rows]) for s in rows[0]}
         return self._cache[key]
 
@@ -250,7 +257,21 @@ class GreyBox:
             edges.append((i, j, G, name))
         for f in preload:
             f.tc_1_K = theta.get("k_preload_1_K", 0.0)
-        system = dc_replace(base, edges=edges, _cache={})
+        # systems (and their cached modes) are kept per set of the parameters that enter K:
+        # a Jacobian column for a source or read-out parameter reuses them
+        # (not with a bearing preload: its flows are shared and set per call, and its steps
+        # are computed lazily per source power)
+        kkey = ("system", self.nodes, self.effects,
+                *(round(float(theta.get(k, 0.0)), 12) for k in _K_PARAMS))
+        system = None if preload else self._cache.get(kkey)
+        if system is None:
+            systems = [k for k in self._cache if isinstance(k, tuple) and k[:1] == ("system",)]
+            if len(systems) > 64:
+                for k in systems[:32]:
+                    del self._cache[k]
+            system = dc_replace(base, edges=edges, _cache={})
+            if not preload:
+                self._cache[kkey] = system
         out = LumpedModel.__new__(LumpedModel)
         out.__dict__.update(model.__dict__)
         out.system = system
