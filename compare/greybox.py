@@ -22,7 +22,6 @@ extension with its own parameters and explanation; see :class:`Effect`.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -30,6 +29,7 @@ import numpy as np
 
 from lumped.blocks import Convection, FixedTemperature, PrescribedHeatFlow
 from lumped.build import build_network
+from lumped.elastic import first_order_lag
 from lumped.realtime import modal_recursion
 from lumped.simulation import LumpedModel
 from spindle.bench import interval_heat_W
@@ -342,18 +342,6 @@ class GreyBox:
             out[self.lag_channel] = first_order_lag(inp.grid_s, out[self.lag_channel],
                                                     th["tau_s"])
         return out
-
-
-def first_order_lag(t: np.ndarray, x: np.ndarray, tau_s: float) -> np.ndarray:
-    """Response of tau y' + y = x for x linear between samples, from y(0) = x(0); exact."""
-    y = np.empty_like(x)
-    y[0] = x[0]
-    for k in range(1, len(x)):
-        h = t[k] - t[k - 1]
-        a = math.exp(-h / tau_s)
-        slope = (x[k] - x[k - 1]) / h
-        y[k] = a * y[k - 1] + (1 - a) * x[k - 1] + slope * (h - tau_s * (1 - a))
-    return y
 
 
 def _film_groups(spec: Spec) -> dict[str, str]:

@@ -275,21 +275,26 @@ class NodeChoice:
     def save(self, out: Path, pictures: bool = True, stem: str = "nodes") -> list[Path]:
         """``<stem>.csv`` (the long table), ``<stem>.json`` (summary), ``<stem>.png``; each
         written atomically."""
-        from spindle.outputs import atomic_write, write_csv, write_json
-        from spindle.plots import pyplot
+        return _save_result(self, Path(out), stem, pictures)
 
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        t = self.table()
-        write_csv(out / f"{stem}.csv", list(t), zip(*t.values(), strict=True))
-        write_json(out / f"{stem}.json", self.summary())
-        files = [out / f"{stem}.csv", out / f"{stem}.json"]
-        if pictures:
-            fig = self.plot()
-            atomic_write(out / f"{stem}.png", lambda tmp: fig.savefig(tmp, dpi=130))
-            pyplot().close(fig)
-            files.append(out / f"{stem}.png")
-        return files
+
+def _save_result(result, out: Path, stem: str, pictures: bool) -> list[Path]:
+    """``<stem>.csv`` (``result.table()``), ``<stem>.json`` (``result.summary()``) and
+    ``<stem>.png`` (``result.plot()``), each written atomically."""
+    from spindle.outputs import atomic_write, write_csv, write_json
+    from spindle.plots import pyplot
+
+    out.mkdir(parents=True, exist_ok=True)
+    t = result.table()
+    write_csv(out / f"{stem}.csv", list(t), zip(*t.values(), strict=True))
+    write_json(out / f"{stem}.json", result.summary())
+    files = [out / f"{stem}.csv", out / f"{stem}.json"]
+    if pictures:
+        fig = result.plot()
+        atomic_write(out / f"{stem}.png", lambda tmp: fig.savefig(tmp, dpi=130))
+        pyplot().close(fig)
+        files.append(out / f"{stem}.png")
+    return files
 
 
 def _check_level(level: int, option: str) -> None:
@@ -702,22 +707,7 @@ class SensorRanking:
 
     def save(self, out: Path, pictures: bool = True, stem: str | None = None) -> list[Path]:
         """``ranking_<method>.csv``, ``.json`` and ``.png`` (atomic writes)."""
-        from spindle.outputs import atomic_write, write_csv, write_json
-        from spindle.plots import pyplot
-
-        stem = stem or f"ranking_{self.method}"
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        t = self.table()
-        write_csv(out / f"{stem}.csv", list(t), zip(*t.values(), strict=True))
-        write_json(out / f"{stem}.json", self.summary())
-        files = [out / f"{stem}.csv", out / f"{stem}.json"]
-        if pictures:
-            fig = self.plot()
-            atomic_write(out / f"{stem}.png", lambda tmp: fig.savefig(tmp, dpi=130))
-            pyplot().close(fig)
-            files.append(out / f"{stem}.png")
-        return files
+        return _save_result(self, Path(out), stem or f"ranking_{self.method}", pictures)
 
 
 def rank_snapshots(snap: Snapshots, k_max: int = 11, method: str = "greedy",

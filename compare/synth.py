@@ -32,7 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.greybox import EFFECTS, first_order_lag
+from compare.greybox import EFFECTS
+from lumped.elastic import first_order_lag
 from spindle.loads import LoadCase, SpeedTable, TimeSeries
 from spindle.spec import Spec
 

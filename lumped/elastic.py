@@ -45,16 +45,21 @@ class KelvinVoigt:
 
     def filter(self, times_s: np.ndarray, x: np.ndarray) -> np.ndarray:
         """Exact response to x linear between samples, starting at rest on x[0]."""
-        tau = self.tau_s
-        y = np.empty_like(x)
-        y[0] = x[0]
-        for k in range(1, len(x)):
-            h = times_s[k] - times_s[k - 1]
-            a = np.exp(-h / tau)
-            slope = (x[k] - x[k - 1]) / h
-            # y' = (x - y) / tau with x = x0 + slope t: exact over the step
-            y[k] = a * y[k - 1] + (1 - a) * x[k - 1] + slope * (h - tau * (1 - a))
-        return y
+        return first_order_lag(times_s, x, self.tau_s)
+
+
+def first_order_lag(times_s: np.ndarray, x: np.ndarray, tau_s: float) -> np.ndarray:
+    """Response of tau y' + y = x [s] for x linear between the samples, from y(0) = x(0);
+    exact over each step."""
+    y = np.empty_like(x)
+    y[0] = x[0]
+    for k in range(1, len(x)):
+        h = times_s[k] - times_s[k - 1]
+        a = np.exp(-h / tau_s)
+        slope = (x[k] - x[k - 1]) / h
+        # y' = (x - y) / tau with x = x0 + slope t: exact over the step
+        y[k] = a * y[k - 1] + (1 - a) * x[k - 1] + slope * (h - tau_s * (1 - a))
+    return y
 
 
 def _chain_part(parts: list, z: float):
