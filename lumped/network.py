@@ -370,7 +370,8 @@ class ThermalSystem:
     def discretize(self, dt_s: float, speed_rpm: float, q: np.ndarray | None = None,
                    integrals: bool = False) -> tuple[np.ndarray, ...]:
         """Exact zero-order-hold step: x+ = Phi x + Gamma u for inputs held over dt_s [s]
-        (matrix exponential of the augmented system, scipy.linalg.expm). With ``integrals``
+        (from :meth:`modes` for a symmetric network, else the matrix exponential of the
+        augmented system, scipy.linalg.expm). With ``integrals``
         also (Psi, Lambda) with integral_0^dt x dt = Psi x + Lambda u, for exact energy
         bookkeeping."""
         key = ("zoh", round(float(dt_s), 9), float(speed_rpm), integrals,
@@ -379,14 +380,10 @@ class ThermalSystem:
             return self._cache[key]
         K, B, _, _ = self.matrices(speed_rpm, q)
         n, m = K.shape[0], B.shape[1]
-        if not integrals and np.allclose(K, K.T, rtol=1e-12, atol=0.0):
-            # symmetric network: exact through the eigenvectors of C^-1/2 K C^-1/2
-            s = 1.0 / np.sqrt(self.C)
-            lam, V = np.linalg.eigh(s[:, None] * K * s[None, :])
-            left, right = s[:, None] * V, V.T * (1.0 / s)[None, :]
-            Phi = (left * np.exp(-lam * dt_s)) @ right
-            Gam = (left * (-np.expm1(-lam * dt_s) / lam)) @ (V.T * s[None, :]) @ B
-            self._cache[key] = (Phi, Gam)
+        modal = None if integrals else self.modes(dt_s, speed_rpm)
+        if modal is not None:  # symmetric network: exact through its eigenvectors
+            a, Bm, to_modal, from_modal = modal
+            self._cache[key] = ((from_modal * a) @ to_modal, from_modal @ Bm)
             return self._cache[key]
         from scipy.linalg import expm
 

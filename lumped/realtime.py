@@ -91,17 +91,11 @@ class RealTimePredictor:
 
     # ------------------------------------------------------------------ batch replay
     def _modes(self, speed_rpm: float) -> tuple:
+        """(a, Bm, to_modal, from_modal, read-out in modal form) at a speed (cached)."""
         key = self._key(speed_rpm)
         if key not in self._modal:
-            K, B, _, _ = self.model.system.matrices(key)
-            s = 1.0 / np.sqrt(self.model.system.C)
-            lam, V = np.linalg.eigh(s[:, None] * K * s[None, :])
-            a = np.exp(-lam * self.dt_s)
-            g = -np.expm1(-lam * self.dt_s) / lam  # (1 - e^{-lambda dt}) / lambda
-            to_modal = V.T * (1.0 / s)[None, :]  # z = V^T C^1/2 x
-            from_modal = s[:, None] * V  # x = C^-1/2 V z
-            Bm = (V.T * s[None, :]) @ B * g[:, None]  # modal ZOH input matrix
-            self._modal[key] = (a, Bm, to_modal, from_modal, self.O @ from_modal)
+            modal = self.model.system.modes(self.dt_s, key)
+            self._modal[key] = (*modal, self.O @ modal[3])
         return self._modal[key]
 
     def run(self, U: np.ndarray, speeds_rpm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
