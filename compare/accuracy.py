@@ -96,11 +96,10 @@ class AccuracyResult:
         return row
 
     def verdict(self, row: dict[str, float]) -> str:
-        temps = [v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)]
+        worst = worst_temperature_K(row)
         growth = row.get("P1_max_um", math.nan)
         parts = []
-        if temps:
-            worst = max(temps)
+        if not math.isnan(worst):
             parts.append(f"temperature {'meets' if worst <= self.tol_temp_K else 'fails'} "
                          f"{self.tol_temp_K:g} K ({worst:.2f} K)")
         if not math.isnan(growth):
@@ -259,15 +258,20 @@ class AccuracyResult:
         return [out / f for f in files]
 
 
-def _worst_temp(t: dict[str, list], i: int) -> float:
-    vals = [t[k][i] for k in t if k.endswith("_max_K") and not math.isnan(t[k][i])]
+def worst_temperature_K(row: dict) -> float:
+    """The largest of a row's ``*_max_K`` temperature errors [K] (nan if it has none)."""
+    vals = [v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)]
     return max(vals) if vals else math.nan
 
 
+def _worst_temp(t: dict[str, list], i: int) -> float:
+    return worst_temperature_K({k: t[k][i] for k in t if k.endswith("_max_K")})
+
+
 def _meets(row: dict[str, float], tol_T: float, tol_P: float) -> bool:
-    temps = [v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)]
+    worst = worst_temperature_K(row)
     growth = row.get("P1_max_um", math.nan)
-    return bool(temps) and max(temps) <= tol_T and (math.isnan(growth) or growth <= tol_P)
+    return worst <= tol_T and (math.isnan(growth) or growth <= tol_P)
 
 
 # ---------------------------------------------------------------------- running the models

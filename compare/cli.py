@@ -163,6 +163,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
+    from compare.accuracy import worst_temperature_K
     from compare.study import run_study
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
@@ -194,11 +195,11 @@ def _cmd_study(args: argparse.Namespace) -> int:
         print(f"  {'model':<22} {'unknowns':>8} {'worst T err K':>14} {'P1 err um':>10} "
               f"{'runtime s':>10}  verdict")
         for i, name in enumerate(t["model"]):
-            temps = [t[k][i] for k in t if k.endswith("_max_K") and t[k][i] == t[k][i]]
+            worst = worst_temperature_K({k: t[k][i] for k in t if k.endswith("_max_K")})
             p1 = t.get("P1_max_um", [float("nan")] * len(t["model"]))[i]
             mark = f" ({t['preset'][i]})" if t["preset"][i] else ""
             print(f"  {name + mark:<22} {t['unknowns'][i]:8d} "
-                  f"{max(temps) if temps else float('nan'):14.3f} {p1:10.3f} "
+                  f"{worst:14.3f} {p1:10.3f} "
                   f"{t['runtime_s'][i]:10.3f}  {'ok' if t['meets_tolerances'][i] else '--'}")
         slopes = acc.slopes()
         if slopes:

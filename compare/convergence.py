@@ -188,8 +188,8 @@ class ConvergenceResult:
         for lv in self.analysed_levels:
             g = [self.gci(q, lv).gci_fine for q in self.values]
             worst[str(lv)] = float(np.nanmax(g)) * 100 if not all(map(math.isnan, g)) else None
-        flagged = {q: self.gci(q, self.levels[-1]).flag for q in self.values
-                   if self.gci(q, self.levels[-1]).flag not in ("", "converged")}
+        flags = {q: self.gci(q, self.levels[-1]).flag for q in self.values}
+        flagged = {q: f for q, f in flags.items() if f not in ("", "converged")}
         return {"spec": self.spec.name, "case": self.case_name, "levels": self.levels,
                 "elements": self.elements, "dofs": self.dofs, "runtime_s": self.runtime_s,
                 "threshold_pct": 100 * self.threshold, "ground_truth_level": gt,

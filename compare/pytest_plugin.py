@@ -22,7 +22,13 @@ from dataclasses import dataclass
 
 import pytest
 
-from compare.accuracy import AccuracyResult, Entry, fem_entry, lumped_entries
+from compare.accuracy import (
+    AccuracyResult,
+    Entry,
+    fem_entry,
+    lumped_entries,
+    worst_temperature_K,
+)
 
 
 @dataclass
@@ -64,9 +70,7 @@ def model_error(spec_ref: str, model: str, case: str | None = None, reference_le
     acc = AccuracyResult(spec, load.name, transient, ref, f"FEM level {reference_level}",
                          [entry])
     row = acc.errors(entry)
-    temps = [v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)]
-    return Verdict(model, max(temps) if temps else math.nan, row.get("P1_max_um", math.nan),
-                   row)
+    return Verdict(model, worst_temperature_K(row), row.get("P1_max_um", math.nan), row)
 
 
 class SpindleVerify:
