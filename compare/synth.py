@@ -97,16 +97,15 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
         case = case.with_sources({rotor[0]: TimeSeries(tuple(t), tuple(np.asarray(src.values)
                                                                        + extra),
                                                        src.interpolation)})
-    ref = ReferenceModel(spec, level, centrifugal=effect == "centrifugal_shortening")
+    ref = ReferenceModel(spec, level)
     if effect in ("coolant_dynamics", "bearing_preload"):
         res = _fixed_point(ref, case, effect, truth, dt_s, T0)
     else:
         res = ref.transient(case, dt_s, T0=T0)
     ch = {n: res.sensor(n) for n in ("T1", "T2", "T_stator") if n in res.names}
     P1 = res.growth_m["P1"].copy()
-    if effect == "centrifugal_shortening":  # scale the centrifugal part only
-        plain = ReferenceModel(spec, level).transient(case, dt_s, T0=T0).growth_m["P1"]
-        P1 = plain + truth["scale"] * (P1 - plain)
+    if effect == "centrifugal_shortening":  # the FEM's centrifugal part, scaled
+        P1 = P1 + truth["scale"] * ref.centrifugal_m(case, res.times_s, "P1")
     ch["P1"] = P1
     t = res.times_s
     if effect == "fixture_expansion":

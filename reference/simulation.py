@@ -44,6 +44,21 @@ class ReferenceModel:
             res.growth_m = self.elastic.growth(res.U)
         return res
 
+    @staticmethod
+    def _step_speeds(case: LoadCase, times_s: np.ndarray) -> np.ndarray:
+        """Speed [rpm] at each output time: the value held over the step ending there (its
+        mid-step value; the first sample: the start value)."""
+        t = np.asarray(times_s, dtype=float)
+        mid = np.concatenate([[t[0]], 0.5 * (t[1:] + t[:-1])])
+        return np.asarray(case.speed_rpm(mid), dtype=float)
+
+    def centrifugal_m(self, case: LoadCase, times_s: np.ndarray, reading: str = "P1"
+                      ) -> np.ndarray:
+        """The centrifugal part omega^2 c of a growth reading [m] at the output times (the
+        speed held over each step), whether or not this model adds it."""
+        omega2 = (self._step_speeds(case, times_s) * np.pi / 30.0) ** 2
+        return omega2 * self.elastic.gain(reading)[1]
+
     def transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
                   T0: np.ndarray | float | None = None, save_every: int = 0,
                   progress: Callable[[float], None] | None = None) -> TransientResult:
@@ -51,11 +66,8 @@ class ReferenceModel:
         res = self.thermal.solve_transient(case, dt_s, theta, T0, save_every, progress,
                                            functionals={k: g for k, (g, _) in gains.items()})
         T_ref = self.elastic.T_ref if self.elastic else 0.0
-        # speed over each step is held at its mid-step value; at the sample times use the
-        # value that applied in the step ending there (the first sample: the start value)
         t = res.times_s
-        mid = np.concatenate([[t[0]], 0.5 * (t[1:] + t[:-1])])
-        speed = np.asarray(case.speed_rpm(mid), dtype=float)
+        speed = self._step_speeds(case, t)
         omega2 = (speed * np.pi / 30.0) ** 2
         for k, (g, c) in gains.items():
             res.growth_m[k] = res.functionals[k] - T_ref * g.sum() \
