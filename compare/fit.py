@@ -34,6 +34,8 @@ import numpy as np
 
 from compare.greybox import BASE_PARAMS, EFFECTS, GreyBox, Param
 
+#: |z| of every base parameter after an effect that is needed for plausibility (95 % central)
+RESTORED_Z = 1.96
 TOLERANCE = {"T1": 1.0, "T2": 1.0, "T_stator": 1.0, "P1": 1.5e-6}  # K, K, K, m (paper)
 
 
@@ -110,6 +112,7 @@ class Fit:
     errors: dict[str, dict[str, dict[str, float]]]  # window -> channel -> rmse, max, within
     runtime_s: float = 0.0
     nfev: int = 0
+    penalty: float = 0.0  # 1/2 sum ((z - z_ref) / sd)^2 over the free parameters with a prior
 
     @property
     def k(self) -> int:
@@ -135,6 +138,77 @@ class Calibrator:
     max_nfev: int = 60
     progress: Callable[[str], None] | None = None
     evaluations: int = field(default=0)
+    #: prior centres (compare.reduction's theta_ref); the widths are Param.prior_sd
+    prior: dict[str, float] | None = None
+    #: sqrt(s^2 n / n_eff) of the data term, so that data and prior weigh as a posterior
+    prior_scale: float = 1.0
+    #: per channel, the validation RMS [tolerance units] no effect can remove: the lumped
+    #: model's own error against the FEM on these inputs and the sensor noise (set_floor)
+    floor: dict[str, float] | None = None
+
+    def set_floor(self, model_form_rms: dict[str, float], fit: Fit) -> None:
+        """The floor from the lumped-versus-FEM RMS [K; m] and the noise of ``fit``'s
+        residual, estimated from its second differences (var(d2 r) = 6 sigma^2 for white
+        noise; the smooth model-form part hardly enters them)."""
+        floor = {}
+        for c in self.channels:
+            m = self.measured.mask(c, "all")
+            r = (self.measured.values[c][m] - fit.model[c][m]) / TOLERANCE[c]
+            noise2 = float(np.var(np.diff(r, 2)) / 6.0) if len(r) > 3 else 0.0
+            floor[c] = float(np.sqrt((model_form_rms.get(c, 0.0) / TOLERANCE[c]) ** 2
+                                     + noise2))
+        self.floor = floor
+
+    def prior_z(self, fit: Fit) -> dict[str, float]:
+        """Each base parameter's distance from its prior centre in prior standard deviations
+        (empty without priors)."""
+        if not self.prior:
+            return {}
+        params = self.gb.variant(fit.effects, fit.lag_channel).parameters()
+        return {k: (_to_z(params[k], fit.theta[k]) - _to_z(params[k], self.prior[k]))
+                / params[k].prior_sd for k in fit.free
+                if params[k].prior_sd and k in self.prior}
+
+    def implausible(self, fit: Fit, alpha: float) -> list[str]:
+        """The base parameters outside their two-sided (1 - alpha) prior range."""
+        from scipy.stats import norm
+
+        z_crit = float(norm.isf(alpha / 2))
+        return [k for k, z in self.prior_z(fit).items() if abs(z) > z_crit]
+
+    def comfortable(self, fit: Fit) -> bool:
+        """Every base parameter inside the central 95 % of its prior (|z| <= 1.96): the bar
+        an effect must clear to count as restoring plausibility, well inside the 1 % bar
+        that called it implausible, so that nudging a parameter just across does not count."""
+        return all(abs(z) <= RESTORED_Z for z in self.prior_z(fit).values())
+
+    def validation_excess(self, fit: Fit) -> float:
+        """Mean square validation error above the floor, summed over channels [tolerance
+        units squared]: what an effect could still explain."""
+        total = 0.0
+        for c, e in fit.errors["validation"].items():
+            if e.get("n"):
+                f = (self.floor or {}).get(c, 0.0)
+                total += max(e["rmse_w"] ** 2 - f * f, 0.0)
+        return total
+
+    def set_prior(self, centre: dict[str, float], fit: Fit) -> None:
+        """Priors around ``centre``, weighed against the data by ``fit``'s residual variance
+        and effective sample size (held fixed from then on, so likelihoods stay comparable)."""
+        r = np.concatenate(list(self.residuals(fit.model, "fit").values()))
+        self.prior = dict(centre)
+        self.prior_scale = float(np.sqrt(np.mean(r * r) * fit.n / fit.n_eff))
+
+    def _prior_terms(self, params: dict[str, Param], free: Sequence[str],
+                     z: np.ndarray) -> np.ndarray:
+        if not self.prior:
+            return np.zeros(0)
+        out = []
+        for k, v in zip(free, z, strict=True):
+            p = params[k]
+            if p.prior_sd and k in self.prior:
+                out.append((v - _to_z(p, self.prior[k])) / p.prior_sd)
+        return np.asarray(out)
 
     def residuals(self, out: dict[str, np.ndarray], window: str) -> dict[str, np.ndarray]:
         res = {}
@@ -177,8 +251,7 @@ class Calibrator:
         from scipy.optimize import least_squares
 
         t0 = time.perf_counter()
-        gb = GreyBox(self.gb.spec, self.gb.drive, self.gb.inputs, self.gb.nodes, effects,
-                     lag_channel, self.gb._cache)
+        gb = self.gb.variant(effects, lag_channel)
         params = gb.parameters()
         free = list(free) if free is not None else list(params)
         theta = {k: p.default for k, p in params.items()}
@@ -198,7 +271,8 @@ class Calibrator:
             th = dict(theta)
             th.update({k: _from_z(params[k], float(v)) for k, v in zip(free, z, strict=True)})
             out = gb.simulate(th)
-            return np.concatenate(list(self.residuals(out, "fit").values()))
+            return np.concatenate([*self.residuals(out, "fit").values(),
+                                   self.prior_scale * self._prior_terms(params, free, z)])
 
         sol = least_squares(vec, z0, bounds=(lo, hi), diff_step=1e-4, x_scale="jac",
                             max_nfev=max_nfev or self.max_nfev, ftol=1e-6, xtol=1e-6)
@@ -208,11 +282,12 @@ class Calibrator:
         r_all = np.concatenate(list(res.values()))
         n = len(r_all)
         n_eff = max(effective_samples(res), len(free) + 2.0)
-        J = sol.jac
+        J = sol.jac[:n]  # the data rows: the intervals say what this run alone determines
+        penalty = 0.5 * float(np.sum(self._prior_terms(params, free, sol.x) ** 2))
         ci, corr, ident = _intervals(J, r_all, n, n_eff, free, params, sol.x)
         self.evaluations += nfev
         return Fit(effects, lag_channel, theta, free, ci, corr, ident, self.loglik(res), n, n_eff,
-                   out, self.errors(out), time.perf_counter() - t0, nfev)
+                   out, self.errors(out), time.perf_counter() - t0, nfev, penalty)
 
 
 def effective_samples(res: dict[str, np.ndarray]) -> float:
@@ -275,6 +350,7 @@ class Step:
     delta_bic: float
     validation_before: float
     validation_after: float
+    needed_by: str = "validation"  # or "plausibility" (compare.fit.forward_selection)
 
 
 @dataclass
@@ -288,19 +364,26 @@ class Selection:
         return self.steps[-1].fit if self.steps else self.base
 
 
+def log_posterior_gain(before: Fit, after: Fit) -> float:
+    """Log-likelihood gain of ``after`` over ``before``, counted in effective samples
+    (n_eff / n), minus the rise of the prior penalty."""
+    return ((after.loglik - before.loglik) * after.n_eff / after.n
+            - (after.penalty - before.penalty))
+
+
 def lr_test(before: Fit, after: Fit) -> tuple[float, float]:
     """(LR statistic corrected for autocorrelation, p-value) of ``after`` against the nested
     ``before``."""
     from scipy.stats import chi2
 
     k = max(after.k - before.k, 1)
-    lr = max(2.0 * (after.loglik - before.loglik), 0.0) * after.n_eff / after.n
+    lr = max(2.0 * log_posterior_gain(before, after), 0.0)
     return lr, float(chi2.sf(lr, k))
 
 
 def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                       alpha: float = 0.01, base: Fit | None = None,
-                      min_gain: float = 0.10, refit_top: int = 3,
+                      min_gain: float = 0.25, refit_top: int = 3,
                       screen_nfev: int = 12) -> Selection:
     """Bacher-Madsen forward selection over the candidate effects."""
     say = cal.progress or (lambda _m: None)
@@ -332,31 +415,51 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                 lr, pv = lr_test(current, screen)
                 tried.append({"effect": name, "channel": lag_ch, "round": len(steps) + 1,
                               "p_value_screen": pv, "loglik": screen.loglik,
-                              "validation": screen.validation_score()})
+                              "validation": screen.validation_score(),
+                              "validation_excess": cal.validation_excess(screen)})
                 screens.append((name, screen, lag_ch))
         if not screens:
             break
-        # the screen holds the other parameters, which may already have absorbed part of an
-        # effect: refit the best few jointly and take the best joint likelihood
-        best = None
-        for name, screen, lag_ch in sorted(screens, key=lambda s: -s[1].loglik)[:refit_top]:
+        # the screen is short: refit the best few jointly; an effect qualifies when its
+        # likelihood-ratio test is significant and it removes at least min_gain of the
+        # validation error above the floor; the qualifying one with the best likelihood wins
+        def gain(f: Fit, cur: Fit = current) -> float:
+            return log_posterior_gain(cur, f)
+
+        x0, v0 = cal.validation_excess(current), current.validation_score()
+        odd0 = cal.implausible(current, alpha)
+        refits = []
+        for name, screen, lag_ch in sorted(screens, key=lambda s: -gain(s[1]))[:refit_top]:
             say(f"refitting with {name}" + (f" ({lag_ch})" if lag_ch else ""))
             full = cal.fit(current.effects + (name,), start=screen.theta,
                            lag_channel=lag_ch or current.lag_channel)
-            if full.loglik < screen.loglik:  # the joint fit may stop early; keep the better
+            if gain(full) < gain(screen):  # the joint fit may stop early; keep the better
                 full = screen
-            if best is None or full.loglik > best[1].loglik:
-                best = (name, full, lag_ch)
-        name, full, lag_ch = best
-        lr, pv = lr_test(current, full)
-        v0, v1 = current.validation_score(), full.validation_score()
-        accepted = pv < alpha and v1 < (1.0 - min_gain) * v0
-        tried.append({"effect": name, "channel": lag_ch, "round": len(steps) + 1,
-                      "p_value": pv, "validation_before": v0, "validation_after": v1,
-                      "accepted": accepted})
-        if not accepted:
+            lr, pv = lr_test(current, full)
+            x1 = cal.validation_excess(full)
+            # needed: it predicts the validation window better, or without it the base
+            # parameters sit outside their prior range and with it they do not
+            why = ("validation" if x1 < (1.0 - min_gain) * x0 else
+                   "plausibility" if odd0 and cal.comfortable(full) else None)
+            ok = pv < alpha and why is not None
+            refits.append((ok, gain(full), name, full, lag_ch, lr, pv, x1, why))
+        qualifying = [r for r in refits if r[0]]
+        chosen = max(qualifying or refits, key=lambda r: r[1])
+        for ok, _g, name, full, lag_ch, _lr, pv, x1, why in refits:
+            tried.append({"effect": name, "channel": lag_ch, "round": len(steps) + 1,
+                          "p_value": pv, "validation_before": v0,
+                          "validation_after": full.validation_score(), "excess_before": x0,
+                          "excess_after": x1, "implausible_before": odd0,
+                          "implausible_after": cal.implausible(full, alpha),
+                          "prior_z_before": cal.prior_z(current),
+                          "prior_z_after": cal.prior_z(full),
+                          "needed_by": why, "qualifies": ok,
+                          "accepted": ok and full is chosen[3]})
+        if not qualifying:
             break
-        steps.append(Step(name, full, lr, pv, full.bic() - current.bic(), v0, v1))
+        _ok, _g, name, full, lag_ch, lr, pv, _x1, why = chosen
+        steps.append(Step(name, full, lr, pv, full.bic() - current.bic(), v0,
+                          full.validation_score(), why))
         current = full
     return Selection(base, steps, tried)
 

@@ -54,17 +54,32 @@ class Param:
     hi: float
     doc: str
     log: bool = True
+    #: prior standard deviation around the reduced value (compare.reduction), on the fitted
+    #: scale (natural log for ``log`` parameters); None: no prior
+    prior_sd: float | None = None
 
 
+# Prior widths (1 sigma, natural log of the factor) are what a designer knows before any
+# bench run, stated as assumptions: Palmgren's f0 spans a factor 2-3 over lubrication and
+# preload (Harris, Rolling Bearing Analysis), 0.4; the rotor's share of an induction motor's
+# losses moves with slip by about half, 0.4; Dittus-Boelter / Gnielinski for the jacket
+# +-25 %, 0.25; natural and mixed convection correlations on the housing +-35 %, 0.35;
+# rotating-surface correlations +-50 %, 0.4; contact conductances scatter by a factor 2-4
+# between assemblies, 0.7; expansion coefficients of steels +-10 %, 0.1.
 BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
-    Param("f0", "-", 0.30, 0.05, 3.0, "Palmgren bearing friction factor of all pairs"),
-    Param("rotor_share", "-", 0.06, 0.01, 0.5, "rotor share of the motor losses"),
-    Param("h_coolant", "x", 1.0, 0.2, 5.0, "factor on the coolant-jacket film conductances"),
-    Param("h_air", "x", 1.0, 0.2, 5.0, "factor on the housing-to-air film conductances"),
-    Param("h_rotating", "x", 1.0, 0.2, 5.0, "factor on the rotating surfaces' films"),
-    Param("contact", "x", 1.0, 0.2, 5.0, "factor on the contact-link interface conductances"),
+    Param("f0", "-", 0.30, 0.05, 3.0, "Palmgren bearing friction factor of all pairs",
+          prior_sd=0.4),
+    Param("rotor_share", "-", 0.06, 0.01, 0.5, "rotor share of the motor losses", prior_sd=0.4),
+    Param("h_coolant", "x", 1.0, 0.2, 5.0, "factor on the coolant-jacket film conductances",
+          prior_sd=0.25),
+    Param("h_air", "x", 1.0, 0.2, 5.0, "factor on the housing-to-air film conductances",
+          prior_sd=0.35),
+    Param("h_rotating", "x", 1.0, 0.2, 5.0, "factor on the rotating surfaces' films",
+          prior_sd=0.4),
+    Param("contact", "x", 1.0, 0.2, 5.0, "factor on the contact-link interface conductances",
+          prior_sd=0.7),
     Param("alpha_eff", "x", 1.0, 0.5, 2.0, "factor on the expansion coefficients of the "
-          "thermoelastic chain (effective expansion coefficient)"),
+          "thermoelastic chain (effective expansion coefficient)", prior_sd=0.1),
 )}
 
 
@@ -160,6 +175,15 @@ class GreyBox:
     effects: tuple[str, ...] = ()
     lag_channel: str | None = None  # the channel of a sensor_lag effect
     _cache: dict = field(default_factory=dict, repr=False)
+    #: per channel, FEM reference minus this lumped model at the reference point, added to
+    #: every simulation [K; m for P1] (compare.reduction): the lumped model then supplies
+    #: only the change that parameters and effects make, the FEM the trajectory itself
+    discrepancy: dict[str, np.ndarray] | None = field(default=None, repr=False)
+
+    def variant(self, effects: tuple[str, ...], lag_channel: str | None = None) -> GreyBox:
+        """The same model with another effect set (sharing caches and discrepancy)."""
+        return GreyBox(self.spec, self.drive, self.inputs, self.nodes, tuple(effects),
+                       lag_channel, self._cache, self.discrepancy)
 
     def parameters(self) -> dict[str, Param]:
         out = dict(BASE_PARAMS)
@@ -338,6 +362,9 @@ class GreyBox:
                 T_env = np.concatenate([[inp.T_env_K[0]], inp.T_env_K])
                 p1 = p1 + th["k_fix_um_K"] * 1e-6 * (T_env - T_env[0])
             out["P1"] = p1 - p1[0]  # relative to the start, as the bench zeroes P1
+        for c, d in (self.discrepancy or {}).items():
+            if c in out:  # before the lag: a lagging sensor lags the whole signal
+                out[c] = out[c] + d
         if "sensor_lag" in self.effects and self.lag_channel in out and th["tau_s"] > 0:
             out[self.lag_channel] = first_order_lag(inp.grid_s, out[self.lag_channel],
                                                     th["tau_s"])

@@ -423,10 +423,12 @@ class Diagnostics:
                        "channels": {k: c.to_dict() for k, c in self.channels.items()},
                        "unexplained": self.unexplained_description()})
 
-    def unexplained_description(self) -> str:
-        """One sentence: the channel where the residual is largest (max |r| over its scale) and
-        when, and the input (and signature) its residual correlates with most, at what lag."""
-        name = max(self.channels, key=self.scaled_max)
+    def unexplained_description(self, among: Sequence[str] | None = None) -> str:
+        """One sentence: the channel where the residual is largest (max |r| over its scale),
+        among ``among`` (default all channels), and when, and the input (and signature) its
+        residual correlates with most, at what lag."""
+        pool = [c for c in (among or self.channels) if c in self.channels] or list(self.channels)
+        name = max(pool, key=self.scaled_max)
         c = self.channels[name]
         scale = (f", {self.scaled_max(name):.3g} times its scale {self.scales[name]:g}"
                  if name in self.scales else "")

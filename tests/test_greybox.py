@@ -134,7 +134,152 @@ def test_fit_names_the_injected_effect(tmp_path, effect, seed):
         assert named == [] and rep["unexplained"]["unexplained"]
     else:
         assert named == [effect]
-        # RMS within the tolerances (the max of T_stator stays ~2.6 K even on clean data: the
-        # lumped end-winding mass against the FEM at each speed step, docs/fit.md)
+        # RMS within the tolerances (the max is not asserted: with centrifugal_shortening P1
+        # jumps by ~3 µm at a speed step, and the 60 s model grid against the bench's
+        # irregular samples leaves a spike of up to ~2 µm there, docs/fit.md)
         for c, e in rep["error_after"]["validation"].items():
             assert e["rmse"] <= (1.5 if c == "P1" else 1.0), (c, e)
+
+
+# ---------------------------------------------------------------------- FEM anchor and priors
+def test_fem_on_greybox_inputs_is_the_fem_on_the_cycle(setup):
+    """compare.discrepancy drives the FEM with the grey box's per-interval inputs; on a cycle
+    whose steps fall on the grid, with the ambient and coolant held per interval as the grey
+    box holds them, this is spindle.drive's load case, so the two FEM runs agree to round-off
+    (same mesh, same steps, same inputs; only the path that builds them differs)."""
+    from compare.discrepancy import reference_channels
+    from reference import ReferenceModel
+    from spindle.loads import TimeSeries
+
+    spec, cycle, _ = setup
+    grid = np.arange(0.0, 4 * 3600.0 + 1.0, 600.0)  # the first 4 h, steps on the grid
+    inp = inputs_from_cycle(cycle, grid)
+    gb = GreyBox(spec, DRIVES["spl2782"], inp)
+    ours = reference_channels(gb, CHANNELS, level=0)
+    case = cycle_load_case(spec, cycle, DRIVES["spl2782"])
+    starts = tuple(grid[:-1])
+    case = type(case)(case.name, case.speed_rpm,
+                      TimeSeries(starts, tuple(inp.T_env_K), "previous"),
+                      TimeSeries(starts, tuple(inp.T_coolant_K), "previous"),
+                      case.sources, grid[-1])
+    res = ReferenceModel(spec, 0).transient(case, 600.0, T0=float(cycle.T_ambient_K(0.0)))
+    for c in ("T1", "T2", "T_stator"):
+        np.testing.assert_allclose(ours[c], np.interp(grid, res.times_s, res.sensor(c)),
+                                   atol=1e-9)
+    p1 = res.growth_m["P1"] - res.growth_m["P1"][0]
+    np.testing.assert_allclose(ours["P1"], np.interp(grid, res.times_s, p1), atol=1e-15)
+
+
+def test_anchored_greybox_is_the_fem_at_the_spec_values(setup):
+    """With the discrepancy added, the grey box at the spec's values returns the FEM
+    readings; a parameter change moves it by what it moves the lumped model alone."""
+    from compare.discrepancy import fem_discrepancy
+
+    spec, cycle, _ = setup
+    grid = np.arange(0.0, 4 * 3600.0 + 1.0, 600.0)
+    inp = inputs_from_cycle(cycle, grid)
+    gb = GreyBox(spec, DRIVES["spl2782"], inp)
+    d = fem_discrepancy(gb, CHANNELS, level=0)
+    plain = {"spec": gb.simulate({}), "h_air": gb.simulate({"h_air": 2.0})}
+    gb.discrepancy = d.offsets
+    anchored = {"spec": gb.simulate({}), "h_air": gb.simulate({"h_air": 2.0})}
+    from compare.discrepancy import reference_channels
+
+    fem = reference_channels(gb, CHANNELS, level=0)
+    for c in CHANNELS:
+        scale = 1e-6 if c == "P1" else 1.0
+        np.testing.assert_allclose(anchored["spec"][c], fem[c], atol=1e-9 * scale)
+        np.testing.assert_allclose(anchored["h_air"][c] - anchored["spec"][c],
+                                   plain["h_air"][c] - plain["spec"][c], atol=1e-9 * scale)
+    # the lumped model is not the FEM: the offsets are real (T_stator: tenths of a kelvin)
+    assert d.rms["T_stator"] > 0.01
+
+
+def test_prior_penalty_and_plausibility(setup):
+    """The prior terms are (z - z_ref) / sd on the fitted scale; a base parameter beyond the
+    two-sided 1 % point (2.576 sd) is implausible."""
+    spec, _, inp = setup
+    out = GreyBox(spec, DRIVES["spl2782"], inp).simulate({})
+    cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, out), CHANNELS)
+    free_fit = cal.fit(free=["h_coolant"], start={"h_coolant": 1.0})
+    cal.set_prior({"h_coolant": 1.0}, free_fit)
+    fit = cal.fit(free=["h_coolant"], start={"h_coolant": 0.5}, max_nfev=1)
+    z = np.log(fit.theta["h_coolant"]) / 0.25  # BASE_PARAMS prior_sd of h_coolant
+    assert fit.penalty == pytest.approx(0.5 * z * z, rel=1e-12)
+    assert cal.prior_z(fit) == {"h_coolant": pytest.approx(z, rel=1e-12)}
+    fit.theta["h_coolant"] = float(np.exp(-2.6 * 0.25))
+    assert cal.implausible(fit, 0.01) == ["h_coolant"]
+    fit.theta["h_coolant"] = float(np.exp(-2.5 * 0.25))
+    assert cal.implausible(fit, 0.01) == []
+
+
+def test_selection_names_an_effect_the_base_would_hide(setup):
+    """coolant_dynamics (R = 0.008 K/W) in data from the grey box itself: without it the
+    jacket film factor absorbs most of it; with priors around the spec's values the
+    selection names it (needed by the validation error or by plausibility) and the
+    parameters return near the spec."""
+    spec, _, inp = setup
+    truth = GreyBox(spec, DRIVES["spl2782"], inp, effects=("coolant_dynamics",))
+    out = truth.simulate({"R_adv_K_W": 0.008})
+    rng = np.random.default_rng(5)
+    vals = {c: out[c] + rng.normal(0, 0.05e-6 if c == "P1" else 0.05, len(inp.grid_s))
+            for c in CHANNELS}
+    cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
+    free_fit = cal.fit()
+    cal.set_prior({k: p.default for k, p in cal.gb.parameters().items()}, free_fit)
+    base = cal.fit(start=free_fit.theta)
+    sel = forward_selection(cal, ["coolant_dynamics", "fixture_expansion", "windage_loss"],
+                            base=base)
+    assert [s.effect for s in sel.steps] == ["coolant_dynamics"]
+    # the estimate within 25 % of the truth (noise 0.05 K, one seed; seeds 5 and 6 give
+    # 0.0079 and 0.0080 K/W)
+    assert abs(sel.final.theta["R_adv_K_W"] - 0.008) < 0.002
+    assert cal.implausible(sel.final, 0.01) == []
+
+
+def test_anderson_solves_a_slow_linear_fixed_point():
+    """x = A x + b with contraction 0.95 (plain iteration: ~300 steps to 1e-6): Anderson
+    acceleration reaches the exact solution to 1e-8 in a handful of evaluations."""
+    from compare.synth import _anderson
+
+    rng = np.random.default_rng(0)
+    Q = np.linalg.qr(rng.normal(size=(40, 40)))[0]
+    A = Q @ np.diag(np.linspace(0.1, 0.95, 40)) @ Q.T
+    b = rng.normal(size=40)
+    x, iterations, err = _anderson(lambda x: A @ x + b, np.zeros(40), 1e-8, max_iter=60,
+                                   memory=40)
+    np.testing.assert_allclose(x, np.linalg.solve(np.eye(40) - A, b), atol=1e-7)
+    assert iterations < 45 and err < 1e-8
+
+
+def test_synth_coolant_feedback_is_converged(setup):
+    """The injected coolant warming satisfies its own equation: the mean coolant
+    temperature equals (Ts + R g.T) / (1 + R sum g) from the final FEM run, to 1e-3 K (the
+    solver's tolerance is 1e-4 K), with R = 0.008 K/W where a fixed number of plain
+    iterations would leave most of the effect out."""
+    from compare.synth import _fixed_point
+    from reference import ReferenceModel
+    from reference.thermal import TWO_PI
+
+    spec, cycle, _ = setup
+    case = cycle_load_case(spec, cycle, DRIVES["spl2782"])
+    case = type(case)(case.name, case.speed_rpm, case.T_ambient_K, case.T_coolant_K,
+                      case.sources, 4 * 3600.0)
+    ref = ReferenceModel(spec, 0)
+    T0 = float(case.T_ambient_K(0.0))
+    R = 0.008
+    res, Tm = _fixed_point(ref, case, "coolant_dynamics", {"R_adv_K_W": R}, 600.0, T0)
+    th = ref.thermal
+    g = np.sum([TWO_PI * s.h_W_m2K(0.0) * b for s, _, b in th.op.films
+                if s.T_ref == "coolant"], axis=0)
+    from dataclasses import replace
+
+    from spindle.loads import TimeSeries
+
+    t = res.times_s
+    again = th.solve_transient(replace(case, T_coolant_K=TimeSeries(tuple(t), tuple(Tm))),
+                               600.0, 1.0, T0, 0, None, {"g": g})
+    Ts = np.asarray(case.T_coolant_K(t))
+    expected = (Ts + R * again.functionals["g"]) / (1 + R * g.sum())
+    np.testing.assert_allclose(Tm, expected, atol=1e-3)
+    assert np.max(Tm - Ts) > 0.5  # the coolant does warm (K): the test is not vacuous

@@ -264,6 +264,9 @@ def test_diagnose_two_channels_with_an_input():
     text = d.unexplained_description()
     assert text.startswith("The residual is largest in P1")  # 2e-6 / 1.5e-6 > 0.4 / 1
     assert "input speed" in text and "+300 s, the residual following it" in text
+    # asked about T1 only (the channel outside its tolerance), it describes T1's largest value
+    assert d.unexplained_description(among=["T1"]).startswith(
+        "The residual is largest in T1 (max |r| = 0.4")
     out = d.to_dict()
     assert json_types_only(out)
     back = json.loads(json.dumps(out, allow_nan=False))
