@@ -169,10 +169,14 @@ def _cmd_study(args: argparse.Namespace) -> int:
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
+    if args.workers < 1:
+        raise InputError("command line", "--workers", f"{args.workers} is below 1",
+                         "give --workers 1 (serial) or more")
     say = _progress(args.quiet)
     levels, nodes = sorted(set(args.levels)), sorted(set(args.nodes))
     result = run_study(spec, levels, nodes, transient=not args.steady_only, dt_s=args.dt,
-                       threshold=args.threshold / 100.0, progress=say)
+                       threshold=args.threshold / 100.0, progress=say, workers=args.workers,
+                       scheduler=args.scheduler)
     out = Path(args.out or f"results/{spec.name}/study")
     with output_dir(out, inputs=[spec.path]) as tmp:
         result.save(tmp, pictures=not args.no_pictures)
@@ -205,8 +209,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
         if slopes:
             print("  fitted slopes of error against unknowns: "
                   + ", ".join(f"{k} {v:.2f}" for k, v in slopes.items()))
+    for f in result.failures:
+        print(f"  FAILED {f['label']}: {f['error']}")
     print(f"wrote {out}/report.html (and tables, plots, JSON)")
-    return 0
+    return 1 if result.failures else 0
 
 
 def _progress(quiet: bool):
@@ -263,7 +269,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     spec = load_spec(args.spec)
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
-                  progress=_progress(args.quiet))
+                  progress=_progress(args.quiet),
+                  fem_level=None if args.lumped_only else args.fem_level)
     out = Path(args.out or f"results/{spec.name}/fit-{Path(args.run).stem}")
     with output_dir(out, inputs=[spec.path, args.run]) as tmp:
         save_report(rep, tmp, pictures=not args.no_pictures)
@@ -289,6 +296,74 @@ def _cmd_synth(args: argparse.Namespace) -> int:
     print(f"wrote {out} and {out.with_suffix('.truth.json')} (effect {truth['effect']}, "
           f"seed {truth['seed']})")
     return 0
+
+
+def _cmd_measures(args: argparse.Namespace) -> int:
+    from compare.executor import stderr_progress
+    from compare.measures import read_measures, run_measures, shipped_measures
+    from lumped.build import PRESETS
+    from spindle.outputs import output_dir
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)
+    for n in args.lumped_nodes:
+        if n not in PRESETS and not (n.isdigit() and int(n) >= 2):
+            raise InputError("command line", "--nodes", f"'{n}' is not a lumped model",
+                             f"give integers >= 2 or {' / '.join(sorted(PRESETS))}")
+    if args.points is not None and not 2 <= args.points <= 100:
+        raise InputError("command line", "--points", f"{args.points} is outside 2..100",
+                         "give --points 7, for example")
+    if args.workers is not None and args.workers < 1:
+        raise InputError("command line", "--workers", f"{args.workers} is below 1",
+                         "give --workers 1 (serial) or more")
+    mpath = args.measures or shipped_measures(spec.name)
+    if mpath is None:
+        raise InputError(spec.path, "--measures", f"no measures file is shipped for spec "
+                         f"'{spec.name}'", "give --measures FILE (format: docs/measures.md)")
+    mfile = read_measures(mpath, spec, args.points)
+    case = spec.default_load_case()
+    inputs = [spec.path, str(mpath)]
+    if args.case:
+        case = _read_cycle(args.case, spec, case)
+        if Path(args.case).is_file():
+            inputs.append(args.case)
+    elif spec.power_preset:
+        case = _read_cycle("nominal", spec, case)
+    rep = run_measures(spec, mfile, case, args.level, tuple(args.lumped_nodes),
+                       sweeps=not args.no_sweeps, points=args.points or 7,
+                       scheduler=args.scheduler, workers=args.workers,
+                       progress=stderr_progress(not args.quiet))
+    out = Path(args.out or f"results/{spec.name}-measures")
+    with output_dir(out, inputs=inputs) as tmp:
+        files = rep.save(tmp, pictures=not args.no_pictures)
+    b = rep.baseline
+    print(f"{spec.name}: thermal stiffness strategy at '{case.name}' ({rep.speed_rpm:g} rpm, "
+          f"{b.losses_W:.0f} W), FEM level {args.level}; {rep.runtime_s:.1f} s")
+    print(f"  {'model':<16} {'K_alpha mean K/W':>16} {'K_alpha max K/W':>16} {'K_T K/um':>9} "
+          f"{'K_Q W/um':>9}")
+    for ind in [b, *rep.lumped.values()]:
+        print(f"  {ind.model:<16} {ind.K_alpha_mean_K_W:16.3e} {ind.K_alpha_max_K_W:16.3e} "
+              f"{ind.K_T_K_um:9.3f} {ind.K_Q_W_um:9.2f}")
+    print(f"  {'formulas':<16} {1.0 / rep.sum_alpha_A_W_K:16.3e}  (1 / sum(alpha A), "
+          f"sum(alpha A) = {rep.sum_alpha_A_W_K:.4g} W/K)")
+    print(f"  {'paper':<16} {0.00019:16.3e} {'':>16} {0.52:9.3f} {64.53:9.2f}")
+    print(f"  {'measure':<22} {'lambda formula':>14} {'lambda FEM':>10} {'xi formula %':>12} "
+          f"{'xi FEM %':>9} {'xi growth FEM %':>15}")
+    for m in rep.measures:
+        r = m.to_row()
+        print(f"  {r['measure']:<22} {r['lambda_formula']:14.4f} {r['lambda_ref_mean']:10.4f} "
+              f"{r['xi_formula_pct']:12.2f} {r['xi_ref_mean_pct']:9.2f} "
+              f"{r['xi_growth_ref_pct']:15.2f}")
+    for i in rep.inverse:
+        goal = (f"xi {i.target.xi_pct:g} %" if i.target.xi_pct is not None
+                else f"growth {i.target.growth_um:g} um")
+        found = (f"{i.target.vary} = {i.size_ref:.4g} {i.unit} (formulas: {i.size_formula:.4g})"
+                 if i.reached else i.note)
+        print(f"  inverse {i.target.name} ({goal}): {found}")
+    for f in rep.failures:
+        print(f"  FAILED {f['label']}: {f['error']}")
+    print("wrote " + ", ".join(str(out / f.name) for f in files))
+    return 1 if rep.failures else 0
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -357,6 +432,15 @@ def build_parser() -> argparse.ArgumentParser:
                          "(default 1)")
     st.add_argument("--dt", type=float, default=60.0, help="transient time step [s] (default 60)")
     st.add_argument("--steady-only", action="store_true", help="skip the transient comparison")
+    st.add_argument("--scheduler", metavar="ADDRESS",
+                    help="run the independent runs on a Dask cluster (tcp://host:8786, or "
+                         "'local' with --workers processes); needs "
+                         "pip install \"spindle-verify[dask]\" (default: no cluster)")
+    st.add_argument("--workers", type=int, default=1,
+                    help="processes for the independent runs (the lumped models, the FEM "
+                         "transients): 1 runs them serially in this process, so the runtimes "
+                         "in the tables are not disturbed by other runs (default 1); 2 runs "
+                         "the independent runs in a process pool")
     st.add_argument("--out", help="output folder (default results/<spec>/study)")
     st.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
     st.add_argument("--quiet", action="store_true", help="no progress on stderr")
@@ -394,8 +478,16 @@ def build_parser() -> argparse.ArgumentParser:
                     help="fraction of the run used for fitting; the rest validates (0.6)")
     fp.add_argument("--alpha", type=float, default=0.01,
                     help="level of the likelihood-ratio test for adding an effect (0.01)")
-    fp.add_argument("--min-gain", type=float, default=10.0,
-                    help="validation error must fall by at least this [%%] (default 10)")
+    fp.add_argument("--min-gain", type=float, default=25.0,
+                    help="an effect must remove at least this share [%%] of the validation "
+                    "error above the floor (lumped-model error against the FEM and sensor "
+                    "noise) (default 25)")
+    fp.add_argument("--fem-level", type=int, default=0,
+                    help="FEM reference level that anchors the model on the run's inputs "
+                    "(default 0; docs/fit.md)")
+    fp.add_argument("--lumped-only", action="store_true",
+                    help="no FEM anchor and no priors: the lumped model alone, factors from "
+                    "1 (faster; effects the base parameters can imitate go unnamed)")
     fp.add_argument("--nodes", type=int, default=11, help="lumped model nodes (default 11)")
     fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
     fp.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
@@ -411,6 +503,34 @@ def build_parser() -> argparse.ArgumentParser:
     sy.add_argument("--level", type=int, default=1, help="FEM level (default 1)")
     sy.add_argument("--out", required=True, help="the CSV to write")
     sy.set_defaults(func=_cmd_synth)
+
+    me = sub.add_parser("measures", help="thermal stiffness strategy (paper section 4): "
+                        "indicators K_alpha, K_T, K_Q from the FEM and lumped models; design "
+                        "measures by the formulas (eq. 25-30) and by the FEM; inverse problem; "
+                        "Fig. 15 and Fig. 16-style sensitivity sweeps")
+    me.add_argument("spec", metavar="SPEC")
+    me.add_argument("--measures", metavar="FILE",
+                    help="measures TOML (docs/measures.md); default: the spec's shipped file, "
+                         "spindle/data/measures/<spec>.toml (there is one for spl2782)")
+    me.add_argument("--case", metavar="CYCLE",
+                    help="steady load case from a cycle's first step (default: 'nominal' for a "
+                         "spec with a power balance, else the spec's own inputs)")
+    me.add_argument("--level", type=int, default=1, help="FEM mesh level (default 1)")
+    me.add_argument("--nodes", dest="lumped_nodes", nargs="+", default=["paper5", "paper11"],
+                    metavar="N", help="lumped models for the indicators and the measures: "
+                                      "integers >= 2 or paper5 / paper11 (default paper5 paper11)")
+    me.add_argument("--points", type=int,
+                    help="points per sensitivity sweep (default: the file's, else 7)")
+    me.add_argument("--no-sweeps", action="store_true", help="skip the Fig. 16 sweeps")
+    me.add_argument("--scheduler", metavar="ADDRESS",
+                    help="run the cases on a Dask cluster (tcp://host:8786, or 'local'); needs "
+                         "pip install \"spindle-verify[dask]\" (default: a local process pool)")
+    me.add_argument("--workers", type=int,
+                    help="processes (default min(2, CPUs)); 1 runs the cases serially")
+    me.add_argument("--out", help="output folder (default results/<spec>-measures)")
+    me.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
+    me.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    me.set_defaults(func=_cmd_measures)
 
     from compare import calculix, sensors
 

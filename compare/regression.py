@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from spindle.errors import InputError
+from spindle.errors import InputError, SpindleVerifyError
 
 FORMAT = "spindle-verify-baseline/1"
 DEFAULT_TOLERANCES = {"temperature_K": 0.01, "growth_um": 0.01, "gci_pct": 0.01, "level": 0}
@@ -76,6 +76,10 @@ def compute(spec_ref: str, settings: dict, progress: Callable[[str], None] | Non
     study = run_study(spec, settings["levels"], settings["nodes"],
                       transient=settings["transient"], dt_s=settings["dt_s"],
                       threshold=settings["threshold_pct"] / 100.0, progress=progress)
+    if study.failures:  # a partial table would store (or check) figures that are missing
+        raise SpindleVerifyError(f"{spec_ref}: {len(study.failures)} run(s) of the study "
+                                 "failed: " + "; ".join(f"{f['label']}: {f['error']}"
+                                                        for f in study.failures))
     return figures_of(study)
 
 

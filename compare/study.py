@@ -7,6 +7,14 @@
 3. Transient accuracy (spl-16h, or an 8 h warm-up for a spec without a power balance): the
    lumped models and the coarser FEM levels against the FEM ground-truth level.
 4. A self-contained HTML report with the tables, the plots and the revolved 3-D field.
+
+The independent runs of steps 2 and 3 (every lumped model, steady and transient, and the FEM
+transients) go through :func:`compare.executor.run_cases`: serially in this process by
+default (``workers=1``), in a process pool (``workers`` > 1) or on a Dask cluster
+(``scheduler``). A run that fails is listed in :attr:`StudyResult.failures` (label and
+message) and left out of its table; the study goes on. The steady FEM levels of step 1 run
+here, one after the other: their results hold the sparse LU factorisation (which does not
+pickle) and the reference level's result draws the 3-D picture.
 """
 
 from __future__ import annotations
@@ -16,7 +24,7 @@ import html
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from compare.accuracy import (
@@ -30,6 +38,7 @@ from compare.accuracy import (
     lumped_entries,
 )
 from compare.convergence import ConvergenceResult, convergence_study
+from spindle.errors import InputError
 from spindle.loads import LoadCase
 from spindle.spec import Spec
 
@@ -47,6 +56,9 @@ class StudyResult:
     runtime_s: float
     steady_case: LoadCase
     reference_result: object  # the FEM steady result on the reference level (3-D picture)
+    #: runs that failed: {"label", "error", "type"} each; their models are missing from the
+    #: tables (a failed FEM transient on the reference level leaves ``transient`` None)
+    failures: list[dict[str, str]] = field(default_factory=list)
 
     def summary(self) -> dict:
         return {"spec": self.spec.name, "runtime_s": self.runtime_s,
@@ -54,7 +66,8 @@ class StudyResult:
                 "reference_level": self.reference_level,
                 "convergence": self.convergence.summary(),
                 "steady": self.steady.summary(),
-                "transient": self.transient.summary() if self.transient else None}
+                "transient": self.transient.summary() if self.transient else None,
+                "failures": self.failures}
 
     def verdicts(self) -> list[tuple[str, str, str]]:
         """(case, model, verdict) for the lumped presets and eq. 14."""
@@ -136,6 +149,7 @@ class StudyResult:
             f"±{TOL_GROWTH_UM:g} µm.</p>",
             "<h2>Verdicts</h2><table><thead><tr><th>case</th><th>model</th><th>verdict</th>"
             f"</tr></thead><tbody>{verdicts}</tbody></table>",
+            self._failures_html(),
             "<h2>1. Grid convergence of the FEM reference</h2>",
             f"<p>Case: {html.escape(conv.case_name)}; levels {conv.levels} "
             f"({', '.join(f'{d} DOFs' for d in conv.dofs)}). Ground truth: "
@@ -162,6 +176,14 @@ class StudyResult:
             ]
         parts.append("</body></html>\n")
         return "\n".join(parts)
+
+    def _failures_html(self) -> str:
+        if not self.failures:
+            return ""
+        rows = "".join(f"<li>{html.escape(f['label'])}: {html.escape(f['error'])}</li>"
+                       for f in self.failures)
+        return (f"<h2>Failed runs ({len(self.failures)})</h2><p>These runs raised an error; "
+                f"their models are missing from the tables below.</p><ul>{rows}</ul>")
 
 
 def _reference_entry(conv: ConvergenceResult, case: LoadCase) -> tuple[Entry, str]:
@@ -200,11 +222,59 @@ def study_cases(spec: Spec) -> tuple[LoadCase, LoadCase]:
     return base, replace(base, name="warm-up 8 h", duration_s=WARMUP_S)
 
 
+@dataclass(frozen=True)
+class StudyRun:
+    """One independent run of the study: a lumped model (``size`` = node count) or the FEM
+    (``size`` = mesh level), steady (``dt_s`` None) or transient from ``T0``. Picklable (the
+    spec and the load case are dataclasses), so the executor can ship it to a worker."""
+
+    spec: Spec
+    case: LoadCase
+    model: str  # "lumped" or "fem"
+    size: int
+    dt_s: float | None = None
+    T0: float | None = None
+
+    @property
+    def label(self) -> str:
+        what = f"lumped {self.size} nodes" if self.model == "lumped" else f"FEM level {self.size}"
+        return f"{what} {'steady' if self.dt_s is None else 'transient'} ({self.case.name})"
+
+
+def run_study_case(run: StudyRun) -> Entry:
+    """The executor's function: one run, as an :class:`~compare.accuracy.Entry` (module level,
+    so it pickles)."""
+    if run.model == "lumped":
+        return lumped_entries(run.spec, run.case, (run.size,), run.dt_s, run.T0)[0]
+    return fem_entry(run.spec, run.size, run.case, run.dt_s, run.T0)
+
+
 def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[int] = NODES,
               steady_case: LoadCase | None = None, transient_case: LoadCase | None = None,
               transient: bool = True, dt_s: float = 60.0, threshold: float = 0.01,
-              progress: Callable[[str], None] | None = None) -> StudyResult:
-    """Run the whole study (see the module docstring)."""
+              progress: Callable[[str], None] | None = None, workers: int = 1,
+              scheduler: str | None = None) -> StudyResult:
+    """Run the whole study (see the module docstring).
+
+    The steady FEM levels (grid convergence) run first, here. Then every independent run (the
+    lumped models for each node count, steady and transient; the FEM transients on the
+    reference level and the coarser ones) goes through :func:`compare.executor.run_cases`
+    with ``workers`` and ``scheduler``. ``workers=1`` (the default) runs them one after the
+    other in this process: the runtimes in the tables (the cost side of accuracy against
+    cost) are then measured without other runs competing for the cores. ``workers=2`` runs
+    them in a process pool (shorter wall time, same figures, runtimes taken under load);
+    ``scheduler`` sends them to a Dask cluster (``"local"`` or ``tcp://host:port``).
+
+    A run that fails does not stop the study: it is reported through ``progress`` and
+    listed in :attr:`StudyResult.failures`, and its model is missing from the tables.
+    """
+    from compare.executor import _import_dask, run_cases
+
+    if workers < 1:
+        raise InputError("command line", "--workers", f"{workers} is below 1",
+                         "give --workers 1 (serial) or more")
+    if scheduler:
+        _import_dask()  # a missing extra fails now, not after the grid convergence
     t0 = time.perf_counter()
     s_case, t_case = study_cases(spec)
     s_case = steady_case or s_case
@@ -217,29 +287,49 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     fem = []
     for lv, res, rt, n in zip(conv.levels, conv.results, conv.runtime_s, conv.dofs, strict=True):
         fem.append(Entry(f"FEM level {lv}", "fem", n, rt, res.sensors, res.growth_m, level=lv))
-    entries = lumped_entries(spec, s_case, nodes, None, None, progress)
+
+    # the independent runs, longest first (the FEM transients) so that a pool stays busy
+    T0 = float(t_case.T_ambient_K(0.0))
+    coarse_levels = [lv for lv in conv.levels if lv < ref_level]
+    groups: dict[str, list[StudyRun]] = {"steady": [StudyRun(spec, s_case, "lumped", n)
+                                                    for n in nodes]}
+    if transient:
+        groups = {"reference": [StudyRun(spec, t_case, "fem", ref_level, dt_s, T0)],
+                  "coarse": [StudyRun(spec, t_case, "fem", lv, dt_s, T0)
+                             for lv in reversed(coarse_levels)],
+                  "lumped": [StudyRun(spec, t_case, "lumped", n, dt_s, T0) for n in nodes],
+                  **groups}
+    runs = [r for g in groups.values() for r in g]
+    if progress:
+        where = (f"Dask scheduler {scheduler}" if scheduler else
+                 "in this process" if workers == 1 else f"{workers} processes")
+        progress(f"{len(runs)} independent runs ({where})")
+    outcomes = iter(run_cases(run_study_case, runs, scheduler=scheduler, workers=workers,
+                              progress=progress))
+    failures: list[dict[str, str]] = []
+    got: dict[str, list[Entry]] = {}
+    for name, group in groups.items():  # outcomes come in the order of ``runs``
+        got[name] = []
+        for _ in group:
+            o = next(outcomes)
+            if o.ok:
+                got[name].append(o.value)
+            else:
+                failures.append({"label": o.label, "error": o.error or "",
+                                 "type": o.error_type or ""})
+
     eq14 = eq14_entry(spec, s_case)
     steady = AccuracyResult(spec, s_case.name, False, ref_entry, label,
-                            ([eq14] if eq14 else []) + entries + fem)
+                            ([eq14] if eq14 else []) + got["steady"] + fem)
     trans = None
-    if transient:
-        T0 = float(t_case.T_ambient_K(0.0))
-        if progress:
-            progress(f"FEM level {ref_level} transient ({t_case.name}, dt {dt_s:g} s)")
-        ref_tr = fem_entry(spec, ref_level, t_case, dt_s, T0)
-        coarse = []
-        for lv in conv.levels:
-            if lv < ref_level:
-                if progress:
-                    progress(f"FEM level {lv} transient")
-                coarse.append(fem_entry(spec, lv, t_case, dt_s, T0))
-        lumped_tr = lumped_entries(spec, t_case, nodes, dt_s, T0, progress)
+    if got.get("reference"):
         from spindle.loads import time_grid
 
-        trans = AccuracyResult(spec, t_case.name, True, ref_tr,
+        coarse = sorted(got["coarse"], key=lambda e: e.level)  # the table goes coarse first
+        trans = AccuracyResult(spec, t_case.name, True, got["reference"][0],
                                f"FEM level {ref_level}, backward Euler dt {dt_s:g} s",
-                               lumped_tr + coarse, times_s=time_grid(t_case, dt_s))
+                               got["lumped"] + coarse, times_s=time_grid(t_case, dt_s))
     ref_res = conv.results[conv.levels.index(ref_level)]
     return StudyResult(spec, conv, steady, trans, gt, ref_level, time.perf_counter() - t0,
-                       s_case, ref_res)
+                       s_case, ref_res, failures)
 
