@@ -13,14 +13,18 @@
   correlations; a parameter is
   reported not identifiable when its interval spans more than its bounds' range or the
   information matrix is numerically singular.
+- **Priors** (when :meth:`Calibrator.set_prior` is called, as ``fit`` does): each base
+  parameter is Gaussian around the spec's value on its fitted scale, with the width
+  ``Param.prior_sd``; the data term is weighted by n_eff / n against them.
 - **Likelihood** (unknown variance per channel, Gaussian): l = -1/2 sum_c n_c ln(RSS_c / n_c).
-  An effect is accepted by a likelihood-ratio test against the model without it:
-  LR = 2 (l1 - l0) n_eff / n ~ chi2(k) (k its parameters; the autocorrelation correction
-  keeps serially correlated residuals from passing as independent evidence), at level
-  ``alpha`` (default 1 %), and only if the validation error falls by at least ``min_gain``
-  (default 10 %, a practical-significance threshold: the base lumped model always leaves some
-  model-form residual that a flexible candidate can nibble at) (Bacher and Madsen 2011,
-  forward selection).
+  An effect qualifies by a likelihood-ratio test against the model without it:
+  LR = 2 [(l1 - l0) n_eff / n - (penalty1 - penalty0)] ~ chi2(k) (k its parameters; the
+  autocorrelation correction keeps serially correlated residuals from passing as independent
+  evidence), at level ``alpha`` (default 1 %), and only if it is needed: it removes at least
+  ``min_gain`` (default 25 %) of the validation error above the noise floor, or without it a
+  base parameter lies beyond the (1 - alpha) prior range and with it all lie within the
+  central 95 %. Of the qualifying candidates the best likelihood is accepted (Bacher and
+  Madsen 2011, forward selection, with these two guards; docs/fit.md says why).
 """
 
 from __future__ import annotations
@@ -138,25 +142,23 @@ class Calibrator:
     max_nfev: int = 60
     progress: Callable[[str], None] | None = None
     evaluations: int = field(default=0)
-    #: prior centres (compare.reduction's theta_ref); the widths are Param.prior_sd
+    #: prior centres (the spec's values, compare.discrepancy); the widths are Param.prior_sd
     prior: dict[str, float] | None = None
     #: sqrt(s^2 n / n_eff) of the data term, so that data and prior weigh as a posterior
     prior_scale: float = 1.0
-    #: per channel, the validation RMS [tolerance units] no effect can remove: the lumped
-    #: model's own error against the FEM on these inputs and the sensor noise (set_floor)
+    #: per channel, the validation RMS [tolerance units] no effect can remove: the sensor
+    #: noise (set_floor); None counts the whole validation error
     floor: dict[str, float] | None = None
 
-    def set_floor(self, model_form_rms: dict[str, float], fit: Fit) -> None:
-        """The floor from the lumped-versus-FEM RMS [K; m] and the noise of ``fit``'s
-        residual, estimated from its second differences (var(d2 r) = 6 sigma^2 for white
-        noise; the smooth model-form part hardly enters them)."""
+    def set_floor(self, fit: Fit) -> None:
+        """The floor from the noise of ``fit``'s residual, estimated from its second
+        differences (var(d2 r) = 6 sigma^2 for white noise; the smooth model-form part hardly
+        enters them)."""
         floor = {}
         for c in self.channels:
             m = self.measured.mask(c, "all")
             r = (self.measured.values[c][m] - fit.model[c][m]) / TOLERANCE[c]
-            noise2 = float(np.var(np.diff(r, 2)) / 6.0) if len(r) > 3 else 0.0
-            floor[c] = float(np.sqrt((model_form_rms.get(c, 0.0) / TOLERANCE[c]) ** 2
-                                     + noise2))
+            floor[c] = float(np.sqrt(np.var(np.diff(r, 2)) / 6.0)) if len(r) > 3 else 0.0
         self.floor = floor
 
     def prior_z(self, fit: Fit) -> dict[str, float]:
@@ -421,8 +423,8 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
         if not screens:
             break
         # the screen is short: refit the best few jointly; an effect qualifies when its
-        # likelihood-ratio test is significant and it removes at least min_gain of the
-        # validation error above the floor; the qualifying one with the best likelihood wins
+        # likelihood-ratio test is significant and it is needed (below); the qualifying one
+        # with the best likelihood wins
         def gain(f: Fit, cur: Fit = current) -> float:
             return log_posterior_gain(cur, f)
 

@@ -2,11 +2,13 @@
 
 1. Ingest the run (spindle.bench), map its channels to the spec's sensors, build the inputs
    through the power balance on a 60 s grid.
-2. Calibrate the declared parameters on the fit window (default the first 60 %), validate on
-   the rest (compare.fit).
+2. Solve the FEM reference on the run's inputs and anchor the grey box to it
+   (compare.discrepancy); calibrate the declared parameters, with priors around the spec's
+   values, on the fit window (default the first 60 %), validate on the rest (compare.fit).
 3. Diagnose the residual (compare.residuals), select effects forward (likelihood-ratio test at
-   ``alpha``, validation must improve), and say ``unexplained`` when the final residual is still
-   structured beyond the tolerances and no candidate explains it.
+   ``alpha``, and needed by the validation error or by plausibility), and say ``unexplained``
+   when the final residual is still structured and material in a channel and no candidate
+   explains it.
 4. Write ``report.json`` (the stable contract of issue 6) and ``report.html``.
 """
 
@@ -210,7 +212,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         say("calibrating the base model")
         free_fit = cal.fit()  # without priors: it sets the data's weight against them
         cal.set_prior(anchor.theta_ref, free_fit)
-        cal.set_floor({}, free_fit)
+        cal.set_floor(free_fit)
         base = cal.fit(start=free_fit.theta)
     sel = forward_selection(cal, candidates, alpha, base=base, min_gain=min_gain)
     final = sel.final
