@@ -266,11 +266,15 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
 
+    if args.model == "fem" and args.lumped_only:
+        raise InputError("command line", "--model", "--model fem calibrates on the FEM "
+                         "reference, --lumped-only switches the FEM off",
+                         "drop one of the two options")
     spec = load_spec(args.spec)
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
                   progress=_progress(args.quiet),
-                  fem_level=None if args.lumped_only else args.fem_level)
+                  fem_level=None if args.lumped_only else args.fem_level, model=args.model)
     out = Path(args.out or f"results/{spec.name}/fit-{Path(args.run).stem}")
     with output_dir(out, inputs=[spec.path, args.run]) as tmp:
         save_report(rep, tmp, pictures=not args.no_pictures)
@@ -488,6 +492,11 @@ def build_parser() -> argparse.ArgumentParser:
     fp.add_argument("--lumped-only", action="store_true",
                     help="no FEM anchor and no priors: the lumped model alone, factors from "
                     "1 (faster; effects the base parameters can imitate go unnamed)")
+    fp.add_argument("--model", choices=("lumped", "fem"), default="lumped",
+                    help="model the base parameters are calibrated on (default lumped: the "
+                    "lumped model anchored to the FEM at the spec's values; fast). fem: "
+                    "calibrate the base parameters on the FEM reference itself (minutes), "
+                    "then select effects on the lumped model anchored there")
     fp.add_argument("--nodes", type=int, default=11, help="lumped model nodes (default 11)")
     fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
     fp.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
