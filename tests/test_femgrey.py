@@ -262,7 +262,7 @@ def test_fem_model_and_lumped_only_contradict(tmp_path, capsys):
 @pytest.mark.slow
 def test_fit_model_fem_names_the_injected_effect(tmp_path):
     """The command line on a 16 h synthetic run (FEM level 0) with fixture_expansion, --model
-    fem (slow: a few minutes; test_fit_model_fem_end_to_end covers the same path on 6 h):
+    fem (slow: about 5 min; test_fit_model_fem_end_to_end covers the same path on 6 h):
     the effect is named and the report records the FEM calibration."""
     run = tmp_path / "run.csv"
     assert main(["synth", "--effect", "fixture_expansion", "--seed", "2", "--level", "0",
