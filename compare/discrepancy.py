@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from compare.greybox import BASE_PARAMS, GreyBox, Inputs
+from compare.greybox import BASE_PARAMS, GreyBox, Inputs, default_theta
 from spindle.loads import LoadCase, TimeSeries
 from spindle.spec import Spec
 
@@ -62,24 +62,38 @@ def load_case_from_inputs(spec: Spec, inputs: Inputs, sources_W: dict[str, np.nd
                     float(inputs.grid_s[-1] - inputs.grid_s[0]))
 
 
+def fem_readings(ref, spec: Spec, inputs: Inputs, sources_W: dict[str, np.ndarray],
+                 channels: tuple[str, ...] | list[str]) -> dict[str, np.ndarray]:
+    """The readings of the FEM reference ``ref`` (a ReferenceModel) at the grid points [K; m
+    for P1, zeroed at the start], driven by ``inputs`` and the heat ``sources_W`` [W per
+    interval]; channels the model does not read are left out."""
+    case = load_case_from_inputs(spec, inputs, sources_W)
+    t_rel = inputs.grid_s - inputs.grid_s[0]
+    T0 = inputs.T_start_K if inputs.T_start_K is not None else float(inputs.T_env_K[0])
+    dt = float(np.median(np.diff(t_rel)))
+    res = ref.transient(case, dt, T0=T0)
+    out = {}
+    for c in channels:
+        if c == "P1":
+            if "P1" not in res.growth_m:
+                continue
+            y = res.growth_m["P1"] - res.growth_m["P1"][0]
+        elif c in res.names:
+            y = res.sensor(c)
+        else:
+            continue
+        out[c] = np.interp(t_rel, res.times_s, y)
+    return out
+
+
 def reference_channels(gb: GreyBox, channels: tuple[str, ...] | list[str], level: int = 0
                        ) -> dict[str, np.ndarray]:
     """The FEM reference's readings at the grid points [K; m for P1, zeroed at the start],
     driven by the grey box's inputs and its heat sources at the spec's parameter values."""
     from reference import ReferenceModel
 
-    inp = gb.inputs
     src = gb._sources(BASE_PARAMS["f0"].default, BASE_PARAMS["rotor_share"].default)
-    case = load_case_from_inputs(gb.spec, inp, src)
-    t_rel = inp.grid_s - inp.grid_s[0]
-    T0 = inp.T_start_K if inp.T_start_K is not None else float(inp.T_env_K[0])
-    dt = float(np.median(np.diff(t_rel)))
-    res = ReferenceModel(gb.spec, level).transient(case, dt, T0=T0)
-    out = {}
-    for c in channels:
-        y = res.growth_m[c] - res.growth_m[c][0] if c == "P1" else res.sensor(c)
-        out[c] = np.interp(t_rel, res.times_s, y)
-    return out
+    return fem_readings(ReferenceModel(gb.spec, level), gb.spec, gb.inputs, src, channels)
 
 
 def fem_discrepancy(gb: GreyBox, channels: tuple[str, ...] | list[str], level: int = 0
@@ -87,7 +101,7 @@ def fem_discrepancy(gb: GreyBox, channels: tuple[str, ...] | list[str], level: i
     """FEM minus lumped (``gb`` without effects, at the spec's values) on ``gb``'s inputs."""
     t0 = time.perf_counter()
     fem = reference_channels(gb, channels, level)
-    theta = {k: p.default for k, p in BASE_PARAMS.items()}
+    theta = default_theta(BASE_PARAMS)
     plain = GreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, _cache=gb._cache)
     lumped = plain.simulate(theta)
     offsets = {c: fem[c] - lumped[c] for c in channels}

@@ -37,18 +37,14 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from compare.greybox import BASE_PARAMS, GreyBox, Inputs, Param, _film_groups
+from compare.paper import _scaled
 from spindle.drive import Drive
-from spindle.loads import SpeedTable
 from spindle.spec import Spec
 
 #: parameters that enter the thermal solve (alpha_eff only scales P1 afterwards)
 _THERMAL = tuple(k for k in BASE_PARAMS if k != "alpha_eff")
 #: FEM results kept (a Jacobian of the six thermal parameters, its centre and a step)
 _KEEP = 10
-
-
-def _scaled_table(table: SpeedTable, factor: float) -> SpeedTable:
-    return SpeedTable(table.speed_rpm, tuple(v * factor for v in table.values))
 
 
 @dataclass
@@ -118,7 +114,7 @@ class FemGreyBox:
             # a factor of exactly 1 keeps the spec's own object: the default point is then the
             # FEM reference of compare.discrepancy bit for bit
             op.films = [(s if g is None or f[g] == 1.0 else
-                         replace(s, h_W_m2K=_scaled_table(s.h_W_m2K, f[g])), R, b)
+                         replace(s, h_W_m2K=_scaled(s.h_W_m2K, f[g])), R, b)
                         for s, R, b, g in films]
             op.contacts = [(lk if f["contact"] == 1.0 else
                             replace(lk, h_W_m2K=lk.h_W_m2K * f["contact"]), C)
@@ -135,31 +131,15 @@ class FemGreyBox:
         if hit is not None:
             self._cache[key] = self._cache.pop(key)  # most recently used last
             return hit
-        from compare.discrepancy import load_case_from_inputs
+        from compare.discrepancy import fem_readings
 
         t0 = time.perf_counter()
         ref = self._apply(th)
-        inp = self.inputs
-        lumped = GreyBox(self.spec, self.drive, inp, self.nodes, _cache=self._cache)
+        lumped = GreyBox(self.spec, self.drive, self.inputs, self.nodes, _cache=self._cache)
         src = lumped._sources(float(th["f0"]), float(th["rotor_share"]))
-        case = load_case_from_inputs(self.spec, inp, src)
-        # the same time origin, start temperature and step as compare.discrepancy's
-        # reference_channels, so the default point is that run exactly
-        t_rel = inp.grid_s - inp.grid_s[0]
-        T0 = inp.T_start_K if inp.T_start_K is not None else float(inp.T_env_K[0])
-        dt = float(np.median(np.diff(t_rel)))
-        res = ref.transient(case, dt, T0=T0)
-        out = {}
-        for c in ("T1", "T2", "T_stator", "P1"):
-            if c == "P1":
-                if "P1" not in res.growth_m:
-                    continue
-                y = res.growth_m["P1"] - res.growth_m["P1"][0]
-            else:
-                if c not in res.names:
-                    continue
-                y = res.sensor(c)
-            out[c] = np.interp(t_rel, res.times_s, y)
+        # the same read-out as compare.discrepancy's reference_channels, so the default
+        # point is that run exactly
+        out = fem_readings(ref, self.spec, self.inputs, src, ("T1", "T2", "T_stator", "P1"))
         runs = [k for k in self._cache if isinstance(k, tuple) and k[:1] == ("fem",)]
         for k in runs[:max(len(runs) - _KEEP + 1, 0)]:
             del self._cache[k]

@@ -39,7 +39,7 @@ from compare.fit import (
     parameters_table,
     resample,
 )
-from compare.greybox import BASE_PARAMS, EFFECTS, GreyBox, Inputs
+from compare.greybox import BASE_PARAMS, EFFECTS, GreyBox, Inputs, default_theta
 from spindle.bench import BenchRun, bench_grid, cell_means, check_against_spec, held, read_bench
 from spindle.drive import drive_for
 from spindle.errors import InputError
@@ -132,7 +132,7 @@ class FitReport:
             "candidates_tried": sel.tried,
             "fem_anchor": None if self.anchor is None else {
                 "fem_level": self.anchor.fem_level,
-                "prior_centre": {k: p.default for k, p in BASE_PARAMS.items()},
+                "prior_centre": default_theta(BASE_PARAMS),
                 # where FEM = anchored lumped: the spec's values, or with --model fem the
                 # FEM-calibrated base parameters
                 "anchored_at": self.anchor.theta_ref,
@@ -311,7 +311,7 @@ def _calibrate_on_fem(cal: Calibrator, fem_level: int, say: Callable[[str], None
     t0 = time.perf_counter()
     gb = cal.gb
     channels = list(cal.channels)
-    theta_spec = {k: p.default for k, p in BASE_PARAMS.items()}
+    theta_spec = default_theta(BASE_PARAMS)
     plain = GreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, _cache=gb._cache)
     say(f"building the FEM reference (level {fem_level}) for the calibration")
     fem = FemGreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, fem_level,
