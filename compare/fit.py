@@ -161,6 +161,19 @@ class Calibrator:
             floor[c] = float(np.sqrt(np.var(np.diff(r, 2)) / 6.0)) if len(r) > 3 else 0.0
         self.floor = floor
 
+    def fit_with_prior(self, centre: dict[str, float], start: dict[str, float] | None = None,
+                       free_nfev: int | None = None,
+                       say: Callable[[str], None] | None = None) -> tuple[Fit, Fit]:
+        """(fit without priors, fit with priors around ``centre``): the first sets the data's
+        weight against the priors and the noise floor (set_prior, set_floor), the second
+        starts where it ended."""
+        free_fit = self.fit(start=start, max_nfev=free_nfev)
+        self.set_prior(centre, free_fit)
+        self.set_floor(free_fit)
+        if say is not None:
+            say("calibrating with priors")
+        return free_fit, self.fit(start=free_fit.theta)
+
     def prior_z(self, fit: Fit) -> dict[str, float]:
         """Each base parameter's distance from its prior centre in prior standard deviations
         (empty without priors)."""

@@ -233,10 +233,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         anchor = fem_discrepancy(cal.gb, channels, fem_level)
         cal.gb.discrepancy = anchor.offsets
         say("calibrating the base model")
-        free_fit = cal.fit()  # without priors: it sets the data's weight against them
-        cal.set_prior(anchor.theta_ref, free_fit)
-        cal.set_floor(free_fit)
-        base = cal.fit(start=free_fit.theta)
+        _, base = cal.fit_with_prior(anchor.theta_ref)
     sel = forward_selection(cal, candidates, alpha, base=base, min_gain=min_gain)
     final = sel.final
     ins = {"speed": np.concatenate([[inputs.speed_rpm[0]], inputs.speed_rpm]),
@@ -326,11 +323,8 @@ def _calibrate_on_fem(cal: Calibrator, fem_level: int, say: Callable[[str], None
     fcal = Calibrator(fem, cal.measured, channels, max_nfev=FEM_MAX_NFEV, progress=say)
     say("calibrating the base parameters on the FEM reference, without priors")
     # as in the lumped path: the fit without priors sets the data's weight against them
-    free_fit = fcal.fit(start=start.theta, max_nfev=FEM_FREE_NFEV)
-    fcal.set_prior(theta_spec, free_fit)
-    fcal.set_floor(free_fit)
-    say("calibrating the base parameters on the FEM reference, with priors")
-    base = fcal.fit(start=free_fit.theta)
+    free_fit, base = fcal.fit_with_prior(theta_spec, start=start.theta,
+                                         free_nfev=FEM_FREE_NFEV, say=say)
     theta_cal = {k: base.theta[k] for k in BASE_PARAMS}
     # re-anchor: the lumped model plus [FEM - lumped] at the calibrated point is the FEM
     # there; the selection of effects runs on it, from the calibrated point
