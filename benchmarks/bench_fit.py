@@ -25,9 +25,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--keep", help="keep the run and the report in this folder")
     args = ap.parse_args(argv)
 
-    from compare.fitrun import greybox_inputs, run_fit, save_report
-    from compare.greybox import GreyBox
-    from compare.synth import synth
+    from compare.fit.greybox import GreyBox
+    from compare.fit.run import greybox_inputs, run_fit, save_report
+    from compare.fit.synth import synth
     from spindle.bench import read_bench
     from spindle.drive import drive_for
     from spindle.spec import load_spec

@@ -1,11 +1,11 @@
-"""Grid convergence analysis (compare/convergence.py): the GCI arithmetic on series with a
+"""Grid convergence analysis (compare/verify/convergence.py): the GCI arithmetic on series with a
 known exact value and order, the flags, and a study of the FEM reference."""
 
 import math
 
 import pytest
 
-from compare.convergence import GCI, ConvergenceResult, convergence_study
+from compare.verify.convergence import GCI, ConvergenceResult, convergence_study
 from spindle.spec import load_spec
 
 

@@ -26,7 +26,7 @@ if shutil.which("ccx") is None:  # the importorskip of an executable
     pytest.skip("CalculiX (ccx) is not installed; apt-get install calculix-ccx",
                 allow_module_level=True)
 
-from compare.calculix import (  # noqa: E402 - after the skip
+from compare.crosscheck.calculix import (  # noqa: E402 - after the skip
     CCX_MISSING,
     crosscheck,
     read_frd,

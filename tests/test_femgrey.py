@@ -1,5 +1,5 @@
-"""The FEM grey box (compare/femgrey.py) and ``fit --model fem`` (compare/fitrun.py): the FEM
-with the base parameters is the FEM reference of compare.discrepancy at the spec's values and
+"""The FEM grey box (compare/fit/femgrey.py) and ``fit --model fem`` (compare/fit/run.py): the FEM
+with the base parameters is the FEM reference of compare.fit.discrepancy at the spec's values and
 a fresh FEM of the scaled spec elsewhere; a calibration on it recovers known factors; the
 selection then runs on the lumped model anchored at the calibrated point."""
 
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from compare.cli import main
-from compare.femgrey import FemGreyBox
-from compare.fit import Calibrator, Measured
-from compare.greybox import BASE_PARAMS, GreyBox, _film_groups, _is_contact_link, inputs_from_cycle
+from compare.fit.calibrate import Calibrator, Measured
+from compare.fit.femgrey import FemGreyBox
+from compare.fit.greybox import BASE_PARAMS, GreyBox, _film_groups, _is_contact_link, inputs_from_cycle
 from spindle.cycles import load_cycle
 from spindle.drive import DRIVES
 from spindle.loads import SpeedTable
@@ -52,9 +52,9 @@ def _close(a: dict, b: dict, atol_K: float = 1e-9, atol_m: float = 1e-15):
 
 
 def test_default_point_is_the_fem_reference(setup):
-    """At the spec's values the FEM grey box is compare.discrepancy's reference run (the same
+    """At the spec's values the FEM grey box is compare.fit.discrepancy's reference run (the same
     model, load case, start temperature and step: equal to round-off, in fact bit for bit)."""
-    from compare.discrepancy import reference_channels
+    from compare.fit.discrepancy import reference_channels
 
     spec, inp, fem = setup
     _close(fem.simulate({}), reference_channels(GreyBox(spec, DRIVE, inp), CHANNELS, 0),
@@ -66,7 +66,7 @@ def test_a_factor_is_a_fresh_fem_of_the_scaled_spec(setup, name):
     """A film or contact factor swapped into the assembled operator equals a new
     ReferenceModel meshed and assembled on the spec with that coefficient scaled; and the
     operator is restored afterwards (the next default-point run is the reference again)."""
-    from compare.discrepancy import reference_channels
+    from compare.fit.discrepancy import reference_channels
 
     spec, inp, fem = setup
     ours = fem.simulate({name: 1.7})
@@ -84,7 +84,7 @@ def test_sources_and_expansion(setup):
     """f0 and rotor_share enter through the grey box's own power balance; alpha_eff scales P1
     alone, exactly as scaling every material's expansion coefficient scales the FEM's growth
     (linear thermoelasticity, thermal strain the only load); its Jacobian column runs no FEM."""
-    from compare.discrepancy import load_case_from_inputs
+    from compare.fit.discrepancy import load_case_from_inputs
     from reference import ReferenceModel
 
     spec, inp, fem = setup
@@ -170,7 +170,7 @@ def test_calibration_on_fem_data_recovers_the_factors(setup):
 def _bench_csv(path, spec, hours: float, truth: dict, seed: int) -> None:
     """A bench export sampled every 60 s from the FEM grey box with ``truth``, on the inputs
     fit itself builds from it (greybox_inputs on a 600 s grid), with small noise."""
-    from compare.fitrun import greybox_inputs
+    from compare.fit.run import greybox_inputs
     from spindle.bench import read_bench
 
     cycle = load_cycle("spl-16h")
@@ -209,7 +209,7 @@ def test_fit_model_fem_end_to_end(setup, tmp_path):
     (600 s grid): the base parameters are calibrated on the FEM (parameters_before), the
     lumped grey box is anchored there (anchored lumped = FEM at the calibrated point), and the
     report says so. The lumped path on the same data is further from the truth."""
-    from compare.fitrun import report_summary_text, run_fit, save_report
+    from compare.fit.run import report_summary_text, run_fit, save_report
 
     spec = setup[0]
     run = tmp_path / "run.csv"
@@ -246,7 +246,7 @@ def test_fit_model_fem_end_to_end(setup, tmp_path):
 def test_fem_model_and_lumped_only_contradict(tmp_path, capsys):
     """--model fem --lumped-only: one error line, exit status 2 (before the run is read);
     run_fit says the same."""
-    from compare.fitrun import run_fit
+    from compare.fit.run import run_fit
     from spindle.errors import InputError
 
     assert main(["fit", str(tmp_path / "missing.csv"), "--model", "fem", "--lumped-only",

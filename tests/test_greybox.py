@@ -1,5 +1,5 @@
-"""The grey-box model and the fit loop (compare/greybox.py, compare/fit.py, compare/fitrun.py,
-compare/synth.py): nesting of every effect, agreement with the lumped model, calibration
+"""The grey-box model and the fit loop (compare/fit/greybox.py, compare/fit/calibrate.py, compare/fit/run.py,
+compare/fit/synth.py): nesting of every effect, agreement with the lumped model, calibration
 intervals, and forward selection on data with a known truth."""
 
 import json
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from compare.cli import main
-from compare.fit import Calibrator, Measured, forward_selection, resample
-from compare.greybox import EFFECTS, GreyBox, inputs_from_cycle
+from compare.fit.calibrate import Calibrator, Measured, forward_selection, resample
+from compare.fit.greybox import EFFECTS, GreyBox, inputs_from_cycle
 from lumped import build
 from spindle.cycles import load_cycle
 from spindle.drive import DRIVES, cycle_load_case
@@ -143,11 +143,11 @@ def test_fit_names_the_injected_effect(tmp_path, effect, seed):
 
 # ---------------------------------------------------------------------- FEM anchor and priors
 def test_fem_on_greybox_inputs_is_the_fem_on_the_cycle(setup):
-    """compare.discrepancy drives the FEM with the grey box's per-interval inputs; on a cycle
+    """compare.fit.discrepancy drives the FEM with the grey box's per-interval inputs; on a cycle
     whose steps fall on the grid, with the ambient and coolant held per interval as the grey
     box holds them, this is spindle.drive's load case, so the two FEM runs agree to round-off
     (same mesh, same steps, same inputs; only the path that builds them differs)."""
-    from compare.discrepancy import reference_channels
+    from compare.fit.discrepancy import reference_channels
     from reference import ReferenceModel
     from spindle.loads import TimeSeries
 
@@ -173,7 +173,7 @@ def test_fem_on_greybox_inputs_is_the_fem_on_the_cycle(setup):
 def test_anchored_greybox_is_the_fem_at_the_spec_values(setup):
     """With the discrepancy added, the grey box at the spec's values returns the FEM
     readings; a parameter change moves it by what it moves the lumped model alone."""
-    from compare.discrepancy import fem_discrepancy
+    from compare.fit.discrepancy import fem_discrepancy
 
     spec, cycle, _ = setup
     grid = np.arange(0.0, 4 * 3600.0 + 1.0, 600.0)
@@ -183,7 +183,7 @@ def test_anchored_greybox_is_the_fem_at_the_spec_values(setup):
     plain = {"spec": gb.simulate({}), "h_air": gb.simulate({"h_air": 2.0})}
     gb.discrepancy = d.offsets
     anchored = {"spec": gb.simulate({}), "h_air": gb.simulate({"h_air": 2.0})}
-    from compare.discrepancy import reference_channels
+    from compare.fit.discrepancy import reference_channels
 
     fem = reference_channels(gb, CHANNELS, level=0)
     for c in CHANNELS:
@@ -240,7 +240,7 @@ def test_selection_names_an_effect_the_base_would_hide(setup):
 def test_anderson_solves_a_slow_linear_fixed_point():
     """x = A x + b with contraction 0.95 (plain iteration: ~300 steps to 1e-6): Anderson
     acceleration reaches the exact solution to 1e-8 in a handful of evaluations."""
-    from compare.synth import _anderson
+    from compare.fit.synth import _anderson
 
     rng = np.random.default_rng(0)
     Q = np.linalg.qr(rng.normal(size=(40, 40)))[0]
@@ -257,7 +257,7 @@ def test_synth_coolant_feedback_is_converged(setup):
     temperature equals (Ts + R g.T) / (1 + R sum g) from the final FEM run, to 1e-3 K (the
     solver's tolerance is 1e-4 K), with R = 0.008 K/W where a fixed number of plain
     iterations would leave most of the effect out."""
-    from compare.synth import _fixed_point
+    from compare.fit.synth import _fixed_point
     from reference import ReferenceModel
     from reference.thermal import TWO_PI
 

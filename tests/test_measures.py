@@ -1,4 +1,4 @@
-"""Design measures of paper section 4 (compare/measures.py): the simplified formulas
+"""Design measures of paper section 4 (compare/design/measures.py): the simplified formulas
 (eq. 22-32) against hand values, the FEM reference where their assumptions hold exactly and
 where they do not, the inverse problem, the sweeps, the measures file and the command.
 
@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 
 from compare import cli
-from compare.measures import (
+from compare.design.measures import (
     InverseTarget,
     Measure,
     MeasureCase,
@@ -441,7 +441,7 @@ def test_command_input_errors_exit_2(tmp_path, capsys):
 
 
 def test_report_tables_as_rows_and_dataframes(body):
-    from compare.measures import MeasureFile, run_measures
+    from compare.design.measures import MeasureFile, run_measures
 
     mf = read_measures(DATA / "uniform_body_measures.toml", body)
     rep = run_measures(body, MeasureFile(mf.path, mf.measures[:1]), body.default_load_case(),

@@ -1,4 +1,4 @@
-"""The paper's figures (compare/paper.py, docs/paper.md).
+"""The paper's figures (compare/design/paper.py, docs/paper.md).
 
 The spl-16h peaks T1 = 32.4 degC and P1 = 6.5 µm and the nominal losses 5146 W are
 CALIBRATION TARGETS, not predictions: the shipped bearing friction factor f0 and the film
@@ -12,7 +12,7 @@ that each factor acts on the figure it should.
 
 import pytest
 
-from compare.paper import TARGETS, PaperStudy
+from compare.design.paper import TARGETS, PaperStudy
 
 
 def test_calibration_targets_within_five_percent():

@@ -1,12 +1,12 @@
-"""Regression verification (compare/regression.py, spindle-verify baseline / check) and the
-pytest helper (compare/pytest_plugin.py), used here on the shipped specs."""
+"""Regression verification (compare/verify/regression.py, spindle-verify baseline / check) and the
+pytest helper (compare/verify/pytest_plugin.py), used here on the shipped specs."""
 
 import json
 
 import pytest
 
 from compare.cli import main
-from compare.regression import Change, check, read_baseline
+from compare.verify.regression import Change, check, read_baseline
 from spindle.errors import InputError
 
 

@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from compare.accuracy import AccuracyResult, fem_entry, lumped_entries
-from compare.sensors import (
+from compare.verify.accuracy import AccuracyResult, fem_entry, lumped_entries
+from compare.verify.sensors import (
     Snapshots,
     Target,
     choose_nodes,
@@ -178,7 +178,7 @@ def test_ranking_outputs(fin_rankings, tmp_path):
 def test_spl2782_ranking_with_p1():
     """Level 0, 10 min steps over spl-16h: both methods give k distinct spec sensors, and
     the snapshot P1 equals the reference model's own transient P1."""
-    from compare.study import study_cases
+    from compare.verify.study import study_cases
     from reference import ReferenceModel
 
     spec = load_spec("spl2782")

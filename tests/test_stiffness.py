@@ -1,4 +1,4 @@
-"""Section-4 indicators (compare/stiffness.py): heat stiffness K_alpha, temperature stiffness
+"""Section-4 indicators (compare/design/stiffness.py): heat stiffness K_alpha, temperature stiffness
 K_T and thermal stiffness K_Q from the FEM reference and the lumped models.
 
 Expected values are computed by hand in the tests. tests/data/uniform_body.toml is a solid
@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from compare.paper import PaperStudy
-from compare.stiffness import (
+from compare.design.paper import PaperStudy
+from compare.design.stiffness import (
     PAPER,
     growth_reading,
     indicators,
@@ -120,13 +120,13 @@ def test_growth_reading_prefers_the_tool_tip():
 
 @pytest.fixture(scope="module")
 def spl_nominal():
-    study = PaperStudy(level=0)  # the paper's readings on the same FEM (compare/paper.py)
+    study = PaperStudy(level=0)  # the paper's readings on the same FEM (compare/design/paper.py)
     return study
 
 
 def test_spl2782_indicators_read_as_the_paper_figures(spl_nominal):
     """K_T and K_Q of the FEM are the shaft rise and the losses over the TCP growth, read
-    exactly as compare.paper reads the paper's 41.6 K, 5146 W and 79.7 µm."""
+    exactly as compare.design.paper reads the paper's 41.6 K, 5146 W and 79.7 µm."""
     from spindle.drive import cycle_load_case
 
     study = spl_nominal

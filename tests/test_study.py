@@ -1,4 +1,4 @@
-"""The accuracy harness and the verification study (compare/accuracy.py, compare/study.py,
+"""The accuracy harness and the verification study (compare/verify/accuracy.py, compare/verify/study.py,
 spindle-verify study) on fin-shaft, where eq. 14 is exact up to its Biot number."""
 
 import json
@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from compare.accuracy import AccuracyResult, Entry
 from compare.cli import main
-from compare.study import run_study
+from compare.verify.accuracy import AccuracyResult, Entry
+from compare.verify.study import run_study
 from spindle.spec import load_spec
 
 

@@ -1,4 +1,4 @@
-"""The study's independent runs go through the executor (compare/study.py, compare/executor.py):
+"""The study's independent runs go through the executor (compare/verify/study.py, compare/executor.py):
 the same figures serially and in a process pool, and a failed run is reported, not raised."""
 
 from __future__ import annotations
@@ -8,9 +8,9 @@ import json
 import numpy as np
 import pytest
 
-import compare.study
+import compare.verify.study
 from compare.cli import main
-from compare.study import StudyRun, run_study
+from compare.verify.study import StudyRun, run_study
 from spindle.errors import InputError
 from spindle.spec import load_spec
 
@@ -57,14 +57,14 @@ def test_serial_and_pool_give_the_same_figures():
 
 
 def _fail_for_5_nodes_steady(monkeypatch):
-    real = compare.study.lumped_entries
+    real = compare.verify.study.lumped_entries
 
     def flaky(spec, case, nodes, dt_s, T0, progress=None):
         if tuple(nodes) == (5,) and dt_s is None:
             raise FloatingPointError("injected failure\nsecond line")
         return real(spec, case, nodes, dt_s, T0, progress)
 
-    monkeypatch.setattr(compare.study, "lumped_entries", flaky)
+    monkeypatch.setattr(compare.verify.study, "lumped_entries", flaky)
 
 
 def test_a_failed_run_is_listed_and_the_others_are_present(monkeypatch):
@@ -84,14 +84,14 @@ def test_a_failed_run_is_listed_and_the_others_are_present(monkeypatch):
 
 
 def test_a_failed_reference_transient_leaves_no_transient_table(monkeypatch):
-    real = compare.study.fem_entry
+    real = compare.verify.study.fem_entry
 
     def broken(spec, level, case, dt_s, T0, order=2):
         if dt_s is not None and level == 2:
             raise RuntimeError("out of memory")
         return real(spec, level, case, dt_s, T0, order)
 
-    monkeypatch.setattr(compare.study, "fem_entry", broken)
+    monkeypatch.setattr(compare.verify.study, "fem_entry", broken)
     study = run_study(load_spec("fin-shaft"), **SMALL, workers=1)
     assert study.transient is None
     assert [f["label"] for f in study.failures] == ["FEM level 2 transient (warm-up 8 h)"]

@@ -3,12 +3,12 @@
 1. Ingest the run (spindle.bench), map its channels to the spec's sensors, build the inputs
    through the power balance on a 60 s grid.
 2. Solve the FEM reference on the run's inputs and anchor the grey box to it
-   (compare.discrepancy); calibrate the declared parameters, with priors around the spec's
-   values, on the fit window (default the first 60 %), validate on the rest (compare.fit).
+   (compare.fit.discrepancy); calibrate the declared parameters, with priors around the spec's
+   values, on the fit window (default the first 60 %), validate on the rest (compare.fit.calibrate).
    With ``model="fem"`` the base parameters are calibrated on the FEM reference itself
-   (compare.femgrey), and the lumped grey box is anchored to the FEM at the calibrated point
+   (compare.fit.femgrey), and the lumped grey box is anchored to the FEM at the calibrated point
    for the selection of effects.
-3. Diagnose the residual (compare.residuals), select effects forward (likelihood-ratio test at
+3. Diagnose the residual (compare.fit.residuals), select effects forward (likelihood-ratio test at
    ``alpha``, and needed by the validation error or by plausibility), and say ``unexplained``
    when the final residual is still structured and material in a channel and no candidate
    explains it.
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.fit import (
+from compare.fit.calibrate import (
     TOLERANCE,
     Calibrator,
     Fit,
@@ -39,7 +39,7 @@ from compare.fit import (
     parameters_table,
     resample,
 )
-from compare.greybox import BASE_PARAMS, EFFECTS, GreyBox, Inputs, default_theta
+from compare.fit.greybox import BASE_PARAMS, EFFECTS, GreyBox, Inputs, default_theta
 from spindle.bench import BenchRun, bench_grid, cell_means, check_against_spec, held, read_bench
 from spindle.drive import drive_for
 from spindle.errors import InputError
@@ -89,7 +89,7 @@ class FitReport:
     signatures: dict[str, dict[str, np.ndarray]]
     runtime_s: float
     alpha: float
-    anchor: object = None  # compare.discrepancy.Discrepancy; None: lumped alone, no priors
+    anchor: object = None  # compare.fit.discrepancy.Discrepancy; None: lumped alone, no priors
     floor: dict | None = None  # per channel [tolerance units]
     prior_z: dict | None = None  # final base parameters, prior sds from the spec's values
     calibration_model: str = "lumped"  # "fem": base parameters calibrated on the FEM itself
@@ -186,8 +186,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     on the lumped grey box anchored to the FEM at the spec's values; "fem" calibrates them on
     the FEM reference itself (level ``fem_level``), then anchors the lumped grey box there
     and selects effects on it."""
-    from compare.discrepancy import fem_discrepancy
-    from compare.residuals import diagnose
+    from compare.fit.discrepancy import fem_discrepancy
+    from compare.fit.residuals import diagnose
 
     t0 = time.perf_counter()
     say = progress or (lambda _m: None)
@@ -296,14 +296,14 @@ FEM_FREE_NFEV = 5
 
 
 def _calibrate_on_fem(cal: Calibrator, fem_level: int, say: Callable[[str], None]):
-    """The base parameters calibrated on the FEM reference (compare.femgrey) with the same
+    """The base parameters calibrated on the FEM reference (compare.fit.femgrey) with the same
     priors, windows and floor as the lumped path; then ``cal``'s grey box anchored to the FEM
     at the calibrated point, and ``cal`` given the FEM calibrator's priors and floor.
 
     Returns (the FEM base fit, the anchor at the calibrated point, a summary for the report).
     """
-    from compare.discrepancy import Discrepancy
-    from compare.femgrey import FemGreyBox
+    from compare.fit.discrepancy import Discrepancy
+    from compare.fit.femgrey import FemGreyBox
 
     t0 = time.perf_counter()
     gb = cal.gb
@@ -366,7 +366,7 @@ def save_report(rep: FitReport, out: Path, pictures: bool = True) -> list[Path]:
 
 
 def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
-    from compare.residuals import plot_acf, plot_cumulated_periodogram
+    from compare.fit.residuals import plot_acf, plot_cumulated_periodogram
     from spindle.outputs import atomic_write
     from spindle.plots import pyplot
 

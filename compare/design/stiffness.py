@@ -13,7 +13,7 @@ For a steady load case with losses Q [W]:
   T_sink is simply that temperature.
 - **temperature stiffness** K_T [K/µm]: shaft rise (volume mean of the ``shaft`` parts above
   ambient) per µm of axial growth (``TCP`` if a tool is clamped, else ``P1``), read as
-  :class:`compare.paper.PaperFigures` reads the paper's 41.6 K / 79.7 µm.
+  :class:`compare.design.paper.PaperFigures` reads the paper's 41.6 K / 79.7 µm.
 - **thermal stiffness** K_Q [W/µm]: losses per µm of that growth.
 
 SI inside; µm only in the names of the reported indicators (``K_T_K_um``, ``K_Q_W_um``).

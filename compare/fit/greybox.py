@@ -54,7 +54,7 @@ class Param:
     hi: float
     doc: str
     log: bool = True
-    #: prior standard deviation around the spec's value (compare.fit), on the fitted
+    #: prior standard deviation around the spec's value (compare.fit.calibrate), on the fitted
     #: scale (natural log for ``log`` parameters); None: no prior
     prior_sd: float | None = None
 
@@ -176,7 +176,7 @@ class GreyBox:
     lag_channel: str | None = None  # the channel of a sensor_lag effect
     _cache: dict = field(default_factory=dict, repr=False)
     #: per channel, FEM reference minus this lumped model at the reference point, added to
-    #: every simulation [K; m for P1] (compare.discrepancy): the lumped model then supplies
+    #: every simulation [K; m for P1] (compare.fit.discrepancy): the lumped model then supplies
     #: only the change that parameters and effects make, the FEM the trajectory itself
     discrepancy: dict[str, np.ndarray] | None = field(default=None, repr=False)
 

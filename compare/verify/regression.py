@@ -29,7 +29,7 @@ KELVIN = 273.15
 
 
 def figures_of(study) -> dict[str, float | int | None]:
-    """The flat table of figures of a :class:`compare.study.StudyResult`."""
+    """The flat table of figures of a :class:`compare.verify.study.StudyResult`."""
     fig: dict[str, float | int | None] = {}
     conv = study.convergence
     fig["convergence/ground_truth_level"] = study.ground_truth_level
@@ -69,7 +69,7 @@ def _tolerance(name: str, tol: dict) -> float:
 
 def compute(spec_ref: str, settings: dict, progress: Callable[[str], None] | None = None
             ) -> dict[str, float | int | None]:
-    from compare.study import run_study
+    from compare.verify.study import run_study
     from spindle.spec import load_spec
 
     spec = load_spec(spec_ref)

@@ -163,8 +163,8 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
-    from compare.accuracy import worst_temperature_K
-    from compare.study import run_study
+    from compare.verify.accuracy import worst_temperature_K
+    from compare.verify.study import run_study
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
 
@@ -224,7 +224,7 @@ def _progress(quiet: bool):
 
 
 def _cmd_baseline(args: argparse.Namespace) -> int:
-    from compare.regression import make_baseline
+    from compare.verify.regression import make_baseline
     from spindle.outputs import atomic_write
     from spindle.spec import load_spec
 
@@ -246,7 +246,7 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from compare.regression import check, read_baseline
+    from compare.verify.regression import check, read_baseline
 
     doc = read_baseline(args.file)
     changes = check(doc, progress=_progress(args.quiet))
@@ -262,7 +262,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
-    from compare.fitrun import report_summary_text, run_fit, save_report
+    from compare.fit.run import report_summary_text, run_fit, save_report
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
 
@@ -284,8 +284,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
 
 
 def _cmd_synth(args: argparse.Namespace) -> int:
-    from compare.greybox import EFFECTS
-    from compare.synth import OUTSIDE, synth
+    from compare.fit.greybox import EFFECTS
+    from compare.fit.synth import OUTSIDE, synth
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
@@ -303,8 +303,8 @@ def _cmd_synth(args: argparse.Namespace) -> int:
 
 
 def _cmd_measures(args: argparse.Namespace) -> int:
+    from compare.design.measures import read_measures, run_measures, shipped_measures
     from compare.executor import stderr_progress
-    from compare.measures import read_measures, run_measures, shipped_measures
     from lumped.build import PRESETS
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
@@ -541,7 +541,8 @@ def build_parser() -> argparse.ArgumentParser:
     me.add_argument("--quiet", action="store_true", help="no progress on stderr")
     me.set_defaults(func=_cmd_measures)
 
-    from compare import calculix, sensors
+    from compare.crosscheck import calculix
+    from compare.verify import sensors
 
     sensors.register(sub)
     calculix.register(sub)

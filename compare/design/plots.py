@@ -1,5 +1,5 @@
 """Pictures of the thermal stiffness strategy (paper section 4); computing stays in
-:mod:`compare.measures`.
+:mod:`compare.design.measures`.
 
 - :func:`fig15_png`: the paper's Fig. 15, the temperature drop Delta T = T1 (lambda - 1) /
   lambda (eq. 24) against the heat stiffness ratio lambda_tr, with each measure's lambda
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.measures import PAPER_LAMBDA_RANGE, SWEEP_UNITS, MeasuresReport, temperature_drop_K
+from compare.design.measures import PAPER_LAMBDA_RANGE, SWEEP_UNITS, MeasuresReport, temperature_drop_K
 from spindle.outputs import atomic_write
 from spindle.plots import pyplot
 

@@ -3,7 +3,7 @@ best reconstruct the shaft temperature and the axial growth P1.
 
 1. :func:`choose_nodes` runs the lumped model for every node count N on every load case and
    compares it with the FEM reference exactly as the accuracy table does
-   (:meth:`compare.accuracy.AccuracyResult.errors`): the worst temperature error is the
+   (:meth:`compare.verify.accuracy.AccuracyResult.errors`): the worst temperature error is the
    largest ``*_max_K`` entry (shaft and housing arrays, T1, T2; over the sensors, and over
    time for a transient), the growth error is ``P1_max_um``. The chosen N is the smallest
    whose worst temperature error is <= ``tol_temp_K`` AND whose P1 error is <=
@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.accuracy import (
+from compare.verify.accuracy import (
     NODES,
     TOL_GROWTH_UM,
     TOL_TEMP_K,
@@ -58,10 +58,10 @@ MAX_LEVEL = 6
 
 # ============================================================================ load cases
 def default_cases(spec: Spec) -> list[LoadCase]:
-    """The two cases of :func:`compare.study.study_cases`: the steady one (its duration set
+    """The two cases of :func:`compare.verify.study.study_cases`: the steady one (its duration set
     to 0 s, so it runs as a steady state) and the transient one (spl-16h, or the 8 h warm-up
     of a spec without a power balance)."""
-    from compare.study import study_cases
+    from compare.verify.study import study_cases
 
     steady, transient = study_cases(spec)
     return [replace(steady, duration_s=0.0), transient]
@@ -85,7 +85,7 @@ def load_cases(spec: Spec, names: Sequence[str], steady_cycles: bool = True) -> 
 
 
 def _transient_default(spec: Spec) -> LoadCase:
-    from compare.study import study_cases
+    from compare.verify.study import study_cases
 
     return study_cases(spec)[1]
 
@@ -319,7 +319,7 @@ def choose_nodes(spec: Spec, cases: Sequence[LoadCase] | None = None,
     ``cases``: load cases; one with ``duration_s > 0`` runs as a transient (backward Euler
     FEM and exact zero-order-hold lumped runs on the same grid, step ``dt_s`` [s], from the
     ambient temperature at t = 0), otherwise as a steady state. Default: the steady and the
-    transient case of :func:`compare.study.study_cases`. ``tol_temp_K`` [K] bounds the worst
+    transient case of :func:`compare.verify.study.study_cases`. ``tol_temp_K`` [K] bounds the worst
     sensor temperature error, ``tol_growth_um`` [µm] the P1 error (ignored for a spec
     without P1). ``reference_level``: the FEM P2 mesh level of the reference (default 2).
     ``progress`` receives one message per model run.
@@ -751,7 +751,7 @@ def rank_sensors(spec: Spec, case: LoadCase | None = None, k_max: int = 11,
     """Rank measuring points by how well they reconstruct the targets over a FEM transient.
 
     ``case``: a transient load case (default: the transient of
-    :func:`compare.study.study_cases`, spl-16h or the 8 h warm-up). ``candidates``: sensor
+    :func:`compare.verify.study.study_cases`, spl-16h or the 8 h warm-up). ``candidates``: sensor
     or array names of the spec, or a mapping name -> (z, r) [m]; default every temperature
     sensor of the spec. ``targets``: sensor arrays, temperature sensors, growth readings or
     ``part:<name>``; default ("shaft", "P1"), those the spec has. ``method``: "greedy" or

@@ -15,7 +15,7 @@ So the fit simulates
 on the run's own inputs: at the spec's parameter values the model *is* the FEM reference, and
 away from them the lumped model supplies the sensitivities (a first-order discrepancy
 correction, as in Kennedy and O'Hagan 2001). The base parameters get priors around the spec's
-values with the widths declared in :data:`compare.greybox.BASE_PARAMS` (``prior_sd``); an
+values with the widths declared in :data:`compare.fit.greybox.BASE_PARAMS` (``prior_sd``); an
 effect is needed when the data would otherwise pull them far outside those widths.
 
 Only the run's inputs (speed, heat from the power balance at the spec's values, ambient,
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from compare.greybox import BASE_PARAMS, GreyBox, Inputs, default_theta
+from compare.fit.greybox import BASE_PARAMS, GreyBox, Inputs, default_theta
 from spindle.loads import LoadCase, TimeSeries
 from spindle.spec import Spec
 

@@ -12,7 +12,7 @@ Installed with spindle-verify (entry point ``pytest11``), it gives every test su
 ``case`` a shipped cycle name (``nominal`` is steady, other cycles are transients) or None
 for the spec's own steady load case. The reference is the FEM at ``reference_level``.
 The error is the worst temperature error over the spec's sensors (K; over time for a
-transient) and the P1 error (µm), as in compare.accuracy.
+transient) and the P1 error (µm), as in compare.verify.accuracy.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import pytest
 
-from compare.accuracy import (
+from compare.verify.accuracy import (
     AccuracyResult,
     Entry,
     fem_entry,

@@ -1,6 +1,6 @@
 """The verification study of a spec: how far can its models be trusted?
 
-1. Grid convergence of the FEM reference on nested levels (compare.convergence): observed
+1. Grid convergence of the FEM reference on nested levels (compare.verify.convergence): observed
    order, Richardson extrapolation, GCI; the ground-truth level.
 2. Steady accuracy (the nominal point, or the spec's own load case): eq. 14, the lumped models
    for every N and the FEM levels against the Richardson-extrapolated reference.
@@ -27,7 +27,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from compare.accuracy import (
+from compare.verify.accuracy import (
     NODES,
     TOL_GROWTH_UM,
     TOL_TEMP_K,
@@ -37,7 +37,7 @@ from compare.accuracy import (
     fem_entry,
     lumped_entries,
 )
-from compare.convergence import ConvergenceResult, convergence_study
+from compare.verify.convergence import ConvergenceResult, convergence_study
 from spindle.errors import InputError
 from spindle.loads import LoadCase
 from spindle.spec import Spec
@@ -242,7 +242,7 @@ class StudyRun:
 
 
 def run_study_case(run: StudyRun) -> Entry:
-    """The executor's function: one run, as an :class:`~compare.accuracy.Entry` (module level,
+    """The executor's function: one run, as an :class:`~compare.verify.accuracy.Entry` (module level,
     so it pickles)."""
     if run.model == "lumped":
         return lumped_entries(run.spec, run.case, (run.size,), run.dt_s, run.T0)[0]

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from compare.greybox import BASE_PARAMS, EFFECTS, GreyBox, Param
+from compare.fit.greybox import BASE_PARAMS, EFFECTS, GreyBox, Param
 
 #: |z| of every base parameter after an effect that is needed for plausibility (95 % central)
 RESTORED_Z = 1.96
@@ -142,7 +142,7 @@ class Calibrator:
     max_nfev: int = 60
     progress: Callable[[str], None] | None = None
     evaluations: int = field(default=0)
-    #: prior centres (the spec's values, compare.discrepancy); the widths are Param.prior_sd
+    #: prior centres (the spec's values, compare.fit.discrepancy); the widths are Param.prior_sd
     prior: dict[str, float] | None = None
     #: sqrt(s^2 n / n_eff) of the data term, so that data and prior weigh as a posterior
     prior_scale: float = 1.0

@@ -26,19 +26,19 @@ ratio of eq. 22 is lambda_tr = K_alpha1 / K_alpha2 = sum_after / sum_before:
   proportional to its rise (eq. 20), so the formulas predict the same lambda.
 
 Here sum(alpha_i A_i) runs over **every surface of the spec with a film coefficient**, at
-the case's speed, coolant jacket included (:func:`compare.stiffness.surface_films`).
+the case's speed, coolant jacket included (:func:`compare.design.stiffness.surface_films`).
 
 **The reference** solves the modified spec (same mesh: only film coefficients change, so the
 assembled operator is reused with the new coefficients, which is exact because K is affine
 in them) and reads K_alpha from the volume-mean and the maximum rise
-(:mod:`compare.stiffness`); lambda_ref = K_alpha1 / K_alpha2 at the same losses.
+(:mod:`compare.design.stiffness`); lambda_ref = K_alpha1 / K_alpha2 at the same losses.
 
 **Inverse problem** (:func:`solve_inverse`): the smallest size of a measure (A_M, or
 alpha_M2) that reaches a target xi (or a target growth), by Brent's method on the FEM solve,
 with the formula's prediction of the same size.
 
 ``spindle-verify measures SPEC --measures FILE`` runs it all (:func:`run_measures`) and writes
-tables, JSON and the Fig. 15 / Fig. 16 pictures (:mod:`compare.measures_plots`).
+tables, JSON and the Fig. 15 / Fig. 16 pictures (:mod:`compare.design.plots`).
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from compare.stiffness import (
+from compare.design.stiffness import (
     Indicators,
     indicators,
     paper_consistency,
@@ -1000,7 +1000,7 @@ class MeasuresReport:
         atomic_write(out / "measures.md", lambda tmp: tmp.write_text(text, "utf-8"))
         files += ["measures.json", "measures.md"]
         if pictures:
-            from compare import measures_plots
+            from compare.design import plots as measures_plots
 
             measures_plots.fig15_png(self, out / "fig15_temperature_drop.png")
             files.append("fig15_temperature_drop.png")

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.greybox import EFFECTS
+from compare.fit.greybox import EFFECTS
 from lumped.elastic import first_order_lag
 from spindle.loads import LoadCase, SpeedTable, TimeSeries
 from spindle.spec import Spec

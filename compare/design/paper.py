@@ -18,8 +18,8 @@ least squares (scipy.optimize.least_squares) on a coarse mesh; the fitted values
 written into the shipped spec and drive (see docs/paper.md), and tests/test_paper.py checks
 that the shipped files reproduce the targets.
 
-``python -m compare.paper`` prints the figures of the shipped spec;
-``python -m compare.paper --calibrate`` runs the fit from the shipped values.
+``python -m compare.design.paper`` prints the figures of the shipped spec;
+``python -m compare.design.paper --calibrate`` runs the fit from the shipped values.
 """
 
 from __future__ import annotations

@@ -2,8 +2,8 @@
 
 ``spindle-verify fit --model fem`` calibrates the base parameters (:data:`BASE_PARAMS`) on
 this model instead of the anchored lumped one, so the calibrated values carry the FEM's
-sensitivities, not the 11-node model's (compare.fitrun). It has the interface
-:class:`compare.fit.Calibrator` uses from :class:`compare.greybox.GreyBox` (``spec``,
+sensitivities, not the 11-node model's (compare.fit.run). It has the interface
+:class:`compare.fit.Calibrator` uses from :class:`compare.fit.greybox.GreyBox` (``spec``,
 ``drive``, ``inputs``, ``nodes``, ``effects``, ``lag_channel``, ``_cache``, ``discrepancy``,
 ``parameters()``, ``variant()``, ``simulate()``), for the base parameters only: the candidate
 effects live in the lumped model (``variant`` with an effect raises).
@@ -12,9 +12,9 @@ How each parameter enters, on one :class:`reference.ReferenceModel` built once:
 
 - ``f0``, ``rotor_share``: the heat sources, from the power balance exactly as the grey box
   computes them (:meth:`GreyBox._sources`), driven through
-  :func:`compare.discrepancy.load_case_from_inputs`;
+  :func:`compare.fit.discrepancy.load_case_from_inputs`;
 - ``h_coolant``, ``h_air``, ``h_rotating``: factors on the film coefficients h of the spec's
-  surfaces, grouped as the grey box groups them (:func:`compare.greybox._film_groups`);
+  surfaces, grouped as the grey box groups them (:func:`compare.fit.greybox._film_groups`);
 - ``contact``: a factor on the interface coefficient h_c of every contact link of the spec
   (``op.contacts`` holds exactly the spec's ContactLinks; the grey box's contact edges are
   the lumped edges between parts joined by a ContactLink, the same joints). Note that the
@@ -22,7 +22,7 @@ How each parameter enters, on one :class:`reference.ReferenceModel` built once:
   the mass centres, while here only h_c is scaled, as the spec's value means;
 - ``alpha_eff``: multiplies P1 (below).
 
-Film and contact factors are applied as :meth:`compare.paper.PaperStudy.apply` does, by
+Film and contact factors are applied as :meth:`compare.design.paper.PaperStudy.apply` does, by
 swapping coefficients in the assembled operator (no reassembly), then dropping the cached LU
 factors. Results are kept for the last few parameter sets (a Jacobian revisits points); the
 thermal solve does not depend on ``alpha_eff``, so its Jacobian column costs no FEM run.
@@ -36,8 +36,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from compare.greybox import BASE_PARAMS, GreyBox, Inputs, Param, _film_groups
-from compare.paper import _scaled
+from compare.design.paper import _scaled
+from compare.fit.greybox import BASE_PARAMS, GreyBox, Inputs, Param, _film_groups
 from spindle.drive import Drive
 from spindle.spec import Spec
 
@@ -112,7 +112,7 @@ class FemGreyBox:
             f = dict(zip(("h_coolant", "h_air", "h_rotating", "contact"), factors, strict=True))
             op = ref.thermal.op
             # a factor of exactly 1 keeps the spec's own object: the default point is then the
-            # FEM reference of compare.discrepancy bit for bit
+            # FEM reference of compare.fit.discrepancy bit for bit
             op.films = [(s if g is None or f[g] == 1.0 else
                          replace(s, h_W_m2K=_scaled(s.h_W_m2K, f[g])), R, b)
                         for s, R, b, g in films]
@@ -131,13 +131,13 @@ class FemGreyBox:
         if hit is not None:
             self._cache[key] = self._cache.pop(key)  # most recently used last
             return hit
-        from compare.discrepancy import fem_readings
+        from compare.fit.discrepancy import fem_readings
 
         t0 = time.perf_counter()
         ref = self._apply(th)
         lumped = GreyBox(self.spec, self.drive, self.inputs, self.nodes, _cache=self._cache)
         src = lumped._sources(float(th["f0"]), float(th["rotor_share"]))
-        # the same read-out as compare.discrepancy's reference_channels, so the default
+        # the same read-out as compare.fit.discrepancy's reference_channels, so the default
         # point is that run exactly
         out = fem_readings(ref, self.spec, self.inputs, src, ("T1", "T2", "T_stator", "P1"))
         runs = [k for k in self._cache if isinstance(k, tuple) and k[:1] == ("fem",)]
@@ -174,4 +174,4 @@ class FemGreyBox:
 
 _NO_EFFECTS = ("the FEM grey box calibrates the base parameters only, not effects "
                "({effects}): select effects on the lumped grey box anchored at the "
-               "FEM-calibrated point (compare.fitrun, --model fem)")
+               "FEM-calibrated point (compare.fit.run, --model fem)")

@@ -1,0 +1,1 @@
+"""The independent cross-check of the reference against CalculiX (ccx)."""
