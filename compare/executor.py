@@ -144,7 +144,7 @@ def _run_pool(fn, cases: Sequence[Any], workers: int, finish) -> None:
                 finish(i, None, _message(exc), type(exc).__name__, time.perf_counter() - t0)
 
 
-def _import_dask():
+def import_dask():
     try:
         from dask import distributed  # optional extra, imported on demand
     except ImportError:
@@ -155,7 +155,7 @@ def _import_dask():
 
 
 def _run_dask(fn, cases: Sequence[Any], scheduler: str, workers: int, finish) -> None:
-    distributed = _import_dask()
+    distributed = import_dask()
     cluster = None
     try:
         if scheduler == "local":

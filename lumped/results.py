@@ -13,8 +13,7 @@ import numpy as np
 from spindle import plots
 from spindle.outputs import write_csv, write_json
 from spindle.results import SteadyTable, TransientTable
-
-KELVIN = 273.15
+from spindle.units import ZERO_C_K
 
 
 def _model_info(model) -> dict:
@@ -42,7 +41,7 @@ class LumpedSteadyResult(SteadyTable):
 
     def mass_table(self) -> dict[str, list]:
         table = self.model.mass_table()
-        return {**table, "T_C": [float(self.T[i]) - KELVIN for i in range(len(self.T))]}
+        return {**table, "T_C": [float(self.T[i]) - ZERO_C_K for i in range(len(self.T))]}
 
     def summary(self) -> dict:
         return self.steady_summary({"model": _model_info(self.model)})
@@ -123,11 +122,11 @@ class LumpedTransientResult(TransientTable):
         if pictures:
             title = f"{self.model.spec.name}: {self.case.name}, lumped {self.model.nodes} nodes"
             arrays = {s.name: s.array for s in self.model.spec.temperature_sensors() if s.array}
-            plots.timeseries_png(self.times_s, self.names, self.sensor_K - KELVIN,
+            plots.timeseries_png(self.times_s, self.names, self.sensor_K - ZERO_C_K,
                                  out / "sensors_timeseries.png", title, arrays)
             files.append("sensors_timeseries.png")
             if "P1" in self.growth_m and "T1" in self.names:
-                plots.growth_band_png(self.times_s, self.sensor("T1") - KELVIN,
+                plots.growth_band_png(self.times_s, self.sensor("T1") - ZERO_C_K,
                                       self.growth_m["P1"] * 1e6, out / "T1_P1_tolerance.png",
                                       title)
                 files.append("T1_P1_tolerance.png")

@@ -30,6 +30,7 @@ from skfem import Basis, ElementTriP0, ElementVector, asm
 from reference.forms import centrifugal, elasticity, thermal_coupling
 from reference.thermal import ELEMENTS, ThermalModel, factorize
 from spindle.spec import ContactLink
+from spindle.units import RPM_TO_RAD_S
 
 #: shear modulus of a floating bearing's rolling layer, relative to its own
 FLOATING_SHEAR = 1e-6
@@ -45,7 +46,7 @@ class ThermoelasticModel:
         self.basis = Basis(sm.mesh, ElementVector(ELEMENTS[order]()), intorder=2 * order + 1)
         self.T_ref = self.spec.T_initial_K
         self.iz, self.ir = self.basis.split_indices()
-        lam, mu, mu_s, alpha, rho_rot = self._element_fields()
+        lam, mu, mu_s, alpha, rho_rot = self.element_fields()
         p0 = self.basis.with_element(ElementTriP0())
         fields = {k: p0.interpolate(v) for k, v in
                   dict(lam=lam, mu=mu, mu_s=mu_s, alpha=alpha, rho_rot=rho_rot).items()}
@@ -60,7 +61,7 @@ class ThermoelasticModel:
         self._gains: dict[str, tuple[np.ndarray, float]] = {}
 
     # ------------------------------------------------------------------ setup
-    def _element_fields(self):
+    def element_fields(self):
         sm, spec = self.smesh, self.spec
         floating = {(lk.part, lk.section) for lk in spec.links
                     if getattr(lk, "section", None) and spec.part(lk.part).role == "rear_bearing"}
@@ -134,7 +135,7 @@ class ThermoelasticModel:
     def load(self, T: np.ndarray, speed_rpm: float = 0.0, centrifugal: bool = False) -> np.ndarray:
         f = self.B @ (np.asarray(T) - self.T_ref)
         if centrifugal and speed_rpm:
-            f = f + (speed_rpm * np.pi / 30.0) ** 2 * self.f_cf
+            f = f + (speed_rpm * RPM_TO_RAD_S) ** 2 * self.f_cf
         return f
 
     def displacement(self, T: np.ndarray, speed_rpm: float = 0.0,
@@ -172,5 +173,5 @@ class ThermoelasticModel:
         g, c = self.gain(sensor)
         out = (np.asarray(T) - self.T_ref) @ g
         if centrifugal:
-            out = out + (np.asarray(speed_rpm) * np.pi / 30.0) ** 2 * c
+            out = out + (np.asarray(speed_rpm) * RPM_TO_RAD_S) ** 2 * c
         return out

@@ -9,12 +9,13 @@ from __future__ import annotations
 import numpy as np
 
 from meshes.io import to_pyvista
+from spindle.units import ZERO_C_K
 
 # local P2 DOFs: 0-2 vertices, 3 = edge (0,1), 4 = edge (1,2), 5 = edge (0,2)
 _P2_SPLIT = np.array([[0, 3, 5], [1, 4, 3], [2, 5, 4], [3, 4, 5]])
 
 
-def field_grid(model, T: np.ndarray, name: str = "T_C", offset: float = -273.15):
+def field_grid(model, T: np.ndarray, name: str = "T_C", offset: float = -ZERO_C_K):
     """The half-section (x = z, y = r [m]) with point data ``name`` = T + offset."""
     basis, sm = model.basis, model.smesh
     if model.order == 1:

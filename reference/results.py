@@ -15,8 +15,7 @@ from spindle.outputs import atomic_write
 from spindle.outputs import write_csv as _write_csv
 from spindle.outputs import write_json as _write_json
 from spindle.results import SteadyTable, TransientTable
-
-KELVIN = 273.15
+from spindle.units import ZERO_C_K
 
 
 def _mesh_info(model) -> dict:
@@ -140,14 +139,14 @@ class TransientResult(TransientTable):
         if pictures:
             title = f"{self.model.spec.name}: {self.case.name}"
             arrays = {s.name: s.array for s in self.model.spec.temperature_sensors() if s.array}
-            shared_plots.timeseries_png(self.times_s, self.names, self.sensor_K - KELVIN,
+            shared_plots.timeseries_png(self.times_s, self.names, self.sensor_K - ZERO_C_K,
                                  out / "sensors_timeseries.png", title, arrays)
             plots.section_png(self.model, self.fields_K[-1], out / "temperature_section.png",
                               f"{title}, t = {self.field_times_s[-1] / 3600:.2f} h")
             plots.revolved_png(self.model, self.fields_K[-1], out / "temperature_3d.png", title)
             files += ["sensors_timeseries.png", "temperature_section.png", "temperature_3d.png"]
             if "P1" in self.growth_m and "T1" in self.names:
-                shared_plots.growth_band_png(self.times_s, self.sensor("T1") - KELVIN,
+                shared_plots.growth_band_png(self.times_s, self.sensor("T1") - ZERO_C_K,
                                       self.growth_m["P1"] * 1e6, out / "T1_P1_tolerance.png",
                                       title)
                 files.append("T1_P1_tolerance.png")

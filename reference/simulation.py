@@ -17,6 +17,7 @@ from reference.results import SteadyResult, TransientResult
 from reference.thermal import ThermalModel
 from spindle.loads import LoadCase
 from spindle.spec import Spec
+from spindle.units import RPM_TO_RAD_S
 
 
 class ReferenceModel:
@@ -56,7 +57,7 @@ class ReferenceModel:
                       ) -> np.ndarray:
         """The centrifugal part omega^2 c of a growth reading [m] at the output times (the
         speed held over each step), whether or not this model adds it."""
-        omega2 = (self._step_speeds(case, times_s) * np.pi / 30.0) ** 2
+        omega2 = (self._step_speeds(case, times_s) * RPM_TO_RAD_S) ** 2
         return omega2 * self.elastic.gain(reading)[1]
 
     def transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
@@ -68,7 +69,7 @@ class ReferenceModel:
         T_ref = self.elastic.T_ref if self.elastic else 0.0
         t = res.times_s
         speed = self._step_speeds(case, t)
-        omega2 = (speed * np.pi / 30.0) ** 2
+        omega2 = (speed * RPM_TO_RAD_S) ** 2
         for k, (g, c) in gains.items():
             res.growth_m[k] = res.functionals[k] - T_ref * g.sum() \
                 + (omega2 * c if self.centrifugal else 0.0)

@@ -116,7 +116,7 @@ class ThermalModel:
         self._lu: dict[tuple, object] = {}
 
     # ------------------------------------------------------------------ assembly
-    def _element_fields(self):
+    def element_fields(self):
         regions, er = self.smesh.regions, self.smesh.element_region
         kr = np.array([r.material.k_r_W_mK if r.kind == "solid" else 0.0 for r in regions])[er]
         kz = np.array([r.material.k_z_W_mK if r.kind == "solid" else 0.0 for r in regions])[er]
@@ -130,7 +130,7 @@ class ThermalModel:
 
     def _assemble(self) -> Operator:
         sm, spec, basis = self.smesh, self.spec, self.basis
-        kr, kz, rhoc = self._element_fields()
+        kr, kz, rhoc = self.element_fields()
         K_solid = asm(conduction, basis, kr=self._cell(kr), kz=self._cell(kz)).tocsr()
         M = asm(capacity, basis, rhoc=self._cell(rhoc)).tocsr()
         links = []

@@ -37,7 +37,8 @@ from spindle.power import power_balance
 from spindle.spec import Spec
 
 #: 0 °C in K.
-ZERO_C_K = 273.15
+from spindle.units import ZERO_C_K
+
 #: µm -> m
 UM_TO_M = 1e-6
 

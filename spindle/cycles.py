@@ -40,7 +40,8 @@ if TYPE_CHECKING:  # only for the annotation: spec.py is not imported at run tim
     from spindle.spec import Spec
 
 #: 0 degC in K.
-ZERO_C_K = 273.15
+from spindle.units import ZERO_C_K
+
 #: Temperatures accepted in cycle files [degC] (as spindle.loads.read_cycle_csv).
 T_MIN_C, T_MAX_C = -60.0, 200.0
 #: Ambient and coolant when a file gives none [degC].

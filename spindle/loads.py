@@ -16,6 +16,7 @@ from typing import Literal
 import numpy as np
 
 from spindle.errors import InputError
+from spindle.units import ZERO_C_K
 
 Interpolation = Literal["linear", "previous"]
 
@@ -83,6 +84,10 @@ class SpeedTable:
         if len(self.values) == 1:
             return float(self.values[0])
         return float(np.interp(speed_rpm, self.speed_rpm, self.values))
+
+    def scaled(self, factor: float) -> SpeedTable:
+        """The same table with every value multiplied by ``factor``."""
+        return SpeedTable(self.speed_rpm, tuple(v * factor for v in self.values))
 
     @property
     def max(self) -> float:
@@ -203,6 +208,6 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
                 raise InputError(name, f"{col} (line {line_no[out[0] + 1]})",
                                  f"{data[col][out[0]]:g} is outside -60..200 degC",
                                  "give temperatures in degrees Celsius (not kelvin)")
-            case = replace(case, **{attr: series(col, 273.15)})
+            case = replace(case, **{attr: series(col, ZERO_C_K)})
     sources = {s: series(f"{s}_W") for s in source_names if f"{s}_W" in data}
     return case.with_sources(sources)

@@ -6,12 +6,16 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from spindle.errors import InputError
 
@@ -70,6 +74,26 @@ def write_csv(path: Path, header: list[str], rows) -> None:
     atomic_write(path, write)
 
 
+def jsonable(v: Any) -> Any:
+    """JSON-ready data: Python scalars, non-finite floats as None (NaN is not JSON), arrays and
+    containers recursively, paths as strings."""
+    if isinstance(v, Mapping):
+        return {str(k): jsonable(x) for k, x in v.items()}
+    if isinstance(v, list | tuple | np.ndarray):
+        return [jsonable(x) for x in v]
+    if isinstance(v, bool | np.bool_):
+        return bool(v)
+    if isinstance(v, int | np.integer):
+        return int(v)
+    if isinstance(v, float | np.floating):
+        return float(v) if math.isfinite(v) else None
+    if isinstance(v, Path):
+        return str(v)
+    return v
+
+
 def write_json(path: Path, data: dict) -> None:
-    """An indented JSON file, written atomically."""
-    atomic_write(path, lambda tmp: tmp.write_text(json.dumps(data, indent=2) + "\n", "utf-8"))
+    """An indented JSON file (made :func:`jsonable` first: valid JSON, no NaN), written
+    atomically."""
+    text = json.dumps(jsonable(data), indent=2, allow_nan=False) + "\n"
+    atomic_write(path, lambda tmp: tmp.write_text(text, "utf-8"))

@@ -30,7 +30,8 @@ import numpy as np
 from spindle.loads import SpeedTable
 
 #: rpm -> rad/s
-RPM_TO_RAD_S = 2.0 * math.pi / 60.0
+from spindle.units import RPM_TO_RAD_S
+
 #: Reference temperature of eq. 17 (20 degC) [K]
 T20_K = 293.15
 #: Temperature coefficient of copper resistance at 20 degC [1/K] (seed paper eq. 17, ref. [17])

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-KELVIN = 273.15
+from spindle.units import ZERO_C_K
 
 
 class SteadyTable:
@@ -28,7 +28,7 @@ class SteadyTable:
         sensors, values = self.model.spec.temperature_sensors(), self.sensors
         return {"sensor": [s.name for s in sensors], "array": [s.array or "" for s in sensors],
                 "z_m": [s.z for s in sensors], "r_m": [s.r for s in sensors],
-                "T_C": [values[s.name] - KELVIN for s in sensors],
+                "T_C": [values[s.name] - ZERO_C_K for s in sensors],
                 "rise_K": [values[s.name] - T_amb for s in sensors]}
 
     def steady_summary(self, about: dict) -> dict:
@@ -36,10 +36,10 @@ class SteadyTable:
         table = self.sensor_table()
         return {"spec": self.model.spec.name, "kind": "steady", **about,
                 "speed_rpm": self.speed_rpm,
-                "T_ambient_C": float(self.case.T_ambient_K(self.time_s)) - KELVIN,
-                "T_coolant_C": float(self.case.T_coolant_K(self.time_s)) - KELVIN,
+                "T_ambient_C": float(self.case.T_ambient_K(self.time_s)) - ZERO_C_K,
+                "T_coolant_C": float(self.case.T_coolant_K(self.time_s)) - ZERO_C_K,
                 "relative_residual": self.residual, "energy": self.energy,
-                "T_max_C": float(self.T.max() - KELVIN),
+                "T_max_C": float(self.T.max() - ZERO_C_K),
                 "sensors_C": dict(zip(table["sensor"], table["T_C"], strict=True)),
                 "growth_um": {k: v * 1e6 for k, v in self.growth_m.items()}}
 
@@ -70,7 +70,7 @@ class TransientTable:
     def to_pandas(self):
         import pandas as pd
 
-        df = pd.DataFrame(self.sensor_K - KELVIN, columns=[f"{n}_C" for n in self.names])
+        df = pd.DataFrame(self.sensor_K - ZERO_C_K, columns=[f"{n}_C" for n in self.names])
         df.insert(0, "time_s", self.times_s)
         for k, v in self.growth_m.items():
             df[f"{k}_um"] = v * 1e6
@@ -78,9 +78,9 @@ class TransientTable:
 
     def peaks(self) -> dict:
         """Peak and final sensor temperatures [degC] and growth readings [µm]."""
-        peak = self.sensor_K.max(axis=0) - KELVIN
+        peak = self.sensor_K.max(axis=0) - ZERO_C_K
         return {"peak_C": dict(zip(self.names, peak.tolist(), strict=True)),
-                "final_C": dict(zip(self.names, (self.sensor_K[-1] - KELVIN).tolist(),
+                "final_C": dict(zip(self.names, (self.sensor_K[-1] - ZERO_C_K).tolist(),
                                     strict=True)),
                 "peak_growth_um": {k: float(v.max() * 1e6) for k, v in self.growth_m.items()},
                 "final_growth_um": {k: float(v[-1] * 1e6) for k, v in self.growth_m.items()}}
@@ -90,7 +90,7 @@ class TransientTable:
         growth = np.array(list(self.growth_m.values())).T * 1e6 if self.growth_m else \
             np.zeros((len(self.times_s), 0))
         header = ["time_s"] + [f"{n}_C" for n in self.names] + [f"{k}_um" for k in self.growth_m]
-        rows = ([t, *row, *g] for t, row, g in zip(self.times_s, self.sensor_K - KELVIN, growth,
+        rows = ([t, *row, *g] for t, row, g in zip(self.times_s, self.sensor_K - ZERO_C_K, growth,
                                                    strict=True))
         return header, rows
 
@@ -101,7 +101,7 @@ class TransientTable:
         if ax is None:
             _, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
         for j, n in enumerate(self.names):
-            ax.plot(self.times_s / 3600, self.sensor_K[:, j] - KELVIN, label=n)
+            ax.plot(self.times_s / 3600, self.sensor_K[:, j] - ZERO_C_K, label=n)
         ax.set_xlabel("time [h]")
         ax.set_ylabel("temperature [°C]")
         return ax

@@ -658,7 +658,7 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass o
             continue
         if aname is not None and pn is not None:
             arrays.append(SensorArray(aname, pn, cnt, rad))
-            sensors.extend(_array_sensors(arrays[-1], next(p for p in parts if p.name == pn)))
+            sensors.extend(array_sensors(arrays[-1], next(p for p in parts if p.name == pn)))
     seen: set[str] = set()
     for s in sensors:
         if s.name in seen:
@@ -682,7 +682,7 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass o
         power_preset=preset)
 
 
-def _array_sensors(arr: SensorArray, part: Part) -> list[Sensor]:
+def array_sensors(arr: SensorArray, part: Part) -> list[Sensor]:
     z0 = min(s.z_start for s in part.sections)
     z1 = max(s.z_end for s in part.sections)
     out = []

@@ -12,7 +12,7 @@ import pytest
 from compare.cli import main
 from compare.fit.calibrate import Calibrator, Measured
 from compare.fit.femgrey import FemGreyBox
-from compare.fit.greybox import BASE_PARAMS, GreyBox, _film_groups, _is_contact_link, inputs_from_cycle
+from compare.fit.greybox import BASE_PARAMS, GreyBox, _is_contact_link, film_groups, inputs_from_cycle
 from spindle.cycles import load_cycle
 from spindle.drive import DRIVES
 from spindle.loads import SpeedTable
@@ -37,7 +37,7 @@ def _scaled_spec(spec, name: str, factor: float):
         return replace(spec, links=tuple(
             replace(lk, h_W_m2K=lk.h_W_m2K * factor) if isinstance(lk, ContactLink) else lk
             for lk in spec.links))
-    groups = _film_groups(spec)
+    groups = film_groups(spec)
     return replace(spec, surfaces=tuple(
         replace(s, h_W_m2K=SpeedTable(s.h_W_m2K.speed_rpm, tuple(v * factor
                                                                  for v in s.h_W_m2K.values)))
@@ -90,7 +90,7 @@ def test_sources_and_expansion(setup):
     spec, inp, fem = setup
     th = {"f0": 0.45, "rotor_share": 0.1}
     ours = fem.simulate(th)
-    src = GreyBox(spec, DRIVE, inp)._sources(0.45, 0.1)
+    src = GreyBox(spec, DRIVE, inp).sources(0.45, 0.1)
     res = ReferenceModel(spec, 0).transient(load_case_from_inputs(spec, inp, src), 600.0,
                                            T0=inp.T_start_K)
     t = inp.grid_s - inp.grid_s[0]

@@ -15,8 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from spindle.errors import InputError, SpindleVerifyError
-
-KELVIN = 273.15
+from spindle.units import ZERO_C_K
 
 
 def _cmd_specs(args: argparse.Namespace) -> int:
@@ -151,7 +150,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     else:
         _print_sensor_table(result.sensor_table(),
                             f"steady state at {result.speed_rpm:g} rpm, ambient "
-                            f"{case.T_ambient_K(0) - KELVIN:.2f} degC:")
+                            f"{case.T_ambient_K(0) - ZERO_C_K:.2f} degC:")
         for n, v in result.growth_m.items():
             print(f"  {n + '_um':<16} {v * 1e6:9.3f}  axial growth relative to the housing "
                   "fixation below the front bearing")

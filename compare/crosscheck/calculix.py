@@ -43,14 +43,15 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 from skfem import Basis, ElementTriP0, ElementTriP2, ElementVector, FacetBasis, asm
 
+from reference.elastic import FLOATING_SHEAR
 from reference.forms import conduction, elasticity, film, surface_flux, thermal_coupling, volume_source
 from reference.simulation import ReferenceModel
 from reference.thermal import TWO_PI, factorize, layer_conductivity_factor
 from spindle.errors import InputError, SolverError
 from spindle.loads import LoadCase
 from spindle.spec import BearingLink, ContactLink, Spec, load_spec
+from spindle.units import ZERO_C_K
 
-KELVIN = 273.15
 CCX_MISSING = "ccx not found; fix: install the Debian package calculix-ccx"
 #: Quadrature of ccx's DCAX6/CAX6 (found by reproducing single-element ccx results with
 #: scikit-fem): the 3-point rule of degree 2 over the triangle, 2-point Gauss on a face.
@@ -62,8 +63,6 @@ CCX_CONTACT_INTORDER = 5
 #: ccx expands a CAX6 section into a 2-degree C3D15 wedge (+-1 degree): the hoop strain of the
 #: expanded element is exact only to O(theta^2), theta = 1 degree in radians
 EXPANSION_REL = (math.pi / 180.0) ** 2
-#: shear moduli of a floating bearing's rolling layer, relative to its own (as the reference)
-FLOATING_SHEAR = 1e-6
 
 _PER_LINE = 10  # ids per line in *ELSET / *NSET (ccx reads at most 16 per line)
 
@@ -152,7 +151,7 @@ def _thermal_inputs(model: ReferenceModel, case: LoadCase, t: float = 0.0) -> _T
     th, spec = model.thermal, model.spec
     sm, mesh = th.smesh, th.smesh.mesh
     n = float(case.speed_rpm(t))
-    kr, kz, _ = th._element_fields()
+    kr, kz, _ = th.element_fields()
     kr, kz = kr.astype(float).copy(), kz.astype(float).copy()
     for li, lk in enumerate(spec.links):
         if isinstance(lk, ContactLink):
@@ -503,7 +502,7 @@ def _elastic_checks(model: ReferenceModel, cm: _Mesh, con: dict) -> dict:
     el = model.elastic
     if el is None:
         return {}
-    lam, mu, mu_s, alpha, _ = el._element_fields()
+    lam, mu, mu_s, alpha, _ = el.element_fields()
     mat = np.array(_elastic_materials(model), dtype=float)
     E, nu, a, fl = mat.T
     mine = np.vstack([E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu)),
@@ -763,9 +762,9 @@ class CrosscheckResult:
 
     def sensor_table(self) -> dict[str, list]:
         return {"sensor": list(self.sensors), "z_m": self.z_m.tolist(), "r_m": self.r_m.tolist(),
-                "T_skfem_C": (self.T_skfem_K - KELVIN).tolist(),
-                "T_ccx_C": (self.T_ccx_K - KELVIN).tolist(), "diff_K": self.diff_K.tolist(),
-                "T_twin_C": (self.T_twin_K - KELVIN).tolist(),
+                "T_skfem_C": (self.T_skfem_K - ZERO_C_K).tolist(),
+                "T_ccx_C": (self.T_ccx_K - ZERO_C_K).tolist(), "diff_K": self.diff_K.tolist(),
+                "T_twin_C": (self.T_twin_K - ZERO_C_K).tolist(),
                 "ccx_minus_twin_K": (self.T_ccx_K - self.T_twin_K).tolist(),
                 "print_bound_K": self.T_print_K.tolist()}
 
@@ -795,13 +794,13 @@ class CrosscheckResult:
                 "mesh": {"level": self.level, "order": 2, "nodes": self.deck.get("nodes"),
                          "elements": self.deck.get("elements")},
                 "case": self.case, "speed_rpm": self.speed_rpm,
-                "T_ambient_C": self.T_ambient_K - KELVIN,
+                "T_ambient_C": self.T_ambient_K - ZERO_C_K,
                 "max_abs_diff_K": float(d.max(initial=0.0)),
                 "max_abs_ccx_minus_twin_K": float(np.abs(self.T_ccx_K - self.T_twin_K)
                                                   .max(initial=0.0)),
                 "sensors": {n: {"T_skfem_C": a, "T_ccx_C": b, "diff_K": c}
-                            for n, a, b, c in zip(self.sensors, self.T_skfem_K - KELVIN,
-                                                  self.T_ccx_K - KELVIN, self.diff_K.tolist(),
+                            for n, a, b, c in zip(self.sensors, self.T_skfem_K - ZERO_C_K,
+                                                  self.T_ccx_K - ZERO_C_K, self.diff_K.tolist(),
                                                   strict=True)},
                 "growth_um": {k: {"skfem": g["skfem_um"][i], "ccx": g["ccx_um"][i],
                                   "diff": g["diff_um"][i]} for i, k in enumerate(g["reading"])},
@@ -817,7 +816,7 @@ class CrosscheckResult:
         out.mkdir(parents=True, exist_ok=True)
         files = [out / "crosscheck.json", out / "crosscheck_sensors.csv",
                  out / "crosscheck_growth.csv"]
-        write_json(files[0], _jsonable(self.summary()))
+        write_json(files[0], self.summary())
         table = self.sensor_table()
         write_csv(files[1], list(table), zip(*table.values(), strict=True))
         gt = self.growth_table()
@@ -825,16 +824,6 @@ class CrosscheckResult:
         return files
 
 
-def _jsonable(x):
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, Path):
-        return str(x)
-    return x
 
 
 def crosscheck(spec: Spec | str | Path, level: int = 1, case: LoadCase | None = None, *,
@@ -976,7 +965,7 @@ def _cmd_crosscheck(args: argparse.Namespace) -> int:
           f"case '{result.case}' at {result.speed_rpm:g} rpm")
     print(f"  {'sensor':<16} {'T_skfem_C':>10} {'T_ccx_C':>10} {'diff_K':>10}")
     for i, n in enumerate(result.sensors):
-        print(f"  {n:<16} {result.T_skfem_K[i] - KELVIN:10.4f} {result.T_ccx_K[i] - KELVIN:10.4f} "
+        print(f"  {n:<16} {result.T_skfem_K[i] - ZERO_C_K:10.4f} {result.T_ccx_K[i] - ZERO_C_K:10.4f} "
               f"{result.diff_K[i]:10.1e}")
     if result.growth_skfem_m:
         print(f"  {'reading':<16} {'skfem_um':>10} {'ccx_um':>10} {'diff_um':>10}")

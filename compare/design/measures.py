@@ -995,7 +995,7 @@ class MeasuresReport:
                 write_csv(out / f"{name}.csv", header,
                           ([_csv(r.get(k)) for k in header] for r in rows[name]))
                 files.append(f"{name}.csv")
-        write_json(out / "measures.json", _jsonable(self.summary()))
+        write_json(out / "measures.json", self.summary())
         text = self.markdown()
         atomic_write(out / "measures.md", lambda tmp: tmp.write_text(text, "utf-8"))
         files += ["measures.json", "measures.md"]
@@ -1018,16 +1018,6 @@ def _csv(v: Any) -> Any:
     return v
 
 
-def _jsonable(v: Any) -> Any:
-    if isinstance(v, dict):
-        return {k: _jsonable(x) for k, x in v.items()}
-    if isinstance(v, list | tuple):
-        return [_jsonable(x) for x in v]
-    if isinstance(v, float | np.floating):
-        return None if not math.isfinite(v) else float(v)
-    if isinstance(v, np.integer):
-        return int(v)
-    return v
 
 
 def _fmt(v: Any, spec: str = ".4g") -> str:

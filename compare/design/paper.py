@@ -33,10 +33,9 @@ import numpy as np
 from reference import ReferenceModel
 from spindle.cycles import load_cycle
 from spindle.drive import DRIVES, Drive, cycle_load_case
-from spindle.loads import SpeedTable
 from spindle.spec import AirGapLink, Spec, load_spec
+from spindle.units import ZERO_C_K
 
-KELVIN = 273.15
 TARGETS = {"losses_W": 5146.0, "shaft_rise_K": 41.6, "housing_rise_K": 46.1, "TCP_um": 79.7,
            "T1_peak_C": 32.4, "P1_peak_um": 6.5}
 PAPER_INDICATORS = {"K_T_K_um": 0.52, "K_Q_W_um": 64.53}
@@ -74,10 +73,6 @@ class PaperFigures:
         return {k: getattr(self, k) / v - 1.0 for k, v in TARGETS.items()}
 
 
-def _scaled(table: SpeedTable, factor: float) -> SpeedTable:
-    return SpeedTable(table.speed_rpm, tuple(v * factor for v in table.values))
-
-
 class PaperStudy:
     """The nominal point and the spl-16h cycle on one FEM reference; parameters are applied
     by swapping coefficients in the assembled operator (no reassembly)."""
@@ -95,11 +90,11 @@ class PaperStudy:
     def apply(self, factors: dict[str, float]) -> Drive:
         op = self.ref.thermal.op
         group = {s: g for g, names in FILM_GROUPS.items() for s in names}
-        op.films = [(replace(s, h_W_m2K=_scaled(s.h_W_m2K, factors.get(group.get(s.name), 1.0))),
+        op.films = [(replace(s, h_W_m2K=s.h_W_m2K.scaled(factors.get(group.get(s.name), 1.0))),
                      R, b) for s, R, b in self._films]
         op.contacts = [(replace(lk, h_W_m2K=lk.h_W_m2K * factors.get("contact", 1.0)), C)
                        for lk, C in self._contacts]
-        op.links = [(replace(lk, h_W_m2K=_scaled(lk.h_W_m2K, factors.get("air_gap", 1.0)))
+        op.links = [(replace(lk, h_W_m2K=lk.h_W_m2K.scaled(factors.get("air_gap", 1.0)))
                      if isinstance(lk, AirGapLink) else lk, A) for lk, A in self._links]
         self.ref.thermal._lu.clear()
         drive = DRIVES[self.spec.power_preset]
@@ -121,7 +116,7 @@ class PaperStudy:
             shaft_rise_K=float(self.w_shaft @ res.T) - T_amb,
             housing_rise_K=float(self.w_housing @ res.T) - T_amb,
             TCP_um=res.growth_m["TCP"] * 1e6, P1_nominal_um=res.growth_m["P1"] * 1e6,
-            T1_peak_C=float(tr.sensor("T1").max()) - KELVIN,
+            T1_peak_C=float(tr.sensor("T1").max()) - ZERO_C_K,
             P1_peak_um=float(tr.growth_m["P1"].max()) * 1e6)
 
 

@@ -92,7 +92,7 @@ def reference_channels(gb: GreyBox, channels: tuple[str, ...] | list[str], level
     driven by the grey box's inputs and its heat sources at the spec's parameter values."""
     from reference import ReferenceModel
 
-    src = gb._sources(BASE_PARAMS["f0"].default, BASE_PARAMS["rotor_share"].default)
+    src = gb.sources(BASE_PARAMS["f0"].default, BASE_PARAMS["rotor_share"].default)
     return fem_readings(ReferenceModel(gb.spec, level), gb.spec, gb.inputs, src, channels)
 
 

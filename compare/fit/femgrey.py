@@ -11,10 +11,10 @@ effects live in the lumped model (``variant`` with an effect raises).
 How each parameter enters, on one :class:`reference.ReferenceModel` built once:
 
 - ``f0``, ``rotor_share``: the heat sources, from the power balance exactly as the grey box
-  computes them (:meth:`GreyBox._sources`), driven through
+  computes them (:meth:`GreyBox.sources`), driven through
   :func:`compare.fit.discrepancy.load_case_from_inputs`;
 - ``h_coolant``, ``h_air``, ``h_rotating``: factors on the film coefficients h of the spec's
-  surfaces, grouped as the grey box groups them (:func:`compare.fit.greybox._film_groups`);
+  surfaces, grouped as the grey box groups them (:func:`compare.fit.greybox.film_groups`);
 - ``contact``: a factor on the interface coefficient h_c of every contact link of the spec
   (``op.contacts`` holds exactly the spec's ContactLinks; the grey box's contact edges are
   the lumped edges between parts joined by a ContactLink, the same joints). Note that the
@@ -36,8 +36,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from compare.design.paper import _scaled
-from compare.fit.greybox import BASE_PARAMS, GreyBox, Inputs, Param, _film_groups
+from compare.fit.greybox import BASE_PARAMS, GreyBox, Inputs, Param, film_groups
 from spindle.drive import Drive
 from spindle.spec import Spec
 
@@ -98,7 +97,7 @@ class FemGreyBox:
 
             ref = ReferenceModel(self.spec, self.level)
             op = ref.thermal.op
-            groups = _film_groups(self.spec)
+            groups = film_groups(self.spec)
             films = [(s, R, b, groups.get(s.name)) for s, R, b in op.films]
             self._cache[key] = (ref, films, list(op.contacts), list(op.links))
             self._cache["fem_applied"] = None
@@ -114,7 +113,7 @@ class FemGreyBox:
             # a factor of exactly 1 keeps the spec's own object: the default point is then the
             # FEM reference of compare.fit.discrepancy bit for bit
             op.films = [(s if g is None or f[g] == 1.0 else
-                         replace(s, h_W_m2K=_scaled(s.h_W_m2K, f[g])), R, b)
+                         replace(s, h_W_m2K=s.h_W_m2K.scaled(f[g])), R, b)
                         for s, R, b, g in films]
             op.contacts = [(lk if f["contact"] == 1.0 else
                             replace(lk, h_W_m2K=lk.h_W_m2K * f["contact"]), C)
@@ -136,7 +135,7 @@ class FemGreyBox:
         t0 = time.perf_counter()
         ref = self._apply(th)
         lumped = GreyBox(self.spec, self.drive, self.inputs, self.nodes, _cache=self._cache)
-        src = lumped._sources(float(th["f0"]), float(th["rotor_share"]))
+        src = lumped.sources(float(th["f0"]), float(th["rotor_share"]))
         # the same read-out as compare.fit.discrepancy's reference_channels, so the default
         # point is that run exactly
         out = fem_readings(ref, self.spec, self.inputs, src, ("T1", "T2", "T_stator", "P1"))

@@ -193,7 +193,7 @@ class GreyBox:
         return out
 
     # ------------------------------------------------------------------ sources
-    def _sources(self, f0: float, rotor_share: float) -> dict[str, np.ndarray]:
+    def sources(self, f0: float, rotor_share: float) -> dict[str, np.ndarray]:
         key = ("src", round(f0, 12), round(rotor_share, 12))
         if key not in self._cache:
             d = self.drive.with_f0(f0).with_rotor_share(rotor_share)
@@ -245,7 +245,7 @@ class GreyBox:
             net.network.connect(hous.masses[-1].block.port, c.port_a)
             net.network.connect(c.port_b, amb.port)
         model = LumpedModel(self.spec, network=net)
-        groups = _film_groups(self.spec)
+        groups = film_groups(self.spec)
         edge_group: list[str | None] = []
         adv = mount = None
         for k, (_, _, _, name) in enumerate(model.system.edges):
@@ -310,7 +310,7 @@ class GreyBox:
         model = self._model(th)
         sys = model.system
         inp = self.inputs
-        src = self._sources(th["f0"], th["rotor_share"])
+        src = self.sources(th["f0"], th["rotor_share"])
         n_int = len(inp.grid_s) - 1
         cols = []
         for name in sys.source_names:
@@ -371,7 +371,7 @@ class GreyBox:
         return out
 
 
-def _film_groups(spec: Spec) -> dict[str, str]:
+def film_groups(spec: Spec) -> dict[str, str]:
     """Surface name -> its film parameter: coolant, rotating or housing air."""
     roles = {p.name: p.role for p in spec.parts}
     out = {}

@@ -55,6 +55,8 @@ from typing import Any
 import numpy as np
 from scipy import signal, stats
 
+from spindle.outputs import jsonable
+
 #: default Ljung-Box lags [samples]
 DEFAULT_LAGS: tuple[int, ...] = (10, 20)
 
@@ -107,19 +109,6 @@ def _pct(alpha: float) -> str:
     return f"{alpha * 100:g} %"
 
 
-def _clean(v: Any) -> Any:
-    """JSON-ready: python scalars, non-finite floats as None, containers recursively."""
-    if isinstance(v, Mapping):
-        return {str(k): _clean(x) for k, x in v.items()}
-    if isinstance(v, list | tuple | np.ndarray):
-        return [_clean(x) for x in v]
-    if isinstance(v, bool | np.bool_):
-        return bool(v)
-    if isinstance(v, int | np.integer):
-        return int(v)
-    if isinstance(v, float | np.floating):
-        return float(v) if math.isfinite(v) else None
-    return v
 
 
 # ----------------------------------------------------------------------- 1. summary statistics
@@ -329,7 +318,7 @@ class Whiteness:
         return f"{head}: {lb}; {cp}"
 
     def to_dict(self) -> dict[str, Any]:
-        return _clean({"alpha": self.alpha, "n": self.n, "white": self.white,
+        return jsonable({"alpha": self.alpha, "n": self.n, "white": self.white,
                        "ljung_box": [{"lag": h, "lag_s": h * self.dt_s, "Q": q, "p": p}
                                      for h, q, p in self.ljung_box],
                        "cp_statistic": self.cp_statistic, "cp_p_value": self.cp_p_value,
@@ -367,7 +356,7 @@ class CrossPeak:
         return abs(self.ccf) > self.band
 
     def to_dict(self) -> dict[str, Any]:
-        return _clean({"name": self.name, "kind": self.kind, "lag": self.lag, "lag_s": self.lag_s,
+        return jsonable({"name": self.name, "kind": self.kind, "lag": self.lag, "lag_s": self.lag_s,
                        "ccf": self.ccf, "band": self.band, "beyond_band": self.beyond_band})
 
 
@@ -390,7 +379,7 @@ class ChannelDiagnostics:
         return max(peaks, key=lambda c: abs(c.ccf)) if peaks else None
 
     def to_dict(self) -> dict[str, Any]:
-        return _clean({"name": self.name, "n": self.n, "rmse": self.rmse, "max_abs": self.max_abs,
+        return jsonable({"name": self.name, "n": self.n, "rmse": self.rmse, "max_abs": self.max_abs,
                        "bias": self.bias, "t_max_s": self.t_max_s,
                        "whiteness": self.whiteness.to_dict(),
                        "cross": [c.to_dict() for c in self.cross]})
@@ -419,7 +408,7 @@ class Diagnostics:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (python types only, non-finite numbers as None)."""
-        return _clean({"dt_s": self.dt_s, "alpha": self.alpha, "scales": self.scales,
+        return jsonable({"dt_s": self.dt_s, "alpha": self.alpha, "scales": self.scales,
                        "channels": {k: c.to_dict() for k, c in self.channels.items()},
                        "unexplained": self.unexplained_description()})
 

@@ -20,7 +20,6 @@ from __future__ import annotations
 import base64
 import html
 import json
-import math
 import time
 import warnings
 from collections.abc import Callable
@@ -43,9 +42,10 @@ from compare.fit.greybox import BASE_PARAMS, EFFECTS, GreyBox, Inputs, default_t
 from spindle.bench import BenchRun, bench_grid, cell_means, check_against_spec, held, read_bench
 from spindle.drive import drive_for
 from spindle.errors import InputError
+from spindle.outputs import jsonable
 from spindle.spec import Spec
+from spindle.units import ZERO_C_K
 
-KELVIN = 273.15
 REPORT_FORMAT = "spindle-verify-fit/1"
 
 
@@ -68,10 +68,10 @@ def greybox_inputs(run: BenchRun, grid_s: float = 60.0) -> Inputs:
     power = cell_means(*valid("power_kW"), grid, mids)
     torque = cell_means(*valid("load_torque_Nm"), grid, mids) if run.load_torque_measured \
         else np.zeros(len(mids))
-    T_env = cell_means(*valid("T_env_C"), grid, mids) + KELVIN
-    T_cool = cell_means(*valid("T_coolant_C"), grid, mids) + KELVIN
+    T_env = cell_means(*valid("T_env_C"), grid, mids) + ZERO_C_K
+    T_cool = cell_means(*valid("T_coolant_C"), grid, mids) + ZERO_C_K
     _, y_env = valid("T_env_C")
-    return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + KELVIN)
+    return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + ZERO_C_K)
 
 
 @dataclass
@@ -112,7 +112,7 @@ class FitReport:
                             "validation_error_before": st.validation_before,
                             "validation_error_after": st.validation_after,
                             "needed_by": st.needed_by})
-        return _clean({
+        return jsonable({
             "format": REPORT_FORMAT, "run": str(self.run.path), "spec": self.spec.name,
             "channels": self.channels, "run_summary": self.run.summary(),
             "windows": {"fit": [float(self.measured.grid_s[0]), self.measured.split_s],
@@ -158,20 +158,6 @@ def _errors(fit: Fit) -> dict:
     return out
 
 
-def _clean(x):
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_clean(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return _clean(x.tolist())
-    if isinstance(x, np.bool_ | bool):
-        return bool(x)
-    if isinstance(x, np.integer):
-        return int(x)
-    if isinstance(x, float | np.floating):
-        return float(x) if math.isfinite(x) else None
-    return x
 
 
 def _residuals(measured: Measured, model: dict[str, np.ndarray], channels) -> dict:
@@ -377,7 +363,7 @@ def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
     n = len(rep.channels)
     fig, axes = plt.subplots(n, 2, figsize=(13, 2.8 * n), layout="constrained", squeeze=False)
     for i, c in enumerate(rep.channels):
-        scale, off, unit = (1e6, 0.0, "µm") if c == "P1" else (1.0, KELVIN, "°C")
+        scale, off, unit = (1e6, 0.0, "µm") if c == "P1" else (1.0, ZERO_C_K, "°C")
         tol = TOLERANCE[c] * scale
         meas = rep.measured.values[c] * scale - off
         for j, (fit, label) in enumerate(((sel.base, "before"), (sel.final, "after"))):

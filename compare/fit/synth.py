@@ -36,8 +36,8 @@ from compare.fit.greybox import EFFECTS
 from lumped.elastic import first_order_lag
 from spindle.loads import LoadCase, SpeedTable, TimeSeries
 from spindle.spec import Spec
+from spindle.units import RPM_TO_RAD_S, ZERO_C_K
 
-KELVIN = 273.15
 OUTSIDE = ("electronics_drift",)
 #: noise (standard deviation) and quantisation of the bench channels
 NOISE = {"T1_C": (0.03, 0.01), "T2_C": (0.03, 0.01), "T_stator_C": (0.1, 0.1),
@@ -223,11 +223,11 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
     cols: dict[str, np.ndarray] = {"time_s": t}
     cols["speed_rpm"] = np.asarray(case.speed_rpm(t), dtype=float)
     cols["power_kW"] = np.asarray(power_W(t), dtype=float) / 1e3 * (1 + rng.normal(0, 0.01, len(t)))
-    cols["T_env_C"] = np.asarray(case.T_ambient_K(t)) - KELVIN
-    cols["T_coolant_C"] = np.asarray(case.T_coolant_K(t)) - KELVIN
+    cols["T_env_C"] = np.asarray(case.T_ambient_K(t)) - ZERO_C_K
+    cols["T_coolant_C"] = np.asarray(case.T_coolant_K(t)) - ZERO_C_K
     for name, y in ch.items():
         v = np.interp(t, t_model, y)
-        cols[f"{name}_um" if name == "P1" else f"{name}_C"] = v * 1e6 if name == "P1" else v - KELVIN
+        cols[f"{name}_um" if name == "P1" else f"{name}_C"] = v * 1e6 if name == "P1" else v - ZERO_C_K
     cols["P1_um"] = cols["P1_um"] - cols["P1_um"][0]
     for key, (sd, q) in NOISE.items():
         if key in cols:
@@ -262,7 +262,7 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
     p_el = []
     for s in cycle.steps:
         heat = sum(drive.heat_W(s.speed_rpm, s.load_torque_Nm, s.power_kW).values())
-        p_el.append(heat + s.load_torque_Nm * s.speed_rpm * np.pi / 30.0)
+        p_el.append(heat + s.load_torque_Nm * s.speed_rpm * RPM_TO_RAD_S)
 
     def power_W(t: np.ndarray) -> np.ndarray:
         i = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(p_el) - 1)

@@ -19,12 +19,12 @@ import numpy as np
 
 from spindle.loads import LoadCase
 from spindle.spec import Spec
+from spindle.units import ZERO_C_K
 
 TOL_TEMP_K = 1.0  # paper: "small temperature deviations of 1 K ... are acceptable"
 TOL_GROWTH_UM = 1.5  # paper: "position deviations of ±1.5 µm"
 NODES = (2, 3, 5, 7, 11, 15, 21, 31, 41)
 PRESET_NODES = {5: "paper5", 11: "paper11"}
-KELVIN = 273.15
 
 
 @dataclass
@@ -215,7 +215,7 @@ class AccuracyResult:
 
         def read(e: Entry, n: str) -> float:
             v = np.asarray(e.sensors[n])
-            return float(v[k] if k is not None else v) - KELVIN
+            return float(v[k] if k is not None else v) - ZERO_C_K
 
         ax.plot(z, [read(self.reference, s.name) for s in sensors], "k-", lw=2.5,
                 label=f"reference ({self.reference_label})")

@@ -20,12 +20,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from spindle.errors import InputError, SpindleVerifyError
+from spindle.units import ZERO_C_K
 
 FORMAT = "spindle-verify-baseline/1"
 DEFAULT_TOLERANCES = {"temperature_K": 0.01, "growth_um": 0.01, "gci_pct": 0.01, "level": 0}
 DEFAULT_SETTINGS = {"levels": [0, 1, 2], "nodes": [5, 11], "dt_s": 300.0, "transient": True,
                     "threshold_pct": 1.0}
-KELVIN = 273.15
 
 
 def figures_of(study) -> dict[str, float | int | None]:
@@ -50,7 +50,7 @@ def figures_of(study) -> dict[str, float | int | None]:
                 if s in e.sensors:
                     v = e.sensors[s]
                     fig[f"{tag}/{e.name}/{s}_{'peak_' if acc.transient else ''}C"] = \
-                        float(max(v) if acc.transient else v) - KELVIN
+                        float(max(v) if acc.transient else v) - ZERO_C_K
             for g, v in e.growth.items():
                 fig[f"{tag}/{e.name}/{g}_{'peak_' if acc.transient else ''}um"] = \
                     float(max(v) if acc.transient else v) * 1e6

@@ -268,13 +268,13 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     A run that fails does not stop the study: it is reported through ``progress`` and
     listed in :attr:`StudyResult.failures`, and its model is missing from the tables.
     """
-    from compare.executor import _import_dask, run_cases
+    from compare.executor import import_dask, run_cases
 
     if workers < 1:
         raise InputError("command line", "--workers", f"{workers} is below 1",
                          "give --workers 1 (serial) or more")
     if scheduler:
-        _import_dask()  # a missing extra fails now, not after the grid convergence
+        import_dask()  # a missing extra fails now, not after the grid convergence
     t0 = time.perf_counter()
     s_case, t_case = study_cases(spec)
     s_case = steady_case or s_case
