@@ -9,10 +9,11 @@ step (the sources are the spec's heat sources of the same names).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
-from spindle.cycles import Cycle
+from spindle.cycles import Cycle, load_cycle
 from spindle.errors import InputError
-from spindle.loads import LoadCase, TimeSeries
+from spindle.loads import LoadCase, TimeSeries, read_cycle_csv
 from spindle.power import (
     SPL2782_BEARINGS,
     SPL2782_MOTOR,
@@ -82,3 +83,18 @@ def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None) -> Loa
                          "name the spec's heat sources stator, rotor, front_bearing, rear_bearing")
     sources = {k: TimeSeries(starts, tuple(h[k] for h in heats), "previous") for k in heats[0]}
     return cycle.to_load_case(spec, sources, others="zero")
+
+
+def load_case(spec: Spec, name_or_path: str | Path, base: LoadCase | None = None) -> LoadCase:
+    """The LoadCase of any cycle a user can name: a shipped cycle name, a cycle TOML, a
+    step-table CSV (``speed_rpm, duration_s, ...``: heat from the power balance) or a
+    time-series CSV (``time_s, speed_rpm, T_env_C, T_coolant_C, <source>_W``: heat as given,
+    what the file leaves out taken from ``base``, by default the spec's own load case)."""
+    path = Path(name_or_path)
+    if path.suffix.lower() == ".csv" and path.is_file():
+        header = next((ln for ln in path.read_text(encoding="utf-8", errors="replace").splitlines()
+                       if ln.strip() and not ln.lstrip().startswith("#")), "")
+        if "time_s" in [h.strip() for h in header.split(",")]:
+            return read_cycle_csv(path, [h.name for h in spec.heat_sources],
+                                  base if base is not None else spec.default_load_case())
+    return cycle_load_case(spec, load_cycle(name_or_path))

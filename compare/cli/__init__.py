@@ -14,6 +14,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from spindle.drive import load_case
 from spindle.errors import InputError, SpindleVerifyError
 from spindle.units import ZERO_C_K
 
@@ -64,20 +65,6 @@ def _print_sensor_table(table: dict, title: str) -> None:
               f"{table['T_C'][i]:9.3f} {table['rise_K'][i]:8.3f}")
 
 
-def _read_cycle(name: str, spec, base):
-    """A shipped cycle name, a cycle TOML, a step-table CSV (speed_rpm, duration_s, ...) or
-    a time-series CSV (time_s, speed_rpm, T_env_C, T_coolant_C, <source>_W)."""
-    from spindle.cycles import load_cycle
-    from spindle.drive import cycle_load_case
-    from spindle.loads import read_cycle_csv
-
-    path = Path(name)
-    if path.suffix.lower() == ".csv" and path.is_file():
-        header = next((ln for ln in path.read_text(encoding="utf-8", errors="replace").splitlines()
-                       if ln.strip() and not ln.lstrip().startswith("#")), "")
-        if "time_s" in [h.strip() for h in header.split(",")]:
-            return read_cycle_csv(path, [h.name for h in spec.heat_sources], base)
-    return cycle_load_case(spec, load_cycle(name))
 
 
 def _cmd_solve(args: argparse.Namespace) -> int:
@@ -106,14 +93,14 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     case = spec.default_load_case()
     inputs = [spec.path]
     if args.case:
-        case = _read_cycle(args.case, spec, case)
+        case = load_case(spec, args.case, case)
         if Path(args.case).is_file():
             inputs.append(args.case)
     if args.speed is not None:
         case = replace(case, speed_rpm=TimeSeries.constant(args.speed))
     quiet = args.quiet
     if args.cycle:
-        case = _read_cycle(args.cycle, spec, case)
+        case = load_case(spec, args.cycle, case)
         if Path(args.cycle).is_file():
             inputs.append(args.cycle)
         if args.model == "lumped":  # exact zero-order hold: no theta, no fields
@@ -327,11 +314,11 @@ def _cmd_measures(args: argparse.Namespace) -> int:
     case = spec.default_load_case()
     inputs = [spec.path, str(mpath)]
     if args.case:
-        case = _read_cycle(args.case, spec, case)
+        case = load_case(spec, args.case, case)
         if Path(args.case).is_file():
             inputs.append(args.case)
     elif spec.power_preset:
-        case = _read_cycle("nominal", spec, case)
+        case = load_case(spec, "nominal", case)
     rep = run_measures(spec, mfile, case, args.level, tuple(args.lumped_nodes),
                        sweeps=not args.no_sweeps, points=args.points or 7,
                        scheduler=args.scheduler, workers=args.workers,

@@ -928,32 +928,14 @@ def _ccx_version(log: Path) -> str:
 
 
 # --------------------------------------------------------------------------- command line
-
-
-def _load_case(name: str, spec: Spec) -> tuple[LoadCase, list[str]]:
-    """A steady case from a cycle's first step: a shipped cycle name, a cycle TOML, a
-    step-table CSV or a time-series CSV (as ``spindle-verify solve --case``)."""
-    from spindle.cycles import load_cycle
-    from spindle.drive import cycle_load_case
-    from spindle.loads import read_cycle_csv
-
-    path = Path(name)
-    inputs = [str(path)] if path.is_file() else []
-    if path.suffix.lower() == ".csv" and path.is_file():
-        header = next((ln for ln in path.read_text(encoding="utf-8", errors="replace").splitlines()
-                       if ln.strip() and not ln.lstrip().startswith("#")), "")
-        if "time_s" in [h.strip() for h in header.split(",")]:
-            return read_cycle_csv(path, [h.name for h in spec.heat_sources],
-                                  spec.default_load_case()), inputs
-    return cycle_load_case(spec, load_cycle(name)), inputs
-
-
 def _cmd_crosscheck(args: argparse.Namespace) -> int:
     """``spindle-verify crosscheck``: print the comparison table, write JSON and CSV."""
+    from spindle.drive import load_case
     from spindle.outputs import output_dir
 
     spec = load_spec(args.spec)
-    case, inputs = (None, []) if args.case is None else _load_case(args.case, spec)
+    case = None if args.case is None else load_case(spec, args.case)
+    inputs = [args.case] if args.case is not None and Path(args.case).is_file() else []
     out = Path(args.out or f"results/{spec.name}/crosscheck")
     with output_dir(out, inputs=[spec.path, *inputs]) as tmp:
         result = crosscheck(spec, args.level, case,

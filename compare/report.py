@@ -1,0 +1,79 @@
+"""Report building blocks shared by every feature: number formatting, Markdown tables, HTML
+tables and self-contained figures (PNG embedded as base64), and the page frame.
+
+Computing and presenting stay apart: features build their numbers, then call these to show them.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+#: the look shared by every report.html
+CSS = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}"
+       "table{border-collapse:collapse;font-size:12px;margin:1em 0}"
+       "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
+       "th{background:#f2f2f2}img{max-width:100%}figcaption{font-size:12px;color:#555}")
+
+MISSING = "—"
+
+
+def fmt(v: Any, spec: str = ".4g") -> str:
+    """One table cell: floats with ``spec``, None and NaN as a dash, anything else as str."""
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return MISSING
+    if isinstance(v, float):
+        return format(v, spec)
+    return str(v)
+
+
+def markdown_table(header: Sequence[str], rows: Sequence[Sequence[Any]],
+                   fmts: Sequence[str] | None = None) -> str:
+    """A Markdown table; ``fmts`` gives one format spec per column (default ``.4g``)."""
+    fmts = list(fmts or [".4g"] * len(header))
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for r in rows:
+        lines.append("| " + " | ".join(fmt(v, f) for v, f in zip(r, fmts, strict=True)) + " |")
+    return "\n".join(lines)
+
+
+def html_table(header: Sequence[str], rows: Sequence[Sequence[Any]],
+               fmts: Sequence[str] | None = None) -> str:
+    """An HTML table, every cell escaped."""
+    fmts = list(fmts or [".4g"] * len(header))
+    th = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(fmt(v, f))}</td>"
+                                    for v, f in zip(r, fmts, strict=True)) + "</tr>"
+                   for r in rows)
+    return f"<table><thead><tr>{th}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def markdown_to_html_table(md: str) -> str:
+    """The HTML form of a Markdown table made by :func:`markdown_table` (cells already text)."""
+    lines = [ln for ln in md.splitlines() if ln.startswith("|")]
+    head = [c.strip() for c in lines[0].strip("|").split("|")]
+    rows = [[c.strip() for c in ln.strip("|").split("|")] for ln in lines[2:]]
+    return html_table(head, rows, ["s"] * len(head))
+
+
+def html_figure(path: Path, caption: str) -> str:
+    """A figure with the PNG at ``path`` embedded (the report stays one file); empty if the
+    picture was not drawn."""
+    path = Path(path)
+    if not path.exists():
+        return ""
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    cap = html.escape(caption)
+    return (f'<figure><img alt="{cap}" src="data:image/png;base64,{data}">'
+            f"<figcaption>{cap}</figcaption></figure>")
+
+
+def html_page(title: str, body: Sequence[str], css: str = CSS) -> str:
+    """A complete, self-contained HTML document."""
+    return "\n".join(["<!doctype html><html><head><meta charset='utf-8'>",
+                      f"<title>{html.escape(title)}</title>", f"<style>{css}</style></head><body>",
+                      *body, "</body></html>\n"])
