@@ -1,69 +1,56 @@
 """From a load cycle to heat sources: the power balance (spindle.power) applied per step.
 
-A :class:`Drive` bundles the motor and bearing parameter sets of one spindle; a spec names
-its drive in ``[power_balance] preset``. Each step of a cycle gives, through eq. 15-19 and
-Palmgren's friction, the heat of the stator, the rotor and each bearing pair, held over the
-step (the sources are the spec's heat sources of the same names).
+A :class:`~spindle.drive_file.Drive` bundles the motor and bearing parameter sets of one
+spindle; it is read from a drive file (spindle/data/drives/*.toml for the shipped ones,
+format in docs/power.md). A spec names its drive in ``[power_balance] preset``: a shipped
+drive's name, or the path of the spindle's own drive file, relative to the spec's folder.
+Each step of a cycle gives, through eq. 15-19 and Palmgren's friction, the heat of the
+stator, the rotor and each bearing pair, held over the step (the sources are the spec's heat
+sources of the same names).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from importlib import resources
 from pathlib import Path
 
 from spindle.cycles import Cycle, load_cycle
+from spindle.drive_file import Drive, read_drive_toml
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries, read_cycle_csv
-from spindle.power import (
-    SPL2782_BEARINGS,
-    SPL2782_MOTOR,
-    SPL2782_NOMINAL_T_WINDING_K,
-    BearingParams,
-    MotorParams,
-    power_balance,
-)
 from spindle.spec import Spec
 
 
-@dataclass(frozen=True)
-class Drive:
-    """Motor and bearings of a spindle. ``T_winding_K`` [K] is the winding temperature used
-    for the copper resistance R(T) (eq. 17); ``bearings`` maps heat-source names to sets."""
-
-    name: str
-    motor: MotorParams
-    bearings: dict[str, BearingParams] = field(default_factory=dict)
-    T_winding_K: float = SPL2782_NOMINAL_T_WINDING_K
-
-    def heat_W(self, speed_rpm: float, load_torque_Nm: float = 0.0,
-               power_kW: float | None = None) -> dict[str, float]:
-        """Heat per source [W] at one operating point."""
-        pb = power_balance(self.motor, self.bearings, speed_rpm, load_torque_Nm,
-                           self.T_winding_K,
-                           P_el_W=None if power_kW is None else power_kW * 1e3)
-        return pb.heat_sources_W()
-
-    def with_f0(self, f0: float) -> Drive:
-        """The same drive with bearing friction factor f0 on every pair."""
-        return replace(self, bearings={k: replace(b, f0=f0) for k, b in self.bearings.items()})
-
-    def with_rotor_share(self, share: float) -> Drive:
-        return replace(self, motor=replace(self.motor, rotor_loss_share=share))
+def shipped_drives() -> dict[str, Path]:
+    """Shipped drive files (spindle/data/drives/*.toml) by name (the file stem)."""
+    root = resources.files("spindle").joinpath("data/drives")
+    return {Path(str(p)).stem: Path(str(p)) for p in sorted(root.iterdir(), key=str)
+            if str(p).endswith(".toml")}
 
 
-DRIVES: dict[str, Drive] = {
-    "spl2782": Drive("spl2782", SPL2782_MOTOR, dict(SPL2782_BEARINGS)),
-}
+#: The shipped drives by name, read once at import.
+DRIVES: dict[str, Drive] = {name: read_drive_toml(path) for name, path in shipped_drives().items()}
 
 
 def drive_for(spec: Spec) -> Drive | None:
-    """The drive named by the spec's ``[power_balance] preset``, or None."""
-    if spec.power_preset is None:
+    """The drive named by the spec's ``[power_balance] preset``, or None without one.
+
+    The preset is a shipped drive's name (:data:`DRIVES`) or else the path of a drive TOML,
+    relative to the folder of the spec file. InputError if it is neither; SpecError, listing
+    every problem, if the drive file is wrong.
+    """
+    preset = spec.power_preset
+    if preset is None:
         return None
-    if spec.power_preset not in DRIVES:
-        raise InputError(spec.path, "power_balance.preset", f"unknown preset "
-                         f"'{spec.power_preset}'", f"use one of: {', '.join(sorted(DRIVES))}")
-    return DRIVES[spec.power_preset]
+    if preset in DRIVES:
+        return DRIVES[preset]
+    path = Path(spec.path).parent / Path(preset).expanduser()  # an absolute preset stays as is
+    if path.is_file():
+        return read_drive_toml(path)
+    raise InputError(spec.path, "power_balance.preset",
+                     f"'{preset}' is neither a shipped drive nor a drive file (no file {path})",
+                     f"use one of: {', '.join(sorted(DRIVES))}, or the path of a drive TOML "
+                     "relative to the spec's folder (format: docs/power.md)")
 
 
 def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None) -> LoadCase:
@@ -80,7 +67,7 @@ def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None) -> Loa
     if missing:
         raise InputError(spec.path, "heat_sources", f"the power balance feeds sources "
                          f"{sorted(missing)} that the spec does not have",
-                         "name the spec's heat sources stator, rotor, front_bearing, rear_bearing")
+                         f"name the spec's heat sources {', '.join(heats[0])}")
     sources = {k: TimeSeries(starts, tuple(h[k] for h in heats), "previous") for k in heats[0]}
     return cycle.to_load_case(spec, sources, others="zero")
 

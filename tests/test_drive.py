@@ -1,11 +1,15 @@
-"""Cycles to heat sources through the power balance."""
+"""Cycles to heat sources through the power balance; drive files and the spec's preset."""
+
+import dataclasses
 
 import pytest
 
+from spindle import drive_file
 from spindle.cycles import load_cycle
 from spindle.drive import DRIVES, cycle_load_case, drive_for
-from spindle.errors import InputError
-from spindle.power import power_balance
+from spindle.drive_file import read_drive_toml
+from spindle.errors import InputError, SpecError
+from spindle.power import BearingParams, MotorParams, power_balance
 from spindle.spec import load_spec
 
 
@@ -54,3 +58,153 @@ def test_drive_variants():
     d = DRIVES["spl2782"]
     assert all(b.f0 == 1.3 for b in d.with_f0(1.3).bearings.values())
     assert d.with_rotor_share(0.2).motor.rotor_loss_share == 0.2
+
+
+# ------------------------------------------------------------------------------ drive files
+
+# The SPL2782.1 parameter set as the Python constants of spindle/power.py held it before it
+# moved to spindle/data/drives/spl2782.toml, copied literally.
+OLD_MOTOR = dict(name="Siemens 1FE1084-4WN31 (SPL2782.1)", R20_ohm=0.195, kT_Nm_A=1.2,
+                 pole_pairs=4, k_h_W_HzT2=0.6, k_e_W_Hz2T2=3.0e-3, B_T=1.5, phases=3,
+                 rotor_loss_share=0.06, alpha_cu_1_K=0.00393)
+OLD_BEARINGS = {
+    "front_bearing": dict(name="SPL2782.1 front pair 2 x 7018", f0=0.30, dm_m=0.115,
+                          nu_mm2_s=12.0, preload_N=400.0, C0_N=52_000.0, count=2,
+                          inner_ring_share=0.5),
+    "rear_bearing": dict(name="SPL2782.1 rear pair 2 x 7016", f0=0.30, dm_m=0.1025,
+                         nu_mm2_s=12.0, preload_N=300.0, C0_N=40_000.0, count=2,
+                         inner_ring_share=0.5),
+}
+OLD_T_WINDING_K = 393.15
+OLD_NOMINAL = dict(speed_rpm=4300.0, P_mech_W=38_000.0, losses_W=5146.0)
+
+SMALL_DRIVE = """
+[drive]
+T_winding_K = 373.15
+
+[motor]
+R20_ohm = 0.5
+kT_Nm_A = 0.8
+pole_pairs = 2
+k_h_W_HzT2 = 0.2
+k_e_W_Hz2T2 = 1e-3
+B_T = 1.2
+
+[bearings.front_bearing]
+f0 = 1.0
+dm_m = 0.06
+nu_mm2_s = 20.0
+preload_N = 200.0
+C0_N = 15000.0
+
+[bearings.rear_bearing]
+f0 = 1.0
+dm_m = 0.05
+nu_mm2_s = 20.0
+preload_N = 150.0
+C0_N = 12000.0
+"""
+
+
+def test_shipped_drive_equals_the_former_constants():
+    d = DRIVES["spl2782"]
+    assert d is drive_for(load_spec("spl2782"))
+    for key, value in OLD_MOTOR.items():
+        got = getattr(d.motor, key)
+        assert got == value and type(got) is type(value), key
+    assert list(d.bearings) == list(OLD_BEARINGS)  # order: front, then rear
+    for name, old in OLD_BEARINGS.items():
+        for key, value in old.items():
+            got = getattr(d.bearings[name], key)
+            assert got == value and type(got) is type(value), (name, key)
+    assert d.T_winding_K == OLD_T_WINDING_K
+    assert (d.nominal.speed_rpm, d.nominal.P_mech_W, d.nominal.losses_W) == tuple(OLD_NOMINAL.values())
+    # the sources keep their status labels and reasons
+    assert d.motor.source.startswith("ASSUMED: pole_pairs 4 (1FE1 PMSM")
+    assert d.motor.source.endswith("(magnet and sleeve eddy losses of a PMSM rotor)")
+    for b, size in zip(d.bearings.values(), ("7018", "7016"), strict=True):
+        assert b.source.startswith(f"Seed paper (grease-lubricated pairs); {size} dimensions ISO 15; "
+                                   "CALIBRATED f0 = 0.30 per bearing (docs/paper.md: fitted")
+        assert b.source.endswith("25 deg super-precision bearings of this size (M1 is ~8 % of M).")
+
+
+def test_drive_file_fields_cover_the_parameter_classes():
+    for fields, cls in ((drive_file.MOTOR_FIELDS, MotorParams),
+                        (drive_file.BEARING_FIELDS, BearingParams)):
+        keys = {f.key for f in fields} | set(drive_file.TEXT_KEYS)
+        assert keys == {f.name for f in dataclasses.fields(cls)}, cls
+
+
+def _spec_with_preset(tmp_path, preset: str):
+    src = open(load_spec("spl2782").path).read().replace('preset = "spl2782"',
+                                                         f"preset = {preset!r}")
+    path = tmp_path / "spec.toml"
+    path.write_text(src)
+    return load_spec(path)
+
+
+def test_spec_preset_can_be_a_drive_file_next_to_the_spec(tmp_path):
+    (tmp_path / "drives").mkdir()
+    (tmp_path / "drives" / "my-motor.toml").write_text(SMALL_DRIVE)
+    spec = _spec_with_preset(tmp_path, "drives/my-motor.toml")
+    d = drive_for(spec)
+    assert d.name == "my-motor" and d.T_winding_K == 373.15 and d.nominal is None
+    assert d.motor.R20_ohm == 0.5 and d.motor.phases == 3 and d.motor.rotor_loss_share == 0.06
+    assert d.bearings["rear_bearing"].dm_m == 0.05 and d.bearings["rear_bearing"].count == 2
+    # its heat reaches the spec's sources through the cycle
+    case = cycle_load_case(spec, load_cycle("nominal"))
+    expected = d.heat_W(4300.0, *[(s.load_torque_Nm, s.power_kW)
+                                  for s in load_cycle("nominal").steps][0])
+    assert case.sources["front_bearing"](0.0) == pytest.approx(expected["front_bearing"])
+    # an absolute path works from anywhere
+    assert drive_for(_spec_with_preset(tmp_path, str(tmp_path / "drives" / "my-motor.toml"))) == d
+    with pytest.raises(ValueError, match="no nominal point"):
+        d.nominal_point()
+
+
+def test_preset_that_is_no_drive_names_the_spec_field_and_the_options(tmp_path):
+    spec = _spec_with_preset(tmp_path, "drives/missing.toml")
+    with pytest.raises(InputError) as err:
+        drive_for(spec)
+    p = err.value.problem
+    assert (p.file, p.field) == (spec.path, "power_balance.preset")
+    assert "spl2782" in p.fix and "relative to the spec's folder" in p.fix
+
+
+def test_drive_file_reports_every_problem_with_file_field_and_fix(tmp_path):
+    bad = (SMALL_DRIVE.replace("T_winding_K = 373.15", "T_winding_K = 120.0")
+           .replace("pole_pairs = 2", "pole_pairs = 2.5")
+           .replace("dm_m = 0.06", "dm_m = 60.0")
+           .replace("kT_Nm_A = 0.8\n", "")
+           .replace("B_T = 1.2", 'B_T = "strong"\nR20_Ohm = 0.5')
+           + "\n[bearings.stator]\nf0 = 1.0\n")
+    path = tmp_path / "bad.toml"
+    path.write_text(bad)
+    with pytest.raises(SpecError) as err:
+        read_drive_toml(path)
+    by_field = {p.field: p for p in err.value.problems}
+    assert set(by_field) == {"drive.T_winding_K", "motor.pole_pairs", "bearings.front_bearing.dm_m",
+                             "motor.kT_Nm_A", "motor.B_T", "motor.R20_Ohm", "bearings.stator"}
+    assert all(p.file == str(path) for p in err.value.problems)
+    assert "393.15 K" in by_field["drive.T_winding_K"].fix  # degC given for K
+    assert "0.115 m" in by_field["bearings.front_bearing.dm_m"].fix  # mm given for m
+    assert by_field["motor.kT_Nm_A"].message == "required field is missing"
+    assert "typo" in by_field["motor.R20_Ohm"].message and "R20_ohm" in by_field["motor.R20_Ohm"].fix
+    assert "whole number" in by_field["motor.pole_pairs"].message
+    # one line per problem, each "FILE: FIELD: message; fix: ..."
+    assert str(err.value).count("\n") == len(err.value.problems) - 1
+    assert all(ln.startswith(f"{path}: ") and "; fix: " in ln for ln in str(err.value).splitlines())
+
+
+@pytest.mark.parametrize("text, field", [
+    ("[motor]\n", "drive"),
+    ("[drive]\nT_winding_K = 350.0\n", "motor"),
+    ("[drive]\nT_winding_K = 350.0\n[motr]\n", "motr"),
+    ("not toml =", "syntax"),
+])
+def test_drive_file_structure_problems(tmp_path, text, field):
+    path = tmp_path / "d.toml"
+    path.write_text(text)
+    with pytest.raises(SpecError) as err:
+        read_drive_toml(path)
+    assert field in {p.field for p in err.value.problems}
