@@ -36,11 +36,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lumped.blocks import (
+    Block,
     Convection,
     FixedTemperature,
     HeatCapacitor,
+    HeatPort,
     PrescribedHeatFlow,
     ThermalConductor,
+    TwoPort,
 )
 from lumped.network import Network, ThermalSystem
 from spindle.errors import Problem, SpecError
@@ -52,6 +55,7 @@ from spindle.spec import (
     AirGapLink,
     BearingLink,
     ContactLink,
+    HeatSource,
     Part,
     Section,
     Spec,
@@ -217,6 +221,22 @@ def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = T
     staying at the supply temperature; ``bearing_tc_1_K`` makes each bearing's friction heat
     rise with the inner-outer ring temperature difference, Q (1 + tc (T_inner - T_outer)), as
     thermal expansion raises the preload."""
+    nodes = _node_number(nodes)
+    b = _Builder(spec, Network(f"{spec.name}-{nodes}"), rad=1.0 if radial_conduction else 0.0,
+                 coolant_advection_W_K=coolant_advection_W_K, bearing_tc_1_K=bearing_tc_1_K)
+    # the blocks are added in this order, which fixes the network's block order
+    b.add_masses(nodes)
+    b.add_axial_chains()
+    b.add_interfaces()
+    b.add_bearings()
+    b.add_air_gaps()
+    surface_pieces = b.add_films()
+    b.add_sources(surface_pieces)
+    return LumpedNetwork(spec, nodes, b.net, b.parts, b.masses)
+
+
+def _node_number(nodes: int | str) -> int:
+    """The number of masses along shaft and housing: an int >= 2 or a preset's number."""
     if isinstance(nodes, str):
         if nodes not in PRESETS:
             raise SpecError([Problem("command line", "--nodes", f"unknown preset '{nodes}'",
@@ -225,246 +245,334 @@ def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = T
     if int(nodes) != nodes or nodes < 2:
         raise SpecError([Problem("command line", "--nodes", f"{nodes!r} is not an integer >= 2",
                                  "give the number of masses along shaft and housing, >= 2")])
-    nodes = int(nodes)
-    rad = 1.0 if radial_conduction else 0.0
-    net = Network(f"{spec.name}-{nodes}")
-    parts: dict[str, PartMasses] = {}
-    masses: list[Mass] = []
-    rings: dict[str, tuple] = {}
+    return int(nodes)
 
-    # ------------------------------------------------------------------ masses
-    for part in spec.parts:
-        bs = _bearing_sections(spec, part)
-        if bs is not None:
-            inner, rolling, outer, _ = bs
-            rings[part.name] = bs
-            pm = PartMasses(part, [], ring=True)
-            for tag, sec in (("inner", inner), ("outer", outer)):
-                C = sum(spec.materials[s.material].rho_kg_m3 * spec.materials[s.material].c_J_kgK
-                        * s.volume_m3 * (1.0 if s is sec else 0.5)
-                        for s in (sec, rolling))
-                m = Mass(f"{part.name}.{tag}", part.name, 0.5 * (sec.z_start + sec.z_end),
-                         sec.z_start, sec.z_end, section=sec)
-                m.block = HeatCapacitor(m.name, C_J_K=C, part=part.name, z_m=m.z_m)
-                pm.masses.append(m)
-            parts[part.name] = pm
-        else:
-            pm = PartMasses(part, [])
-            for k, (z, lo, hi) in enumerate(_slices(part, _node_count(spec, part, nodes))):
-                C = sum(spec.materials[s.material].rho_kg_m3 * spec.materials[s.material].c_J_kgK
-                        * _volume(s, lo, hi) for s in part.sections)
-                m = Mass(f"{part.name}[{k}]", part.name, z, lo, hi)
-                m.block = HeatCapacitor(m.name, C_J_K=C, part=part.name, z_m=z)
-                pm.masses.append(m)
-            parts[part.name] = pm
-        for m in parts[part.name].masses:
-            net.add(m.block)
-            masses.append(m)
 
-    ports = {"ambient": None, "coolant": None}
+def _capacity_J_K(spec: Spec, sec: Section, volume_m3: float) -> float:
+    """rho c V [J/K] of ``volume_m3`` of the section's material (eq. 6, 9)."""
+    m = spec.materials[sec.material]
+    return m.rho_kg_m3 * m.c_J_kgK * volume_m3
 
-    def fixed(ref: str):
+
+def _ring_masses(spec: Spec, part: Part, inner: Section, rolling: Section,
+                 outer: Section) -> PartMasses:
+    """A bearing's two ring masses; each takes half the rolling layer's capacity."""
+    pm = PartMasses(part, [], ring=True)
+    for tag, sec in (("inner", inner), ("outer", outer)):
+        C = sum(_capacity_J_K(spec, s, s.volume_m3) * (1.0 if s is sec else 0.5)
+                for s in (sec, rolling))
+        m = Mass(f"{part.name}.{tag}", part.name, 0.5 * (sec.z_start + sec.z_end),
+                 sec.z_start, sec.z_end, section=sec)
+        m.block = HeatCapacitor(m.name, C_J_K=C, part=part.name, z_m=m.z_m)
+        pm.masses.append(m)
+    return pm
+
+
+def _slice_masses(spec: Spec, part: Part, nodes: int) -> PartMasses:
+    """The z-slice masses of a part (module docstring: vertex-centred slices)."""
+    pm = PartMasses(part, [])
+    for k, (z, lo, hi) in enumerate(_slices(part, _node_count(spec, part, nodes))):
+        C = sum(_capacity_J_K(spec, s, _volume(s, lo, hi)) for s in part.sections)
+        m = Mass(f"{part.name}[{k}]", part.name, z, lo, hi)
+        m.block = HeatCapacitor(m.name, C_J_K=C, part=part.name, z_m=z)
+        pm.masses.append(m)
+    return pm
+
+
+def _add_to(acc: dict, key, value: float) -> None:
+    """acc[key] += value, starting from 0."""
+    acc[key] = acc.get(key, 0.0) + value
+
+
+class _Builder:
+    """The network under construction and the masses of each part; one method per kind of
+    block, called in the order of :func:`build_network`."""
+
+    def __init__(self, spec: Spec, net: Network, rad: float, coolant_advection_W_K: float | None,
+                 bearing_tc_1_K: float):
+        self.spec, self.net = spec, net
+        self.rad = rad  # 1, or 0 to drop the conduction from a mass to its faces
+        self.coolant_advection_W_K = coolant_advection_W_K
+        self.bearing_tc_1_K = bearing_tc_1_K
+        self.parts: dict[str, PartMasses] = {}
+        self.masses: list[Mass] = []
+        self.by_name: dict[str, Mass] = {}
+        self.rings: dict[str, tuple] = {}  # bearing part -> (inner, rolling, outer, link)
+        self.ports: dict[str, Block | None] = {"ambient": None, "coolant": None}
+
+    # ------------------------------------------------------------------ lookups
+    def owner(self, part: Part, sec: Section, z: float) -> Mass | None:
+        """The mass holding section ``sec`` of ``part`` at z (None for a rolling layer)."""
+        pm = self.parts[part.name]
+        if pm.ring:
+            inner, rolling, outer, _ = self.rings[part.name]
+            if sec is rolling:
+                return None  # the rolling layer touches only its rings (module docstring)
+            return pm.at(z, sec)
+        return pm.at(z)
+
+    def edges_of(self, part: Part) -> list[float]:
+        return [e for m in self.parts[part.name].masses for e in (m.z_lo, m.z_hi)]
+
+    def cuts(self, lo: float, hi: float, *parts: Part) -> list[tuple[float, float]]:
+        """[lo, hi] cut at the slice edges of ``parts``: pieces that each lie in one slice."""
+        edges = [e for part in parts for e in self.edges_of(part) if lo < e < hi]
+        cuts = sorted({lo, hi, *edges})
+        return list(zip(cuts, cuts[1:], strict=False))
+
+    def add_between(self, block: TwoPort, a: Mass, b: Mass) -> None:
+        """Add a two-port block from mass ``a`` (port_a) to mass ``b`` (port_b)."""
+        self.net.add(block)
+        self.net.connect(a.block.port, block.port_a)
+        self.net.connect(b.block.port, block.port_b)
+
+    def fixed(self, ref: str) -> HeatPort:
+        """The port of the ambient or coolant temperature (added on first use)."""
+        ports, net = self.ports, self.net
         if ports[ref] is None:
             ports[ref] = net.add(FixedTemperature(ref, source=ref))
-            if ref == "coolant" and coolant_advection_W_K is not None:
+            if ref == "coolant" and self.coolant_advection_W_K is not None:
                 # the films see the coolant's mean temperature: a junction behind the
                 # advection conductance 2 m_dot c_p
-                adv = net.add(ThermalConductor("coolant_advection", G_W_K=coolant_advection_W_K))
+                adv = net.add(ThermalConductor("coolant_advection", G_W_K=self.coolant_advection_W_K))
                 net.connect(ports[ref].port, adv.port_b)
                 ports["coolant_mean"] = adv
         if ref == "coolant" and "coolant_mean" in ports:
             return ports["coolant_mean"].port_a
         return ports[ref].port
 
+    # ------------------------------------------------------------------ masses
+    def add_masses(self, nodes: int) -> None:
+        """Two ring masses per bearing part, z-slice masses for every other part."""
+        for part in self.spec.parts:
+            bs = _bearing_sections(self.spec, part)
+            if bs is not None:
+                self.rings[part.name] = bs
+                pm = _ring_masses(self.spec, part, *bs[:3])
+            else:
+                pm = _slice_masses(self.spec, part, nodes)
+            self.parts[part.name] = pm
+            for m in pm.masses:
+                self.net.add(m.block)
+                self.masses.append(m)
+        self.by_name = {m.name: m for m in self.masses}
+
     # ------------------------------------------------------------------ axial chains
-    for pm in parts.values():
-        if pm.ring:
-            continue
-        for a, b in zip(pm.masses, pm.masses[1:], strict=False):
-            R = _axial_resistance(spec, pm.part, a.z_m, b.z_m)
-            c = net.add(ThermalConductor(f"axial:{a.name}-{b.name}", G_W_K=1.0 / R))
-            net.connect(a.block.port, c.port_a)
-            net.connect(b.block.port, c.port_b)
+    def add_axial_chains(self) -> None:
+        """Axial conduction between neighbouring slices of a part."""
+        for pm in self.parts.values():
+            if pm.ring:
+                continue
+            for a, b in zip(pm.masses, pm.masses[1:], strict=False):
+                R = _axial_resistance(self.spec, pm.part, a.z_m, b.z_m)
+                self.add_between(ThermalConductor(f"axial:{a.name}-{b.name}", G_W_K=1.0 / R), a, b)
 
     # ------------------------------------------------------------------ interfaces
-    contact_h = {frozenset(lk.parts): lk.h_W_m2K for lk in spec.links
-                 if isinstance(lk, ContactLink)}
-    conductance: dict[tuple[str, str], float] = {}
+    def add_interfaces(self) -> None:
+        """One conductor per pair of masses of touching parts, summed over the overlaps of
+        their slices: radial where two sections' z ranges overlap, else axial where one
+        section ends and the other starts."""
+        contact_h = {frozenset(lk.parts): lk.h_W_m2K for lk in self.spec.links
+                     if isinstance(lk, ContactLink)}
+        conductance: dict[tuple[str, str], float] = {}
+        sections = list(self.spec.sections())
+        for ia, (pa, sa) in enumerate(sections):
+            for pb, sb in sections[ia + 1:]:
+                if pa.name == pb.name:
+                    continue
+                h = contact_h.get(frozenset((pa.name, pb.name)))
+                a, b = max(sa.z_start, sb.z_start), min(sa.z_end, sb.z_end)
+                if b - a > TOL_M:  # radial interface?
+                    pieces = self._radial_interface(pa, sa, pb, sb, a, b, h)
+                else:
+                    pieces = self._axial_interface(pa, sa, pb, sb, h)
+                for key, G in pieces:
+                    _add_to(conductance, key, G)
+        for (na, nb), G in conductance.items():
+            self.add_between(ThermalConductor(f"contact:{na}-{nb}", G_W_K=G),
+                             self.by_name[na], self.by_name[nb])
 
-    def owner(part: Part, sec: Section, z: float) -> Mass | None:
-        pm = parts[part.name]
-        if pm.ring:
-            inner, rolling, outer, _ = rings[part.name]
-            if sec is rolling:
-                return None  # the rolling layer touches only its rings (module docstring)
-            return pm.at(z, sec)
-        return pm.at(z)
-
-    def edges_of(part: Part) -> list[float]:
-        return [e for m in parts[part.name].masses for e in (m.z_lo, m.z_hi)]
-
-    sections = list(spec.sections())
-    for ia, (pa, sa) in enumerate(sections):
-        for pb, sb in sections[ia + 1:]:
-            if pa.name == pb.name:
+    def _radial_interface(self, pa: Part, sa: Section, pb: Part, sb: Section, a: float,
+                          b: float, h: float | None) -> list[tuple[tuple[str, str], float]]:
+        """(mass names, conductance) of each slice overlap where one section's outer radius
+        is the other's inner radius over z in [a, b]."""
+        out = []
+        for lo, hi in ((sa, sb), (sb, sa)):
+            if not all(abs(float(lo.r_out(z)) - float(hi.r_in(z))) <= TOL_M for z in (a, b)):
                 continue
-            h = contact_h.get(frozenset((pa.name, pb.name)))
-            a, b = max(sa.z_start, sb.z_start), min(sa.z_end, sb.z_end)
-            if b - a > TOL_M:  # radial interface?
-                for lo, hi in ((sa, sb), (sb, sa)):
-                    if not all(abs(float(lo.r_out(z)) - float(hi.r_in(z))) <= TOL_M
-                               for z in (a, b)):
-                        continue
-                    plo, phi = (pa, pb) if lo is sa else (pb, pa)
-                    cuts = sorted({a, b, *[e for e in edges_of(plo) + edges_of(phi) if a < e < b]})
-                    for p, q in zip(cuts, cuts[1:], strict=False):
-                        zm, dz = 0.5 * (p + q), q - p
-                        ma, mb = owner(plo, lo, zm), owner(phi, hi, zm)
-                        if ma is None or mb is None or ma is mb:
-                            continue
-                        r = float(lo.r_out(zm))
-                        R = rad * (_radial_R(spec, lo, r, dz) + _radial_R(spec, hi, r, dz))
-                        if h is not None:
-                            R += 1.0 / (h * 2 * np.pi * r * dz)
-                        key = (ma.name, mb.name)
-                        conductance[key] = conductance.get(key, 0.0) + 1.0 / R
-                continue
-            for first, second, pf, ps in ((sa, sb, pa, pb), (sb, sa, pb, pa)):
-                if abs(first.z_end - second.z_start) > TOL_M:
+            plo, phi = (pa, pb) if lo is sa else (pb, pa)
+            for p, q in self.cuts(a, b, plo, phi):
+                zm, dz = 0.5 * (p + q), q - p
+                ma, mb = self.owner(plo, lo, zm), self.owner(phi, hi, zm)
+                if ma is None or mb is None or ma is mb:
                     continue
-                z = first.z_end
-                r1 = max(float(first.r_in(z)), float(second.r_in(z)))
-                r2 = min(float(first.r_out(z)), float(second.r_out(z)))
-                if r2 - r1 <= TOL_M:
-                    continue
-                A = np.pi * (r2 * r2 - r1 * r1)
-                ma, mb = owner(pf, first, z - TOL_M), owner(ps, second, z + TOL_M)
-                if ma is None or mb is None:
-                    continue
-                R = 0.0
-                for m, sec in ((ma, first), (mb, second)):
-                    mid = 0.5 * (m.z_lo + m.z_hi)
-                    R += rad * abs(z - mid) / (spec.materials[sec.material].k_z_W_mK * A)
+                r = float(lo.r_out(zm))
+                R = self.rad * (_radial_R(self.spec, lo, r, dz) + _radial_R(self.spec, hi, r, dz))
                 if h is not None:
-                    R += 1.0 / (h * A)
-                if R <= 0:
-                    continue
-                key = (ma.name, mb.name)
-                conductance[key] = conductance.get(key, 0.0) + 1.0 / R
-    by_name = {m.name: m for m in masses}
-    for (na, nb), G in conductance.items():
-        c = net.add(ThermalConductor(f"contact:{na}-{nb}", G_W_K=G))
-        net.connect(by_name[na].block.port, c.port_a)
-        net.connect(by_name[nb].block.port, c.port_b)
+                    R += 1.0 / (h * 2 * np.pi * r * dz)
+                out.append(((ma.name, mb.name), 1.0 / R))
+        return out
+
+    def _axial_interface(self, pa: Part, sa: Section, pb: Part, sb: Section,
+                         h: float | None) -> list[tuple[tuple[str, str], float]]:
+        """(mass names, conductance) where one section ends at the z where the other starts,
+        over the annulus their radii share."""
+        out = []
+        for first, second, pf, ps in ((sa, sb, pa, pb), (sb, sa, pb, pa)):
+            if abs(first.z_end - second.z_start) > TOL_M:
+                continue
+            z = first.z_end
+            r1 = max(float(first.r_in(z)), float(second.r_in(z)))
+            r2 = min(float(first.r_out(z)), float(second.r_out(z)))
+            if r2 - r1 <= TOL_M:
+                continue
+            A = np.pi * (r2 * r2 - r1 * r1)
+            ma, mb = self.owner(pf, first, z - TOL_M), self.owner(ps, second, z + TOL_M)
+            if ma is None or mb is None:
+                continue
+            R = 0.0
+            for m, sec in ((ma, first), (mb, second)):
+                mid = 0.5 * (m.z_lo + m.z_hi)
+                R += self.rad * abs(z - mid) / (self.spec.materials[sec.material].k_z_W_mK * A)
+            if h is not None:
+                R += 1.0 / (h * A)
+            if R <= 0:
+                continue
+            out.append(((ma.name, mb.name), 1.0 / R))
+        return out
 
     # ------------------------------------------------------------------ bearings
-    for name, (inner, rolling, outer, link) in rings.items():
-        L = rolling.z_end - rolling.z_start
-        z = 0.5 * (rolling.z_start + rolling.z_end)
-        R_rings = rad * (_radial_R(spec, inner, float(rolling.r_in(z)), L)
-                         + _radial_R(spec, outer, float(rolling.r_out(z)), L))
-        c = net.add(Convection(f"bearing:{name}", Gc_W_K=_series(link.G_W_K, R_rings)))
-        net.connect(parts[name].masses[0].block.port, c.port_a)
-        net.connect(parts[name].masses[1].block.port, c.port_b)
+    def add_bearings(self) -> None:
+        """G(n) of each rolling layer between its rings, in series with the rings' conduction."""
+        for name, (inner, rolling, outer, link) in self.rings.items():
+            L = rolling.z_end - rolling.z_start
+            z = 0.5 * (rolling.z_start + rolling.z_end)
+            R_rings = self.rad * (_radial_R(self.spec, inner, float(rolling.r_in(z)), L)
+                                  + _radial_R(self.spec, outer, float(rolling.r_out(z)), L))
+            ring_in, ring_out = self.parts[name].masses
+            self.add_between(Convection(f"bearing:{name}", Gc_W_K=_series(link.G_W_K, R_rings)),
+                             ring_in, ring_out)
 
     # ------------------------------------------------------------------ air gap
-    for lk in spec.links:
-        if not isinstance(lk, AirGapLink):
-            continue
-        pin, pout = spec.part(lk.inner), spec.part(lk.outer)
+    def add_air_gaps(self) -> None:
+        """Rotor-stator gap films, one per pair of facing masses."""
+        for lk in self.spec.links:
+            if not isinstance(lk, AirGapLink):
+                continue
+            for (na, nb), pcs in self._air_gap_pieces(lk).items():
+                self.add_between(Convection(f"air_gap:{na}-{nb}", Gc_W_K=_film(lk.h_W_m2K, pcs)),
+                                 self.by_name[na], self.by_name[nb])
+
+    def _air_gap_pieces(self, lk: AirGapLink) -> dict[tuple[str, str], list[tuple[float, float]]]:
+        """(rotor-side area [m2], conduction resistance [K/W]) of each slice overlap across
+        the gap, by pair of mass names."""
+        pin, pout = self.spec.part(lk.inner), self.spec.part(lk.outer)
         pieces: dict[tuple[str, str], list[tuple[float, float]]] = {}
         for si in pin.sections:
             for so in pout.sections:
                 a, b = max(si.z_start, so.z_start), min(si.z_end, so.z_end)
                 if b - a <= TOL_M:
                     continue
-                cuts = sorted({a, b, *[e for e in edges_of(pin) + edges_of(pout) if a < e < b]})
-                for p, q in zip(cuts, cuts[1:], strict=False):
+                for p, q in self.cuts(a, b, pin, pout):
                     zm, dz = 0.5 * (p + q), q - p
-                    ma, mb = owner(pin, si, zm), owner(pout, so, zm)
+                    ma, mb = self.owner(pin, si, zm), self.owner(pout, so, zm)
                     r = float(si.r_out(zm))
-                    R = rad * (_radial_R(spec, si, r, dz)
-                               + _radial_R(spec, so, float(so.r_in(zm)), dz))
+                    R = self.rad * (_radial_R(self.spec, si, r, dz)
+                                    + _radial_R(self.spec, so, float(so.r_in(zm)), dz))
                     pieces.setdefault((ma.name, mb.name), []).append((2 * np.pi * r * dz, R))
-        for (na, nb), pcs in pieces.items():
-            c = net.add(Convection(f"air_gap:{na}-{nb}", Gc_W_K=_film(lk.h_W_m2K, pcs)))
-            net.connect(by_name[na].block.port, c.port_a)
-            net.connect(by_name[nb].block.port, c.port_b)
+        return pieces
 
-    # ------------------------------------------------------------------ surfaces, sources
-    faces = exposed_faces(spec)
-
-    def face_pieces(f: Face) -> list[tuple[Mass, float, float]]:
+    # ------------------------------------------------------------------ surfaces
+    def face_pieces(self, f: Face) -> list[tuple[Mass, float, float]]:
         """(mass, area, conduction resistance to the face) for each slice the face crosses."""
+        spec, rad = self.spec, self.rad
         part = spec.part(f.part)
         if f.is_line:
-            cuts = sorted({f.lo, f.hi, *[e for e in edges_of(part) if f.lo < e < f.hi]})
             out = []
-            for p, q in zip(cuts, cuts[1:], strict=False):
+            for p, q in self.cuts(f.lo, f.hi, part):
                 piece = Face(f.part, f.section, f.side, p, q)
                 zm = 0.5 * (p + q)
-                m = owner(part, f.section, zm)
+                m = self.owner(part, f.section, zm)
                 if m is None:
                     continue
                 out.append((m, piece.area_m2, rad * _radial_R(spec, f.section, f.radius(zm), q - p)))
             return out
-        m = owner(part, f.section, f.z - TOL_M if f.side == "front" else f.z + TOL_M)
+        m = self.owner(part, f.section, f.z - TOL_M if f.side == "front" else f.z + TOL_M)
         if m is None:
             return []
         A = f.area_m2
         mid = 0.5 * (m.z_lo + m.z_hi)
         return [(m, A, rad * abs(f.z - mid) / (spec.materials[f.section.material].k_z_W_mK * A))]
 
-    surface_map: dict[str, list[tuple[Mass, float, float]]] = {}
-    for s in spec.surfaces:
-        surface_map[s.name] = [p for f in surface_faces(s, faces) for p in face_pieces(f)]
-        if s.h_W_m2K is None:
-            continue
-        grouped: dict[str, list[tuple[float, float]]] = {}
-        for m, A, R in surface_map[s.name]:
-            grouped.setdefault(m.name, []).append((A, R))
-        for mname, pcs in grouped.items():
-            c = net.add(Convection(f"film:{s.name}:{mname}", Gc_W_K=_film(s.h_W_m2K, pcs)))
-            net.connect(by_name[mname].block.port, c.port_a)
-            net.connect(fixed(s.T_ref), c.port_b)
+    def add_films(self) -> dict[str, list[tuple[Mass, float, float]]]:
+        """Film conductances of the surfaces with a film coefficient; returns the face pieces
+        of every named surface (for the surface heat sources)."""
+        faces = exposed_faces(self.spec)
+        surface_map: dict[str, list[tuple[Mass, float, float]]] = {}
+        for s in self.spec.surfaces:
+            surface_map[s.name] = [p for f in surface_faces(s, faces) for p in self.face_pieces(f)]
+            if s.h_W_m2K is None:
+                continue
+            grouped: dict[str, list[tuple[float, float]]] = {}
+            for m, A, R in surface_map[s.name]:
+                grouped.setdefault(m.name, []).append((A, R))
+            for mname, pcs in grouped.items():
+                # the ambient or coolant port is added after the first film that uses it
+                c = self.net.add(Convection(f"film:{s.name}:{mname}", Gc_W_K=_film(s.h_W_m2K, pcs)))
+                self.net.connect(self.by_name[mname].block.port, c.port_a)
+                self.net.connect(self.fixed(s.T_ref), c.port_b)
+        return surface_map
 
-    for src in spec.heat_sources:
-        shares: dict[str, float] = {}
-        if src.surface is not None:
-            pcs = surface_map[src.surface]
-            total = sum(A for _, A, _ in pcs)
-            for m, A, _ in pcs:
-                shares[m.name] = shares.get(m.name, 0.0) + A / total
-        else:
-            part = spec.part(src.part)
-            secs = [s for s in part.sections if src.section is None or s.name == src.section]
-            pm = parts[part.name]
-            weights: dict[str, float] = {}
-            for s in secs:
-                if pm.ring:
-                    inner, rolling, outer, _ = rings[part.name]
-                    targets = [(pm.masses[0], 0.5), (pm.masses[1], 0.5)] if s is rolling else \
-                        [(pm.at(0.0, s), 1.0)] if pm.at(0.0, s) else []
-                    for m, f in targets:
-                        weights[m.name] = weights.get(m.name, 0.0) + f * s.volume_m3
-                else:
-                    for m in pm.masses:
-                        v = _volume(s, m.z_lo, m.z_hi)
-                        if v > 0:
-                            weights[m.name] = weights.get(m.name, 0.0) + v
-            total = sum(weights.values())
-            shares = {k: v / total for k, v in weights.items()}
-        preload = None
-        if bearing_tc_1_K and src.part is not None and parts[src.part].ring:
-            inner_m, outer_m = parts[src.part].masses
-            preload = (inner_m.block.port, outer_m.block.port)
-        for mname, share in shares.items():
-            q = net.add(PrescribedHeatFlow(f"source:{src.name}:{mname}", source=src.name,
-                                           share=share, tc_1_K=bearing_tc_1_K if preload else 0.0,
-                                           across=preload))
-            net.connect(by_name[mname].block.port, q.port)
+    # ------------------------------------------------------------------ sources
+    def add_sources(self, surface_map: dict[str, list[tuple[Mass, float, float]]]) -> None:
+        """Each heat source split over masses by volume or area; bearing friction optionally
+        rising with the ring temperature difference (``bearing_tc_1_K``)."""
+        tc = self.bearing_tc_1_K
+        for src in self.spec.heat_sources:
+            if src.surface is not None:
+                shares = _area_shares(surface_map[src.surface])
+            else:
+                shares = self._volume_shares(src)
+            preload = None
+            if tc and src.part is not None and self.parts[src.part].ring:
+                inner_m, outer_m = self.parts[src.part].masses
+                preload = (inner_m.block.port, outer_m.block.port)
+            for mname, share in shares.items():
+                q = self.net.add(PrescribedHeatFlow(f"source:{src.name}:{mname}", source=src.name,
+                                                    share=share, tc_1_K=tc if preload else 0.0,
+                                                    across=preload))
+                self.net.connect(self.by_name[mname].block.port, q.port)
 
-    return LumpedNetwork(spec, nodes, net, parts, masses)
+    def _volume_shares(self, src: HeatSource) -> dict[str, float]:
+        """Fractions of a part (or section) source per mass, by volume; a bearing's rolling
+        layer feeds both rings half each."""
+        part = self.spec.part(src.part)
+        secs = [s for s in part.sections if src.section is None or s.name == src.section]
+        pm = self.parts[part.name]
+        weights: dict[str, float] = {}
+        for s in secs:
+            if pm.ring:
+                inner, rolling, outer, _ = self.rings[part.name]
+                targets = [(pm.masses[0], 0.5), (pm.masses[1], 0.5)] if s is rolling else \
+                    [(pm.at(0.0, s), 1.0)] if pm.at(0.0, s) else []
+                for m, f in targets:
+                    _add_to(weights, m.name, f * s.volume_m3)
+            else:
+                for m in pm.masses:
+                    v = _volume(s, m.z_lo, m.z_hi)
+                    if v > 0:
+                        _add_to(weights, m.name, v)
+        total = sum(weights.values())
+        return {k: v / total for k, v in weights.items()}
+
+
+def _area_shares(pieces: list[tuple[Mass, float, float]]) -> dict[str, float]:
+    """Fractions of a surface source per mass, by the area of its face pieces."""
+    shares: dict[str, float] = {}
+    total = sum(A for _, A, _ in pieces)
+    for m, A, _ in pieces:
+        _add_to(shares, m.name, A / total)
+    return shares
 
 
 def _series(G: SpeedTable, R_extra: float):

@@ -86,24 +86,7 @@ class Network:
         """Check the network and build :class:`ThermalSystem`; raises :class:`NetworkError`
         listing every unconnected port, conflicting fixed temperature and node group without a
         path to a fixed temperature."""
-        problems: list[str] = []
-        connected = self._connected
-        for b in self.blocks:
-            for p in b.ports:
-                if p not in connected:
-                    problems.append(f"port {p!r} is not connected; fix: connect it or remove "
-                                    f"block '{b.name}'")
-        for b in self.blocks:
-            bad = [(k, v) for k, v in (("C_J_K", getattr(b, "C_J_K", 0.0)),
-                                       ("G_W_K", getattr(b, "G_W_K", 0.0))) if v < 0]
-            if isinstance(b, Convection) and isinstance(b.Gc_W_K, SpeedTable) \
-                    and b.Gc_W_K.min < 0:
-                bad.append(("Gc_W_K", b.Gc_W_K.min))
-            elif isinstance(b, Convection) and isinstance(b.Gc_W_K, int | float) \
-                    and b.Gc_W_K < 0:
-                bad.append(("Gc_W_K", b.Gc_W_K))
-            problems += [f"block '{b.name}': {k} = {v:g} is negative; fix: give a value >= 0"
-                         for k, v in bad]
+        problems = self._port_problems() + self._value_problems()
         if problems:
             raise NetworkError(self.name, problems)
 
@@ -116,6 +99,53 @@ class Network:
         def node(p: HeatPort) -> int:
             return roots[self._root(p)]
 
+        capacity, labels, fixed, where = self._nodes(n_all, node, problems)
+        edges: list[tuple[int, int, Conductance, str]] = []
+        for b in self.blocks:
+            if isinstance(b, ThermalConductor):
+                edges.append((node(b.port_a), node(b.port_b), float(b.G_W_K), b.name))
+            elif isinstance(b, Convection):
+                edges.append((node(b.port_a), node(b.port_b), b.Gc_W_K, b.name))
+        flows = [(node(b.port), b) for b in self.blocks if isinstance(b, PrescribedHeatFlow)]
+        across = {id(b): (node(b.across[0]), node(b.across[1])) for _, b in flows
+                  if b.across is not None}
+        problems += _unheld_groups(n_all, edges, fixed, labels)
+        if problems:
+            raise NetworkError(self.name, problems)
+
+        free = [i for i in range(n_all) if i not in fixed]
+        fixed_nodes = sorted(fixed)
+        fixed_sources = [fixed[i] for i in fixed_nodes]
+        source_names = list(dict.fromkeys(f.source for _, f in flows))
+        return ThermalSystem(
+            name=self.name, n_all=n_all, free=free, fixed_nodes=fixed_nodes,
+            fixed_sources=fixed_sources, capacity=capacity, labels=labels, where=where,
+            edges=edges, flows=flows, source_names=source_names, across=across)
+
+    def _port_problems(self) -> list[str]:
+        """Every port left unconnected."""
+        return [f"port {p!r} is not connected; fix: connect it or remove block '{b.name}'"
+                for b in self.blocks for p in b.ports if p not in self._connected]
+
+    def _value_problems(self) -> list[str]:
+        """Every negative capacity or conductance."""
+        problems = []
+        for b in self.blocks:
+            bad = [(k, v) for k, v in (("C_J_K", getattr(b, "C_J_K", 0.0)),
+                                       ("G_W_K", getattr(b, "G_W_K", 0.0))) if v < 0]
+            if isinstance(b, Convection) and isinstance(b.Gc_W_K, SpeedTable) \
+                    and b.Gc_W_K.min < 0:
+                bad.append(("Gc_W_K", b.Gc_W_K.min))
+            elif isinstance(b, Convection) and isinstance(b.Gc_W_K, int | float) \
+                    and b.Gc_W_K < 0:
+                bad.append(("Gc_W_K", b.Gc_W_K))
+            problems += [f"block '{b.name}': {k} = {v:g} is negative; fix: give a value >= 0"
+                         for k, v in bad]
+        return problems
+
+    def _nodes(self, n_all: int, node, problems: list[str]) -> tuple:
+        """Per node: capacity [J/K], block labels, fixed temperature source and location;
+        clashing fixed temperatures are appended to ``problems``."""
         capacity = np.zeros(n_all)
         labels: list[list[str]] = [[] for _ in range(n_all)]
         fixed: dict[int, str | float] = {}
@@ -134,50 +164,35 @@ class Network:
                                     "through a conductor")
                 fixed[i] = b.source
                 labels[i].append(b.name)
-        edges: list[tuple[int, int, Conductance, str]] = []
-        for b in self.blocks:
-            if isinstance(b, ThermalConductor):
-                edges.append((node(b.port_a), node(b.port_b), float(b.G_W_K), b.name))
-            elif isinstance(b, Convection):
-                edges.append((node(b.port_a), node(b.port_b), b.Gc_W_K, b.name))
-        flows = [(node(b.port), b) for b in self.blocks if isinstance(b, PrescribedHeatFlow)]
-        across = {id(b): (node(b.across[0]), node(b.across[1])) for _, b in flows
-                  if b.across is not None}
+        return capacity, labels, fixed, where
 
-        # every group of unknown nodes joined by conductances needs a fixed temperature
-        adj: dict[int, set[int]] = {i: set() for i in range(n_all)}
-        for i, j, G, _ in edges:
-            if _may_conduct(G):
-                adj[i].add(j)
-                adj[j].add(i)
-        seen: set[int] = set()
-        for start in range(n_all):
-            if start in seen or start in fixed:
-                continue
-            group, stack = set(), [start]
-            while stack:
-                k = stack.pop()
-                if k not in group:
-                    group.add(k)
-                    stack.extend(adj[k] - group)
-            seen |= group
-            if not group & set(fixed):
-                names = sorted({lab for k in group for lab in labels[k]}) or ["(junction)"]
-                problems.append(f"nodes {names[:6]}{' ...' if len(names) > 6 else ''} have no "
-                                "heat path to a fixed temperature (the system would be "
-                                "singular); fix: add a Convection or ThermalConductor to a "
-                                "FixedTemperature")
-        if problems:
-            raise NetworkError(self.name, problems)
 
-        free = [i for i in range(n_all) if i not in fixed]
-        fixed_nodes = sorted(fixed)
-        fixed_sources = [fixed[i] for i in fixed_nodes]
-        source_names = list(dict.fromkeys(f.source for _, f in flows))
-        return ThermalSystem(
-            name=self.name, n_all=n_all, free=free, fixed_nodes=fixed_nodes,
-            fixed_sources=fixed_sources, capacity=capacity, labels=labels, where=where,
-            edges=edges, flows=flows, source_names=source_names, across=across)
+def _unheld_groups(n_all: int, edges, fixed: dict, labels: list[list[str]]) -> list[str]:
+    """Every group of unknown nodes joined by conductances needs a fixed temperature: one
+    problem per group without one (the system would be singular)."""
+    adj: dict[int, set[int]] = {i: set() for i in range(n_all)}
+    for i, j, G, _ in edges:
+        if _may_conduct(G):
+            adj[i].add(j)
+            adj[j].add(i)
+    problems, seen = [], set()
+    for start in range(n_all):
+        if start in seen or start in fixed:
+            continue
+        group, stack = set(), [start]
+        while stack:
+            k = stack.pop()
+            if k not in group:
+                group.add(k)
+                stack.extend(adj[k] - group)
+        seen |= group
+        if not group & set(fixed):
+            names = sorted({lab for k in group for lab in labels[k]}) or ["(junction)"]
+            problems.append(f"nodes {names[:6]}{' ...' if len(names) > 6 else ''} have no "
+                            "heat path to a fixed temperature (the system would be "
+                            "singular); fix: add a Convection or ThermalConductor to a "
+                            "FixedTemperature")
+    return problems
 
 
 def _may_conduct(G: Conductance) -> bool:

@@ -24,6 +24,7 @@ import io
 import math
 import re
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -308,6 +309,10 @@ def _has_skipped_line(text: str) -> bool:
     return False
 
 
+#: What every check of :func:`read_bench` raises: InputError(file, field, message, fix).
+_ErrorFor = Callable[[str, str, str], InputError]
+
+
 def read_bench(path: str | Path) -> BenchRun:
     """Read a test-bench run (CSV, format: docs/bench.md) into a :class:`BenchRun`.
 
@@ -324,6 +329,34 @@ def read_bench(path: str | Path) -> BenchRun:
     def error(fld: str, message: str, fix: str) -> InputError:
         return InputError(name, fld, message, fix)
 
+    lines = _read_lines(path, error)
+    metadata, header_idx = _comments_before_header(lines, error)
+    header, seen = _read_header(lines, header_idx, error)
+    table = _read_rows(lines, header_idx, header, error)
+    line_no = table.line_no
+    t = _read_time(table, seen["time_s"], error)
+    columns = _read_known_columns(table, seen, error)
+    _check_plausible(columns, line_no, error)
+    extra = _read_unknown_columns(table, header)
+    unknown = list(extra)
+    for h in unknown:
+        hint = next((_hint_for(k, [h]) for k in KNOWN_COLUMNS if _hint_for(k, [h])), "")
+        if hint:
+            warnings.warn(BenchWarning(f"{name}: {h}: kept as an unknown column{hint}"), stacklevel=2)
+
+    channels = [c for c, col in CHANNEL_COLUMNS.items() if col in columns]
+    p1_ref = _zero_P1(columns)
+    _check_enough_data(t, columns, channels, error)
+    torque_measured = "load_torque_Nm" in columns
+    if not torque_measured:
+        columns["load_torque_Nm"] = np.zeros(len(t))
+    return BenchRun(path=path, metadata=metadata, time_s=t, columns=columns, extra=extra,
+                    unknown_columns=unknown, channels=channels, duration_s=float(t[-1]),
+                    lines=line_no, P1_reference_um=p1_ref, load_torque_measured=torque_measured)
+
+
+def _read_lines(path: Path, error: _ErrorFor) -> list[str]:
+    """The file's lines (UTF-8; a byte-order mark dropped)."""
     try:
         raw = path.read_bytes()
     except OSError as exc:
@@ -331,12 +364,13 @@ def read_bench(path: str | Path) -> BenchRun:
                     "check the path of the bench export") from None
     if not raw.strip():
         raise error("file", "is empty", "export the bench run again (a header row and data rows)")
-    text = _decode(raw, name)
-    lines = text.split("\n")
+    return _decode(raw, str(path)).split("\n")
 
-    # ------------------------------------------------------------- comments, header, rows
+
+def _comments_before_header(lines: list[str], error: _ErrorFor) -> tuple[dict[str, str], int]:
+    """The ``# key: value`` metadata of the comment lines before the header (a key without
+    spaces), and the index of the header line (the first line that is not blank or a comment)."""
     metadata: dict[str, str] = {}
-    header_idx = -1
     for k, line in enumerate(lines):
         s = line.strip()
         if not s:
@@ -347,12 +381,16 @@ def read_bench(path: str | Path) -> BenchRun:
             if sep and key and not any(ch.isspace() for ch in key):
                 metadata[key] = value.strip()
             continue
-        header_idx = k
-        break
-    if header_idx < 0:
-        raise error("header", "the file has no header row (only comments)",
-                    "export the run with its header row, e.g. 'time_s,speed_rpm,power_kW,"
-                    "T_env_C,T_coolant_C,T1_C'")
+        return metadata, k
+    raise error("header", "the file has no header row (only comments)",
+                "export the run with its header row, e.g. 'time_s,speed_rpm,power_kW,"
+                "T_env_C,T_coolant_C,T1_C'")
+
+
+def _read_header(lines: list[str], header_idx: int,
+                 error: _ErrorFor) -> tuple[list[str], dict[str, int]]:
+    """The column names and the index of each: comma-separated, no duplicates, the required
+    columns and at least one measured channel."""
     hline = header_idx + 1
     header = [h.strip() for h in next(csv.reader([lines[header_idx].rstrip("\r")]))]
     if len(header) == 1 and any(sep in header[0] for sep in (";", "\t")):
@@ -381,27 +419,35 @@ def read_bench(path: str | Path) -> BenchRun:
         raise error(f"header (line {hline})", "no measured channel: the run has none of the columns "
                     f"{', '.join(CHANNEL_COLUMNS.values())}{hints}",
                     "export at least one of the sensor columns the model is checked against")
+    return header, seen
 
-    ncol = len(header)
+
+def _read_rows(lines: list[str], header_idx: int, header: list[str], error: _ErrorFor) -> _Table:
+    """The data rows: at least one, each with one cell per column."""
+    hline = header_idx + 1
     table = _Table.parse(lines, header_idx, header)
     line_no = table.line_no
     if table.bad_row >= 0:
         raise error(f"line {line_no[table.bad_row]}", f"has {table.row_lengths[table.bad_row]} cells, "
-                    f"the header (line {hline}) has {ncol}", "give every row one cell per column (an "
-                    "empty cell for a value not measured)")
+                    f"the header (line {hline}) has {len(header)}", "give every row one cell per "
+                    "column (an empty cell for a value not measured)")
     if not len(line_no):
         raise error("rows", f"the file has a header (line {hline}) but no data rows",
                     "export the run with its data")
+    return table
 
-    # ------------------------------------------------------------------------- time
-    t, _ = table.column(seen["time_s"])
+
+def _read_time(table: _Table, j: int, error: _ErrorFor) -> np.ndarray:
+    """time_s (column j) [s]: a finite number in every row, >= 0, strictly increasing."""
+    line_no = table.line_no
+    t, _ = table.column(j)
     if t is None or np.isnan(t).any():
         if t is None:  # the first cell that is empty or not a number
-            k = next(i for i, c in enumerate(table.strings(seen["time_s"]))
+            k = next(i for i, c in enumerate(table.strings(j))
                      if not _is_number(c) or c.lower() == "nan")
         else:
             k = int(np.flatnonzero(np.isnan(t))[0])
-        cell = table.cell(seen["time_s"], k)
+        cell = table.cell(j, k)
         what = "is empty" if not cell or cell.lower() == "nan" else f"'{cell}' is not a number"
         raise error(f"time_s (line {line_no[k]})", f"{what}; every row needs its time",
                     "give the time since the start of the run [s] in every row, or delete the row")
@@ -417,8 +463,14 @@ def read_bench(path: str | Path) -> BenchRun:
         raise error(f"time_s (line {line_no[k]})", f"{t[k]:g} s is not after {t[k - 1]:g} s on line "
                     f"{line_no[k - 1]}: time must increase strictly",
                     "export the rows in time order without duplicate rows")
+    return t
 
-    # ----------------------------------------------------------------- known columns
+
+def _read_known_columns(table: _Table, seen: dict[str, int],
+                        error: _ErrorFor) -> dict[str, np.ndarray]:
+    """The known columns present except time_s, in file units: numbers or empty cells,
+    finite, not empty in every row."""
+    line_no = table.line_no
     columns: dict[str, np.ndarray] = {}
     for col in KNOWN_COLUMNS[1:]:
         if col not in seen:
@@ -436,9 +488,13 @@ def read_bench(path: str | Path) -> BenchRun:
             raise error(col, "the column is empty in every row",
                         "export the measurement, or drop the column if it was not measured")
         columns[col] = arr
-    _check_plausible(columns, line_no, error)
+    return columns
 
-    # --------------------------------------------------------------- unknown columns
+
+def _read_unknown_columns(table: _Table, header: list[str]) -> dict[str, np.ndarray | list[str]]:
+    """Columns the format does not define, by name (an unnamed one as '(column j)'), as
+    floats or, if a cell is not a number, as strings; an unnamed empty column (a trailing
+    separator) is no column."""
     extra: dict[str, np.ndarray | list[str]] = {}
     for j, h in enumerate(header):
         if h in KNOWN_COLUMNS:
@@ -449,19 +505,22 @@ def read_bench(path: str | Path) -> BenchRun:
                 continue  # a trailing separator: no column
             h = f"(column {j + 1})"
         extra[h] = arr if arr is not None else table.strings(j)
-    unknown = list(extra)
-    for h in unknown:
-        hint = next((_hint_for(k, [h]) for k in KNOWN_COLUMNS if _hint_for(k, [h])), "")
-        if hint:
-            warnings.warn(BenchWarning(f"{name}: {h}: kept as an unknown column{hint}"), stacklevel=2)
+    return extra
 
-    # ------------------------------------------------------------- channels and data
-    channels = [c for c, col in CHANNEL_COLUMNS.items() if col in columns]
-    p1_ref = None
-    if "P1_um" in columns:
-        p1 = columns["P1_um"]
-        p1_ref = float(p1[np.flatnonzero(~np.isnan(p1))[0]])
-        columns["P1_um"] = p1 - p1_ref
+
+def _zero_P1(columns: dict[str, np.ndarray]) -> float | None:
+    """Zero P1_um at its first valid sample (in place); returns that raw reading."""
+    if "P1_um" not in columns:
+        return None
+    p1 = columns["P1_um"]
+    p1_ref = float(p1[np.flatnonzero(~np.isnan(p1))[0]])
+    columns["P1_um"] = p1 - p1_ref
+    return p1_ref
+
+
+def _check_enough_data(t: np.ndarray, columns: dict[str, np.ndarray], channels: list[str],
+                       error: _ErrorFor) -> None:
+    """At least MIN_ROWS rows with a measured channel over MIN_SPAN_S."""
     measured = np.zeros(len(t), dtype=bool)
     for c in channels:
         measured |= ~np.isnan(columns[CHANNEL_COLUMNS[c]])
@@ -472,12 +531,6 @@ def read_bench(path: str | Path) -> BenchRun:
                     f"({', '.join(channels)}) spanning {span / 60:.1f} min",
                     f"export a run with at least {MIN_ROWS} rows with a measured channel over at "
                     f"least {MIN_SPAN_S / 60:.0f} min")
-    torque_measured = "load_torque_Nm" in columns
-    if not torque_measured:
-        columns["load_torque_Nm"] = np.zeros(len(t))
-    return BenchRun(path=path, metadata=metadata, time_s=t, columns=columns, extra=extra,
-                    unknown_columns=unknown, channels=channels, duration_s=float(t[-1]),
-                    lines=line_no, P1_reference_um=p1_ref, load_torque_measured=torque_measured)
 
 
 def _is_number(s: str) -> bool:
@@ -488,7 +541,7 @@ def _is_number(s: str) -> bool:
     return True
 
 
-def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error: Any) -> None:
+def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error: _ErrorFor) -> None:
     """Temperatures in °C (not kelvin, >= -60 °C), speed 0..100 000 rpm, power within
     ±1000 kW; the first offending line is named."""
 

@@ -22,7 +22,6 @@ step, row or line) and the fix.
 
 from __future__ import annotations
 
-import csv
 import math
 import tomllib
 from collections.abc import Callable, Mapping
@@ -33,6 +32,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from spindle.commented_csv import split_commented_csv
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
 
@@ -294,7 +294,9 @@ def _is_number(v: Any) -> bool:
 
 
 class _File:
-    """Error helpers bound to one file."""
+    """Error helpers bound to one file. They raise at the first problem, where
+    spindle.spec's reader collects every problem of a spec; the two word their messages
+    differently (the tests check the words), so they stay apart."""
 
     def __init__(self, path: Path):
         self.name = str(path)
@@ -377,31 +379,42 @@ def _read_temperature(f: _File, data: Mapping[str, Any], key: str, duration_s: f
             raise f.error(f"{key}.T_C", "required field is missing", "add T_C = <degC>")
         return TimeSeries.constant(f.temperature(d["T_C"], f"{key}.T_C") + ZERO_C_K)
     if model == "table":
-        f.unknown_keys(d, ("model", "T_C", "time_s", "time_h"), key)
-        if ("time_s" in d) == ("time_h" in d):
-            raise f.error(f"{key}.time_h", "a table needs exactly one of time_s and time_h",
-                          "write time_h = [0, 8, 16] and T_C = [20, 22, 21]")
-        tkey = "time_s" if "time_s" in d else "time_h"
-        times, temps = d[tkey], d.get("T_C")
-        if not isinstance(times, list) or not times:
-            raise f.error(f"{key}.{tkey}", "is not a non-empty list", f"write {tkey} = [0, ...]")
-        if not isinstance(temps, list) or len(temps) != len(times):
-            raise f.error(f"{key}.T_C", f"needs a list of {len(times)} values (one per {tkey})",
-                          f"give one T_C value per {tkey} entry")
-        scale = 1.0 if tkey == "time_s" else 3600.0
-        t = []
-        for i, v in enumerate(times):
-            if not _is_number(v) or not math.isfinite(v):
-                raise f.error(f"{key}.{tkey}[{i}]", f"{v!r} is not a number", "write a number")
-            t.append(float(v) * scale)
-        if t[0] < 0:
-            raise f.error(f"{key}.{tkey}[0]", "is negative", "start the table at 0 or later")
-        for i in range(1, len(t)):
-            if t[i] <= t[i - 1]:
-                raise f.error(f"{key}.{tkey}[{i}]", "time does not increase",
-                              "sort the entries by time and remove duplicates")
-        T = [f.temperature(v, f"{key}.T_C[{i}]") + ZERO_C_K for i, v in enumerate(temps)]
-        return TimeSeries(tuple(t), tuple(T), "linear")
+        return _read_temperature_table(f, d, key)
+    return _generated_temperature(f, d, key, model, duration_s)
+
+
+def _read_temperature_table(f: _File, d: dict[str, Any], key: str) -> TimeSeries:
+    """A table of T_C against time_s or time_h (increasing), linear between entries [K]."""
+    f.unknown_keys(d, ("model", "T_C", "time_s", "time_h"), key)
+    if ("time_s" in d) == ("time_h" in d):
+        raise f.error(f"{key}.time_h", "a table needs exactly one of time_s and time_h",
+                      "write time_h = [0, 8, 16] and T_C = [20, 22, 21]")
+    tkey = "time_s" if "time_s" in d else "time_h"
+    times, temps = d[tkey], d.get("T_C")
+    if not isinstance(times, list) or not times:
+        raise f.error(f"{key}.{tkey}", "is not a non-empty list", f"write {tkey} = [0, ...]")
+    if not isinstance(temps, list) or len(temps) != len(times):
+        raise f.error(f"{key}.T_C", f"needs a list of {len(times)} values (one per {tkey})",
+                      f"give one T_C value per {tkey} entry")
+    scale = 1.0 if tkey == "time_s" else 3600.0
+    t = []
+    for i, v in enumerate(times):
+        if not _is_number(v) or not math.isfinite(v):
+            raise f.error(f"{key}.{tkey}[{i}]", f"{v!r} is not a number", "write a number")
+        t.append(float(v) * scale)
+    if t[0] < 0:
+        raise f.error(f"{key}.{tkey}[0]", "is negative", "start the table at 0 or later")
+    for i in range(1, len(t)):
+        if t[i] <= t[i - 1]:
+            raise f.error(f"{key}.{tkey}[{i}]", "time does not increase",
+                          "sort the entries by time and remove duplicates")
+    T = [f.temperature(v, f"{key}.T_C[{i}]") + ZERO_C_K for i, v in enumerate(temps)]
+    return TimeSeries(tuple(t), tuple(T), "linear")
+
+
+def _generated_temperature(f: _File, d: dict[str, Any], key: str, model: str,
+                           duration_s: float) -> TimeSeries:
+    """The temperature [K] of one of the :data:`GENERATORS` over ``duration_s``."""
     allowed = _GENERATOR_KEYS[model]
     f.unknown_keys(d, ("model", *allowed), key)
     kwargs: dict[str, float] = {}
@@ -480,81 +493,23 @@ def read_cycle_steps_csv(path: str | Path, *, T_ambient_C: float | None = None,
     """
     path = Path(path)
     f = _File(path)
-    text = _read_text(path, f)
-    meta: dict[str, tuple[str, int]] = {}
-    numbered: list[tuple[int, str]] = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        s = line.strip()
-        if not s:
-            continue
-        if s.startswith("#"):
-            key, sep, value = s[1:].partition(":")
-            if sep and key.strip() in _CSV_META:
-                meta[key.strip()] = (value.strip(), lineno)
-            continue
-        numbered.append((lineno, line))
-    if not numbered:
+    table = split_commented_csv(_read_text(path, f))
+    meta: dict[str, tuple[str, int]] = {}  # key -> (value, file line); the last one counts
+    for lineno, comment in table.comments:
+        key, sep, value = comment.partition(":")
+        if sep and key.strip() in _CSV_META:
+            meta[key.strip()] = (value.strip(), lineno)
+    if not table.line_no:
         raise f.error("header", "the file has no header row",
                       "add a header such as 'speed_rpm,duration_s,load_torque_Nm'")
-    rows = list(csv.reader([ln for _, ln in numbered]))
-    header = [h.strip() for h in rows[0]]
-    hline = numbered[0][0]
-    for col in _CSV_REQUIRED:
-        if col not in header:
-            raise f.error(col, f"required column is missing from the header (line {hline})",
-                          f"add a '{col}' column (header: {','.join(_CSV_REQUIRED + _CSV_OPTIONAL)})")
-    for h in header:
-        if h not in _CSV_REQUIRED + _CSV_OPTIONAL:
-            raise f.error(f"{h or '(empty)'} (line {hline})", "is not a step column",
-                          f"use only {list(_CSV_REQUIRED + _CSV_OPTIONAL)}")
-        if header.count(h) > 1:
-            raise f.error(f"{h} (line {hline})", "column appears twice", "keep one of them")
-    if len(rows) < 2:
+    header, hline = table.header, table.line_no[0]
+    _check_steps_header(f, header, hline)
+    if len(table.rows) < 2:
         raise f.error("steps", "the step table is empty", "add one row per step below the header")
-    steps = []
-    for (lineno, _), row in zip(numbered[1:], rows[1:], strict=True):
-        if len(row) != len(header):
-            raise f.error(f"line {lineno}", f"has {len(row)} cells, the header has {len(header)}",
-                          "give every row one cell per column")
-        vals: dict[str, float | None] = {}
-        for h, cell in zip(header, row, strict=True):
-            fld = f"{h} (line {lineno})"
-            cell = cell.strip()
-            if not cell:
-                if h in _CSV_REQUIRED:
-                    raise f.error(fld, "is empty", "give a number in every row")
-                vals[h] = None
-                continue
-            try:
-                v = float(cell)
-            except ValueError:
-                raise f.error(fld, f"'{cell}' is not a number",
-                              "write a decimal number with '.' as the separator") from None
-            if not math.isfinite(v):
-                raise f.error(fld, "is not finite", "write a finite number")
-            if v < 0:
-                raise f.error(fld, f"{v:g} is negative", f"give {h} >= 0")
-            if h == "duration_s" and v == 0:
-                raise f.error(fld, "is zero", "give every step a duration > 0 s or drop the row")
-            vals[h] = v
-        steps.append(Step(vals["speed_rpm"], vals["duration_s"],  # type: ignore[arg-type]
-                          vals.get("load_torque_Nm") or 0.0, vals.get("power_kW")))
-
-    def meta_temperature(key: str, override: float | None, default: float) -> float:
-        if override is not None:
-            return f.temperature(override, key)
-        if key not in meta:
-            return default
-        value, lineno = meta[key]
-        try:
-            v = float(value)
-        except ValueError:
-            raise f.error(f"{key} (line {lineno})", f"'{value}' is not a number",
-                          f"write '# {key}: 20.0'") from None
-        return f.temperature(v, f"{key} (line {lineno})")
-
-    T_amb = meta_temperature("T_ambient_C", T_ambient_C, DEFAULT_T_C)
-    T_cool = meta_temperature("T_coolant_C", T_coolant_C, T_amb)
+    steps = [_read_csv_step(f, header, row, lineno)
+             for lineno, row in zip(table.line_no[1:], table.rows[1:], strict=True)]
+    T_amb = _meta_temperature(f, meta, "T_ambient_C", T_ambient_C, DEFAULT_T_C)
+    T_cool = _meta_temperature(f, meta, "T_coolant_C", T_coolant_C, T_amb)
     steady = False
     if "steady" in meta:
         value, lineno = meta["steady"]
@@ -567,6 +522,68 @@ def read_cycle_steps_csv(path: str | Path, *, T_ambient_C: float | None = None,
                  source=meta.get("source", ("", 0))[0], steps=tuple(steps),
                  T_ambient_K=TimeSeries.constant(T_amb + ZERO_C_K),
                  T_coolant_K=TimeSeries.constant(T_cool + ZERO_C_K), steady=steady)
+
+
+def _check_steps_header(f: _File, header: list[str], hline: int) -> None:
+    """The required step columns are there; every column is a step column, once."""
+    for col in _CSV_REQUIRED:
+        if col not in header:
+            raise f.error(col, f"required column is missing from the header (line {hline})",
+                          f"add a '{col}' column (header: {','.join(_CSV_REQUIRED + _CSV_OPTIONAL)})")
+    for h in header:
+        if h not in _CSV_REQUIRED + _CSV_OPTIONAL:
+            raise f.error(f"{h or '(empty)'} (line {hline})", "is not a step column",
+                          f"use only {list(_CSV_REQUIRED + _CSV_OPTIONAL)}")
+        if header.count(h) > 1:
+            raise f.error(f"{h} (line {hline})", "column appears twice", "keep one of them")
+
+
+def _read_csv_step(f: _File, header: list[str], row: list[str], lineno: int) -> Step:
+    """One step row (file line ``lineno``): a number >= 0 in each cell; an empty cell is
+    allowed only in the optional columns."""
+    if len(row) != len(header):
+        raise f.error(f"line {lineno}", f"has {len(row)} cells, the header has {len(header)}",
+                      "give every row one cell per column")
+    vals = {h: _step_cell(f, h, cell.strip(), f"{h} (line {lineno})")
+            for h, cell in zip(header, row, strict=True)}
+    return Step(vals["speed_rpm"], vals["duration_s"],  # type: ignore[arg-type]
+                vals.get("load_torque_Nm") or 0.0, vals.get("power_kW"))
+
+
+def _step_cell(f: _File, h: str, cell: str, fld: str) -> float | None:
+    """The value of a stripped cell of column ``h`` (None when empty and optional)."""
+    if not cell:
+        if h in _CSV_REQUIRED:
+            raise f.error(fld, "is empty", "give a number in every row")
+        return None
+    try:
+        v = float(cell)
+    except ValueError:
+        raise f.error(fld, f"'{cell}' is not a number",
+                      "write a decimal number with '.' as the separator") from None
+    if not math.isfinite(v):
+        raise f.error(fld, "is not finite", "write a finite number")
+    if v < 0:
+        raise f.error(fld, f"{v:g} is negative", f"give {h} >= 0")
+    if h == "duration_s" and v == 0:
+        raise f.error(fld, "is zero", "give every step a duration > 0 s or drop the row")
+    return v
+
+
+def _meta_temperature(f: _File, meta: dict[str, tuple[str, int]], key: str,
+                      override: float | None, default: float) -> float:
+    """A ``# key: value`` temperature [degC]: the override, else the comment, else the default."""
+    if override is not None:
+        return f.temperature(override, key)
+    if key not in meta:
+        return default
+    value, lineno = meta[key]
+    try:
+        v = float(value)
+    except ValueError:
+        raise f.error(f"{key} (line {lineno})", f"'{value}' is not a number",
+                      f"write '# {key}: 20.0'") from None
+    return f.temperature(v, f"{key} (line {lineno})")
 
 
 # --------------------------------------------------------------------------- shipped cycles

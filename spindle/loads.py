@@ -7,7 +7,6 @@ A steady solve evaluates them at one instant; a transient solve follows them.
 
 from __future__ import annotations
 
-import csv
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -15,6 +14,7 @@ from typing import Literal
 
 import numpy as np
 
+from spindle.commented_csv import CommentedCsv, split_commented_csv
 from spindle.errors import InputError
 from spindle.units import ZERO_C_K
 
@@ -148,50 +148,14 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
     except OSError as exc:
         raise InputError(name, "file", f"cannot be read ({exc.strerror})",
                          "check the path given to --cycle") from None
-    numbered = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1)
-                if ln.strip() and not ln.lstrip().startswith("#")]
-    if not numbered:
+    table = split_commented_csv(text)
+    if not table.line_no:
         raise InputError(name, "header", "the file has no header row",
                          "add a header such as 'time_s,speed_rpm,T_env_C'")
-    line_no = [i for i, _ in numbered]  # file line of each row, comments counted
-    rows = list(csv.reader([ln for _, ln in numbered]))
-    header = [h.strip() for h in rows[0]]
-    if "time_s" not in header:
-        raise InputError(name, "time_s", "required column is missing",
-                         "add a 'time_s' column with the time since the start [s]")
-    allowed = _KNOWN_CYCLE_COLUMNS | {f"{s}_W" for s in source_names}
-    unknown = [h for h in header if h not in allowed]
-    if unknown:
-        raise InputError(name, unknown[0], "is not a cycle column",
-                         f"use one of {sorted(allowed)}")
-    data: dict[str, list[float]] = {h: [] for h in header}
-    for k, row in enumerate(rows[1:], start=1):
-        lineno = line_no[k]
-        if len(row) != len(header):
-            raise InputError(name, f"line {lineno}", f"has {len(row)} cells, header has "
-                             f"{len(header)}", "give every row one cell per column")
-        for h, cell in zip(header, row, strict=True):
-            try:
-                v = float(cell)
-            except ValueError:
-                raise InputError(name, f"{h} (line {lineno})", f"'{cell}' is not a number",
-                                 "write a decimal number with '.' as the separator") from None
-            if not np.isfinite(v):
-                raise InputError(name, f"{h} (line {lineno})", "is not finite",
-                                 "write a finite number")
-            data[h].append(v)
-    t = np.asarray(data["time_s"])
-    if len(t) < 2:
-        raise InputError(name, "time_s", "a cycle needs at least two rows",
-                         "add rows up to the end time of the run")
-    bad = np.nonzero(np.diff(t) <= 0)[0]
-    if len(bad):
-        raise InputError(name, f"time_s (line {line_no[bad[0] + 2]})", "time does not increase",
-                         "sort the rows by time and remove duplicates")
-    if t[0] < 0:
-        raise InputError(name, f"time_s (line {line_no[1]})", "is negative",
-                         "start the cycle at 0 s")
-    times = tuple(float(x) for x in t - t[0])
+    line_no = table.line_no  # file line of each row, comments counted
+    _check_cycle_header(name, table.header, source_names)
+    data = _read_cycle_columns(name, table)
+    times = _cycle_times(name, data["time_s"], line_no)
 
     def series(col: str, offset: float = 0.0, interp: Interpolation = "linear") -> TimeSeries:
         return TimeSeries(times, tuple(v + offset for v in data[col]), interp)
@@ -211,3 +175,53 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
             case = replace(case, **{attr: series(col, ZERO_C_K)})
     sources = {s: series(f"{s}_W") for s in source_names if f"{s}_W" in data}
     return case.with_sources(sources)
+
+
+def _check_cycle_header(name: str, header: list[str], source_names: list[str]) -> None:
+    """time_s is required; every column is a known one or ``<source>_W``."""
+    if "time_s" not in header:
+        raise InputError(name, "time_s", "required column is missing",
+                         "add a 'time_s' column with the time since the start [s]")
+    allowed = _KNOWN_CYCLE_COLUMNS | {f"{s}_W" for s in source_names}
+    unknown = [h for h in header if h not in allowed]
+    if unknown:
+        raise InputError(name, unknown[0], "is not a cycle column",
+                         f"use one of {sorted(allowed)}")
+
+
+def _read_cycle_columns(name: str, table: CommentedCsv) -> dict[str, list[float]]:
+    """The values of each column, by name: a finite number in every cell."""
+    header = table.header
+    data: dict[str, list[float]] = {h: [] for h in header}
+    for k, row in enumerate(table.rows[1:], start=1):
+        lineno = table.line_no[k]
+        if len(row) != len(header):
+            raise InputError(name, f"line {lineno}", f"has {len(row)} cells, header has "
+                             f"{len(header)}", "give every row one cell per column")
+        for h, cell in zip(header, row, strict=True):
+            try:
+                v = float(cell)
+            except ValueError:
+                raise InputError(name, f"{h} (line {lineno})", f"'{cell}' is not a number",
+                                 "write a decimal number with '.' as the separator") from None
+            if not np.isfinite(v):
+                raise InputError(name, f"{h} (line {lineno})", "is not finite",
+                                 "write a finite number")
+            data[h].append(v)
+    return data
+
+
+def _cycle_times(name: str, time_s: list[float], line_no: list[int]) -> tuple[float, ...]:
+    """The times [s] from the first row (at least two rows, >= 0, strictly increasing)."""
+    t = np.asarray(time_s)
+    if len(t) < 2:
+        raise InputError(name, "time_s", "a cycle needs at least two rows",
+                         "add rows up to the end time of the run")
+    bad = np.nonzero(np.diff(t) <= 0)[0]
+    if len(bad):
+        raise InputError(name, f"time_s (line {line_no[bad[0] + 2]})", "time does not increase",
+                         "sort the rows by time and remove duplicates")
+    if t[0] < 0:
+        raise InputError(name, f"time_s (line {line_no[1]})", "is negative",
+                         "start the cycle at 0 s")
+    return tuple(float(x) for x in t - t[0])

@@ -460,17 +460,50 @@ def load_spec(name_or_path: str | Path) -> Spec:
     return _build(_Reader(file), data)
 
 
-def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass over the schema
+def _build(r: _Reader, data: dict[str, Any]) -> Spec:
+    """Read the tables one after the other (the problems are listed in that order), then,
+    if none was found, check the geometry; raises SpecError with every problem."""
     head = r.table(data, "spindle", "") or {}
     name = r.string(head, "name", "spindle") or "?"
+    speed, T_amb, T_cool, T_init = _read_operating(r, data)
+    mesh = r.table(data, "mesh", "", required=False) or {}
+    h0 = r.number(mesh, "h0_m", "mesh", "m", required=False, default=0.01, lo=0.0, lo_open=True)
+    materials = _read_materials(r, data)
+    parts = _read_parts(r, data, materials)
+    links = _read_links(r, data, parts)
+    surfaces = _read_surfaces(r, data, parts)
+    sources = _read_heat_sources(r, data, parts, surfaces)
+    sensors, arrays = _read_sensors(r, data, parts)
+    pb = r.table(data, "power_balance", "", required=False) or {}
+    preset = r.string(pb, "preset", "power_balance", required=False)
+
+    if not r.problems:
+        _check_geometry(r, parts, links, surfaces, sensors)
+    if r.problems:
+        raise SpecError(r.problems)
+    return Spec(
+        name=name, path=r.file, description=str(head.get("description", "")),
+        source=str(head.get("source", "")), speed_rpm=speed, T_ambient_K=T_amb,
+        T_coolant_K=T_cool, T_initial_K=T_init, h0_m=h0,
+        materials={m: materials[m] for m in {s.material for p in parts for s in p.sections}},
+        parts=tuple(parts), links=tuple(links), surfaces=tuple(surfaces),
+        heat_sources=tuple(sources), sensors=tuple(sensors), sensor_arrays=tuple(arrays),
+        power_preset=preset)
+
+
+def _read_operating(r: _Reader, data: dict[str, Any]) -> tuple[float, float, float, float]:
+    """[operating]: speed [rpm] and the ambient, coolant and initial temperatures [K]
+    (coolant and initial default to the ambient)."""
     op = r.table(data, "operating", "") or {}
     speed = r.number(op, "speed_rpm", "operating", "rpm", required=False, default=0.0, lo=0.0, hi=1e5)
     T_amb = r.number(op, "T_ambient_K", "operating", "K", lo=150.0, hi=500.0)
     T_cool = r.number(op, "T_coolant_K", "operating", "K", required=False, default=T_amb, lo=150.0, hi=500.0)
     T_init = r.number(op, "T_initial_K", "operating", "K", required=False, default=T_amb, lo=150.0, hi=500.0)
-    mesh = r.table(data, "mesh", "", required=False) or {}
-    h0 = r.number(mesh, "h0_m", "mesh", "m", required=False, default=0.01, lo=0.0, lo_open=True)
+    return speed, T_amb, T_cool, T_init
 
+
+def _read_materials(r: _Reader, data: dict[str, Any]) -> dict[str, Material]:
+    """The shipped materials, overridden and extended by the spec's [materials] tables."""
     materials = dict(shipped_materials())
     for mname, md in (r.table(data, "materials", "", required=False) or {}).items():
         if not isinstance(md, dict):
@@ -479,8 +512,11 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass o
         m = _read_material(r, mname, md, f"materials.{mname}")
         if m is not None:
             materials[mname] = m
+    return materials
 
-    # parts and sections
+
+def _read_parts(r: _Reader, data: dict[str, Any], materials: dict[str, Material]) -> list[Part]:
+    """[[parts]] with their sections; a part with a problem is left out."""
     parts: list[Part] = []
     for i, pd in enumerate(r.array(data, "parts", "")):
         path = f"parts[{i}]"
@@ -496,79 +532,109 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass o
             secs = []
         sections = []
         for j, sd in enumerate(secs):
-            sp = f"{path}.sections[{j}]"
-            z0 = r.number(sd, "z_start", sp, "m")
-            z1 = r.number(sd, "z_end", sp, "m")
-            ri = r.radius(sd, "r_inner", sp)
-            ro = r.radius(sd, "r_outer", sp)
-            mat = sd.get("material", pmat)
-            if mat is None:
-                r.add(f"{sp}.material", "no material for this section or its part",
-                      f"add material = \"...\" to {path} (one of: {', '.join(sorted(materials))})")
-            elif mat not in materials:
-                r.add(f"{sp}.material" if "material" in sd else f"{path}.material",
-                      f"unknown material '{mat}'",
-                      f"use one of: {', '.join(sorted(materials))}, or define [materials.{mat}]")
-                mat = None
-            if None in (z0, z1, ri, ro, mat):
-                continue
-            if z1 - z0 <= TOL_M:
-                r.add(f"{sp}.z_end", f"z_end = {z1:g} m is not after z_start = {z0:g} m",
-                      "give z_end > z_start (z grows from the rear towards the tool)")
-                continue
-            if ri[0] >= ro[0] - TOL_M or ri[1] >= ro[1] - TOL_M:
-                r.add(f"{sp}.r_inner", f"r_inner {list(ri)} m is not below r_outer {list(ro)} m",
-                      "give r_inner < r_outer at both ends (r_inner = 0 for a solid section)")
-                continue
-            sections.append(Section(z0, z1, ri, ro, material=mat, name=str(sd.get("name", ""))))
+            sec = _read_section(r, sd, f"{path}.sections[{j}]", path, pmat, materials)
+            if sec is not None:
+                sections.append(sec)
         if pname is not None and role is not None and sections:
             parts.append(Part(pname, role, tuple(sections)))
-    part_names = {p.name for p in parts}
+    return parts
 
-    # links
+
+def _read_section(r: _Reader, sd: dict, sp: str, path: str, pmat: Any,
+                  materials: dict[str, Material]) -> Section | None:
+    """One section ``sp`` of part ``path``; its material defaults to the part's ``pmat``."""
+    z0 = r.number(sd, "z_start", sp, "m")
+    z1 = r.number(sd, "z_end", sp, "m")
+    ri = r.radius(sd, "r_inner", sp)
+    ro = r.radius(sd, "r_outer", sp)
+    mat = sd.get("material", pmat)
+    if mat is None:
+        r.add(f"{sp}.material", "no material for this section or its part",
+              f"add material = \"...\" to {path} (one of: {', '.join(sorted(materials))})")
+    elif mat not in materials:
+        r.add(f"{sp}.material" if "material" in sd else f"{path}.material",
+              f"unknown material '{mat}'",
+              f"use one of: {', '.join(sorted(materials))}, or define [materials.{mat}]")
+        mat = None
+    if None in (z0, z1, ri, ro, mat):
+        return None
+    if z1 - z0 <= TOL_M:
+        r.add(f"{sp}.z_end", f"z_end = {z1:g} m is not after z_start = {z0:g} m",
+              "give z_end > z_start (z grows from the rear towards the tool)")
+        return None
+    if ri[0] >= ro[0] - TOL_M or ri[1] >= ro[1] - TOL_M:
+        r.add(f"{sp}.r_inner", f"r_inner {list(ri)} m is not below r_outer {list(ro)} m",
+              "give r_inner < r_outer at both ends (r_inner = 0 for a solid section)")
+        return None
+    return Section(z0, z1, ri, ro, material=mat, name=str(sd.get("name", "")))
+
+
+def _read_links(r: _Reader, data: dict[str, Any], parts: list[Part]) -> list[Link]:
+    """[[links]]: bearing, air_gap and contact; a link with a problem is left out."""
+    readers = {"bearing": _read_bearing_link, "air_gap": _read_air_gap_link,
+               "contact": _read_contact_link}
     links: list[Link] = []
     for i, ld in enumerate(r.array(data, "links", "", required=False)):
         path = f"links[{i}]"
         kind = r.string(ld, "type", path, choices=LINK_TYPES)
-        if kind == "bearing":
-            pn = r.string(ld, "part", path)
-            sn = r.string(ld, "section", path)
-            G = r.speed_table(ld, "G_W_K", path, "W/K")
-            if pn is not None and pn not in part_names:
-                r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
-            elif pn is not None and sn is not None and not any(
-                    s.name == sn for s in next(p for p in parts if p.name == pn).sections):
-                r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
-                      f"add name = \"{sn}\" to the rolling-element section of part '{pn}'")
-            elif G is not None and G.min <= 0:
-                r.add(f"{path}.G_W_K", "a bearing conductance must be > 0 W/K",
-                      "give G_W_K > 0 (typ. 5-50 W/K per bearing pair)")
-            elif None not in (pn, sn, G):
-                links.append(BearingLink(pn, sn, G))
-        elif kind == "air_gap":
-            a = r.string(ld, "inner", path)
-            b = r.string(ld, "outer", path)
-            h = r.speed_table(ld, "h_W_m2K", path, "W/m2/K")
-            for key, v in (("inner", a), ("outer", b)):
-                if v is not None and v not in part_names:
-                    r.add(f"{path}.{key}", f"unknown part '{v}'", f"use one of: {sorted(part_names)}")
-            if h is not None and h.min <= 0:
-                r.add(f"{path}.h_W_m2K", "an air-gap coefficient must be > 0 W/m2/K",
-                      "give h_W_m2K > 0")
-            elif a in part_names and b in part_names and h is not None:
-                links.append(AirGapLink(a, b, h))
-        elif kind == "contact":
-            pl = ld.get("parts")
-            h = r.number(ld, "h_W_m2K", path, "W/m2/K", lo=0.0, lo_open=True)
-            if not (isinstance(pl, list) and len(pl) == 2 and all(isinstance(x, str) for x in pl)):
-                r.add(f"{path}.parts", "must name two parts", "write parts = [\"shaft\", \"rotor\"]")
-            elif any(x not in part_names for x in pl):
-                bad = next(x for x in pl if x not in part_names)
-                r.add(f"{path}.parts", f"unknown part '{bad}'", f"use one of: {sorted(part_names)}")
-            elif h is not None:
-                links.append(ContactLink((pl[0], pl[1]), h))
+        link = readers[kind](r, ld, path, parts) if kind is not None else None
+        if link is not None:
+            links.append(link)
+    return links
 
-    # surfaces
+
+def _read_bearing_link(r: _Reader, ld: dict, path: str, parts: list[Part]) -> BearingLink | None:
+    part_names = {p.name for p in parts}
+    pn = r.string(ld, "part", path)
+    sn = r.string(ld, "section", path)
+    G = r.speed_table(ld, "G_W_K", path, "W/K")
+    if pn is not None and pn not in part_names:
+        r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+    elif pn is not None and sn is not None and not any(
+            s.name == sn for s in next(p for p in parts if p.name == pn).sections):
+        r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
+              f"add name = \"{sn}\" to the rolling-element section of part '{pn}'")
+    elif G is not None and G.min <= 0:
+        r.add(f"{path}.G_W_K", "a bearing conductance must be > 0 W/K",
+              "give G_W_K > 0 (typ. 5-50 W/K per bearing pair)")
+    elif None not in (pn, sn, G):
+        return BearingLink(pn, sn, G)
+    return None
+
+
+def _read_air_gap_link(r: _Reader, ld: dict, path: str, parts: list[Part]) -> AirGapLink | None:
+    part_names = {p.name for p in parts}
+    a = r.string(ld, "inner", path)
+    b = r.string(ld, "outer", path)
+    h = r.speed_table(ld, "h_W_m2K", path, "W/m2/K")
+    for key, v in (("inner", a), ("outer", b)):
+        if v is not None and v not in part_names:
+            r.add(f"{path}.{key}", f"unknown part '{v}'", f"use one of: {sorted(part_names)}")
+    if h is not None and h.min <= 0:
+        r.add(f"{path}.h_W_m2K", "an air-gap coefficient must be > 0 W/m2/K",
+              "give h_W_m2K > 0")
+    elif a in part_names and b in part_names and h is not None:
+        return AirGapLink(a, b, h)
+    return None
+
+
+def _read_contact_link(r: _Reader, ld: dict, path: str, parts: list[Part]) -> ContactLink | None:
+    part_names = {p.name for p in parts}
+    pl = ld.get("parts")
+    h = r.number(ld, "h_W_m2K", path, "W/m2/K", lo=0.0, lo_open=True)
+    if not (isinstance(pl, list) and len(pl) == 2 and all(isinstance(x, str) for x in pl)):
+        r.add(f"{path}.parts", "must name two parts", "write parts = [\"shaft\", \"rotor\"]")
+    elif any(x not in part_names for x in pl):
+        bad = next(x for x in pl if x not in part_names)
+        r.add(f"{path}.parts", f"unknown part '{bad}'", f"use one of: {sorted(part_names)}")
+    elif h is not None:
+        return ContactLink((pl[0], pl[1]), h)
+    return None
+
+
+def _read_surfaces(r: _Reader, data: dict[str, Any], parts: list[Part]) -> list[Surface]:
+    """[[surfaces]]; a surface with a problem is left out."""
+    part_names = {p.name for p in parts}
     surfaces: list[Surface] = []
     for i, sd in enumerate(r.array(data, "surfaces", "", required=False)):
         path = f"surfaces[{i}]"
@@ -590,96 +656,109 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:  # noqa: C901 - one pass o
             r.add(f"{path}.name", f"surface '{sname}' is defined twice", "give each its own name")
         elif sname is not None and all(x in part_names for x in pl) and pl:
             surfaces.append(Surface(sname, tuple(pl), side, zmin, zmax, h, tref))
-    surface_names = {s.name for s in surfaces}
+    return surfaces
 
-    # heat sources
+
+def _read_heat_sources(r: _Reader, data: dict[str, Any], parts: list[Part],
+                       surfaces: list[Surface]) -> list[HeatSource]:
+    """[[heat_sources]]; a source with a problem is left out."""
     sources: list[HeatSource] = []
     for i, hd in enumerate(r.array(data, "heat_sources", "", required=False)):
-        path = f"heat_sources[{i}]"
-        hname = r.string(hd, "name", path)
-        pw = r.power(hd, path)
-        pn, sn, surf = hd.get("part"), hd.get("section"), hd.get("surface")
-        if (pn is None) == (surf is None):
-            r.add(path, "a heat source goes into either a part or a surface",
-                  "give exactly one of part = \"...\" or surface = \"...\"")
-            continue
-        if pn is not None and pn not in part_names:
-            r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
-            continue
-        if sn is not None and not any(s.name == sn for s in
-                                      next(p for p in parts if p.name == pn).sections):
-            r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
-                  f"name one of its sections '{sn}' or drop the section field")
-            continue
-        if surf is not None and surf not in surface_names:
-            r.add(f"{path}.surface", f"unknown surface '{surf}'",
-                  f"define it under [[surfaces]] (known: {sorted(surface_names)})")
-            continue
-        if hname is not None and any(h.name == hname for h in sources):
-            r.add(f"{path}.name", f"heat source '{hname}' is defined twice",
-                  "give each its own name")
-            continue
-        if hname is not None and pw is not None:
-            sources.append(HeatSource(hname, pw, pn, sn, surf))
+        src = _read_heat_source(r, hd, f"heat_sources[{i}]", parts, surfaces, sources)
+        if src is not None:
+            sources.append(src)
+    return sources
 
-    # sensors
+
+def _read_heat_source(r: _Reader, hd: dict, path: str, parts: list[Part],
+                      surfaces: list[Surface], earlier: list[HeatSource]) -> HeatSource | None:
+    part_names = {p.name for p in parts}
+    surface_names = {s.name for s in surfaces}
+    hname = r.string(hd, "name", path)
+    pw = r.power(hd, path)
+    pn, sn, surf = hd.get("part"), hd.get("section"), hd.get("surface")
+    if (pn is None) == (surf is None):
+        r.add(path, "a heat source goes into either a part or a surface",
+              "give exactly one of part = \"...\" or surface = \"...\"")
+        return None
+    if pn is not None and pn not in part_names:
+        r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+        return None
+    if sn is not None and not any(s.name == sn for s in
+                                  next(p for p in parts if p.name == pn).sections):
+        r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
+              f"name one of its sections '{sn}' or drop the section field")
+        return None
+    if surf is not None and surf not in surface_names:
+        r.add(f"{path}.surface", f"unknown surface '{surf}'",
+              f"define it under [[surfaces]] (known: {sorted(surface_names)})")
+        return None
+    if hname is not None and any(h.name == hname for h in earlier):
+        r.add(f"{path}.name", f"heat source '{hname}' is defined twice",
+              "give each its own name")
+        return None
+    if hname is not None and pw is not None:
+        return HeatSource(hname, pw, pn, sn, surf)
+    return None
+
+
+def _read_sensors(r: _Reader, data: dict[str, Any],
+                  parts: list[Part]) -> tuple[list[Sensor], list[SensorArray]]:
+    """[[sensors]], then [[sensor_arrays]] (whose sensors follow); every name once."""
     sensors: list[Sensor] = []
     for i, sd in enumerate(r.array(data, "sensors", "", required=False)):
-        path = f"sensors[{i}]"
-        sname = r.string(sd, "name", path)
-        kind = r.string(sd, "kind", path, required=False, default="temperature",
-                        choices=("temperature", "axial_displacement"))
-        z = r.number(sd, "z", path, "m")
-        rr = r.number(sd, "r", path, "m", lo=0.0)
-        zr = rr_ref = None
-        if kind == "axial_displacement":
-            zr = r.number(sd, "z_ref", path, "m")
-            rr_ref = r.number(sd, "r_ref", path, "m", lo=0.0)
-        if None in (sname, z, rr) or (kind == "axial_displacement" and None in (zr, rr_ref)):
-            continue
-        sensors.append(Sensor(sname, kind, z, rr, zr, rr_ref))
+        s = _read_sensor(r, sd, f"sensors[{i}]")
+        if s is not None:
+            sensors.append(s)
     arrays: list[SensorArray] = []
     for i, ad in enumerate(r.array(data, "sensor_arrays", "", required=False)):
-        path = f"sensor_arrays[{i}]"
-        aname = r.string(ad, "name", path)
-        pn = r.string(ad, "part", path)
-        cnt = ad.get("count", 11)
-        rad = ad.get("radius", "mid")
-        if not isinstance(cnt, int) or isinstance(cnt, bool) or cnt < 2:
-            r.add(f"{path}.count", f"must be an integer >= 2, not {cnt!r}", "write count = 11")
-            continue
-        if not (rad in ("mid", "inner", "outer") or (isinstance(rad, int | float)
-                                                      and not isinstance(rad, bool))):
-            r.add(f"{path}.radius", f"{rad!r} is not a radius", "write \"mid\", \"inner\", "
-                  "\"outer\" or a radius in m")
-            continue
-        if pn is not None and pn not in part_names:
-            r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
-            continue
-        if aname is not None and pn is not None:
-            arrays.append(SensorArray(aname, pn, cnt, rad))
-            sensors.extend(array_sensors(arrays[-1], next(p for p in parts if p.name == pn)))
+        arr = _read_sensor_array(r, ad, f"sensor_arrays[{i}]", parts)
+        if arr is not None:
+            arrays.append(arr)
+            sensors.extend(array_sensors(arr, next(p for p in parts if p.name == arr.part)))
     seen: set[str] = set()
     for s in sensors:
         if s.name in seen:
             r.add(f"sensors.{s.name}", "sensor name is used twice", "give each sensor its own name")
         seen.add(s.name)
+    return sensors, arrays
 
-    pb = r.table(data, "power_balance", "", required=False) or {}
-    preset = r.string(pb, "preset", "power_balance", required=False)
 
-    if not r.problems:
-        _check_geometry(r, parts, links, surfaces, sensors)
-    if r.problems:
-        raise SpecError(r.problems)
-    return Spec(
-        name=name, path=r.file, description=str(head.get("description", "")),
-        source=str(head.get("source", "")), speed_rpm=speed, T_ambient_K=T_amb,
-        T_coolant_K=T_cool, T_initial_K=T_init, h0_m=h0,
-        materials={m: materials[m] for m in {s.material for p in parts for s in p.sections}},
-        parts=tuple(parts), links=tuple(links), surfaces=tuple(surfaces),
-        heat_sources=tuple(sources), sensors=tuple(sensors), sensor_arrays=tuple(arrays),
-        power_preset=preset)
+def _read_sensor(r: _Reader, sd: dict, path: str) -> Sensor | None:
+    sname = r.string(sd, "name", path)
+    kind = r.string(sd, "kind", path, required=False, default="temperature",
+                    choices=("temperature", "axial_displacement"))
+    z = r.number(sd, "z", path, "m")
+    rr = r.number(sd, "r", path, "m", lo=0.0)
+    zr = rr_ref = None
+    if kind == "axial_displacement":
+        zr = r.number(sd, "z_ref", path, "m")
+        rr_ref = r.number(sd, "r_ref", path, "m", lo=0.0)
+    if None in (sname, z, rr) or (kind == "axial_displacement" and None in (zr, rr_ref)):
+        return None
+    return Sensor(sname, kind, z, rr, zr, rr_ref)
+
+
+def _read_sensor_array(r: _Reader, ad: dict, path: str, parts: list[Part]) -> SensorArray | None:
+    part_names = {p.name for p in parts}
+    aname = r.string(ad, "name", path)
+    pn = r.string(ad, "part", path)
+    cnt = ad.get("count", 11)
+    rad = ad.get("radius", "mid")
+    if not isinstance(cnt, int) or isinstance(cnt, bool) or cnt < 2:
+        r.add(f"{path}.count", f"must be an integer >= 2, not {cnt!r}", "write count = 11")
+        return None
+    if not (rad in ("mid", "inner", "outer") or (isinstance(rad, int | float)
+                                                  and not isinstance(rad, bool))):
+        r.add(f"{path}.radius", f"{rad!r} is not a radius", "write \"mid\", \"inner\", "
+              "\"outer\" or a radius in m")
+        return None
+    if pn is not None and pn not in part_names:
+        r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+        return None
+    if aname is not None and pn is not None:
+        return SensorArray(aname, pn, cnt, rad)
+    return None
 
 
 def array_sensors(arr: SensorArray, part: Part) -> list[Sensor]:
@@ -703,6 +782,20 @@ def _check_geometry(r: _Reader, parts: list[Part], links: list[Link],
                     surfaces: list[Surface], sensors: list[Sensor]) -> None:
     """Overlaps, gaps where a link is required, sensors outside, and heat paths."""
     secs = [(p, j, s) for p in parts for j, s in enumerate(p.sections)]
+    touching = _check_overlaps(r, parts, secs)
+    if r.problems:
+        return
+    joined = _check_links(r, parts, links, touching)
+    _check_parts_joined(r, parts, links, touching, joined)
+    _check_sensors_inside(r, sensors, secs)
+    if r.problems:
+        return
+    _check_heat_paths(r, parts, surfaces, joined)
+
+
+def _check_overlaps(r: _Reader, parts: list[Part],
+                    secs: list[tuple[Part, int, Section]]) -> dict[str, set[str]]:
+    """Sections must not overlap; returns the parts each part touches."""
     touching: dict[str, set[str]] = {p.name: set() for p in parts}
     for a in range(len(secs)):
         pa, ja, sa = secs[a]
@@ -716,17 +809,17 @@ def _check_geometry(r: _Reader, parts: list[Part], links: list[Link],
             elif pa.name != pb.name and contact_length(sa, sb) > 0:
                 touching[pa.name].add(pb.name)
                 touching[pb.name].add(pa.name)
-    if r.problems:
-        return
+    return touching
+
+
+def _check_links(r: _Reader, parts: list[Part], links: list[Link],
+                 touching: dict[str, set[str]]) -> dict[str, set[str]]:
+    """An air gap must be a real, narrow gap; a contact link needs touching parts. Returns
+    the parts each part exchanges heat with (touching or across an air gap)."""
     joined = {k: set(v) for k, v in touching.items()}
-    roles = {p.name: p.role for p in parts}
     for i, link in enumerate(links):
         if isinstance(link, AirGapLink):
-            gaps = [float(so.r_in(z) - si.r_out(z))
-                    for si in next(p for p in parts if p.name == link.inner).sections
-                    for so in next(p for p in parts if p.name == link.outer).sections
-                    for z in (max(si.z_start, so.z_start), min(si.z_end, so.z_end))
-                    if min(si.z_end, so.z_end) - max(si.z_start, so.z_start) > TOL_M]
+            gaps = _air_gap_widths(parts, link)
             if not gaps:
                 r.add(f"links[{i}]", f"'{link.inner}' and '{link.outer}' do not face each "
                       "other over any axial length", "make their z ranges overlap")
@@ -743,6 +836,23 @@ def _check_geometry(r: _Reader, parts: list[Part], links: list[Link],
             if b not in touching[a]:
                 r.add(f"links[{i}].parts", f"'{a}' and '{b}' do not touch",
                       "a contact link needs parts that share a boundary: fix the radii")
+    return joined
+
+
+def _air_gap_widths(parts: list[Part], link: AirGapLink) -> list[float]:
+    """Radial gap [m] at both ends of every z range where the inner and outer part face."""
+    return [float(so.r_in(z) - si.r_out(z))
+            for si in next(p for p in parts if p.name == link.inner).sections
+            for so in next(p for p in parts if p.name == link.outer).sections
+            for z in (max(si.z_start, so.z_start), min(si.z_end, so.z_end))
+            if min(si.z_end, so.z_end) - max(si.z_start, so.z_start) > TOL_M]
+
+
+def _check_parts_joined(r: _Reader, parts: list[Part], links: list[Link],
+                        touching: dict[str, set[str]], joined: dict[str, set[str]]) -> None:
+    """No part stands alone, bearings sit between shaft and housing, and a rotor and a
+    stator have an air-gap link."""
+    roles = {p.name: p.role for p in parts}
     for p in parts:
         if len(parts) > 1 and not joined[p.name]:
             r.add(f"parts[{parts.index(p)}]", f"part '{p.name}' is separated from every other "
@@ -759,15 +869,21 @@ def _check_geometry(r: _Reader, parts: list[Part], links: list[Link],
     if has_rotor and has_stator and not any(isinstance(x, AirGapLink) for x in links):
         r.add("links", f"rotor '{has_rotor[0]}' and stator '{has_stator[0]}' have no air-gap "
               "link", "add [[links]] type = \"air_gap\" with inner/outer and h_W_m2K")
+
+
+def _check_sensors_inside(r: _Reader, sensors: list[Sensor],
+                          secs: list[tuple[Part, int, Section]]) -> None:
     for s in sensors:
         pts = [(s.z, s.r)] + ([(s.z_ref, s.r_ref)] if s.kind == "axial_displacement" else [])
         for z, rr in pts:
             if not any(sec.contains(z, rr) for _, _, sec in secs):
                 r.add(f"sensors.{s.name}", f"point (z = {z:g} m, r = {rr:g} m) is outside every "
                       "part", "move it into a part's section (z along the axis, r radius)")
-    if r.problems:
-        return
-    # every group of joined parts needs a path to a fixed temperature
+
+
+def _check_heat_paths(r: _Reader, parts: list[Part], surfaces: list[Surface],
+                      joined: dict[str, set[str]]) -> None:
+    """Every group of joined parts needs a path to a fixed temperature."""
     anchored = {x for s in surfaces if s.h_W_m2K is not None and s.h_W_m2K.max > 0
                 for x in s.parts}
     seen: set[str] = set()
