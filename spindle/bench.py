@@ -642,6 +642,28 @@ def held(t_samples: np.ndarray, y_samples: np.ndarray, t: np.ndarray) -> np.ndar
     return y_samples[np.clip(idx, 0, len(y_samples) - 1)]
 
 
+#: speed scatter a drive shows around its set speed: a logged speed within this band of the
+#: current operating step belongs to it (the spindle's drive holds 0.1-0.3 % in practice)
+SPEED_BAND_REL = 0.01
+SPEED_BAND_RPM = 20.0
+
+
+def settled_speed(speed_rpm: np.ndarray, rel: float = SPEED_BAND_REL,
+                  band_rpm: float = SPEED_BAND_RPM) -> np.ndarray:
+    """The operating steps of a logged speed [rpm]: consecutive values within
+    max(``band_rpm``, ``rel`` x level) of the step's first value form one step, which takes
+    their median. The drive's few-rpm scatter then does not make every interval a new
+    operating point (each one costs the models a new set of film coefficients and modes)."""
+    n = np.asarray(speed_rpm, dtype=float)
+    out = np.empty_like(n)
+    start = 0
+    for k in range(1, len(n) + 1):
+        if k == len(n) or abs(n[k] - n[start]) > max(band_rpm, rel * abs(n[start])):
+            out[start:k] = np.median(n[start:k])
+            start = k
+    return out
+
+
 def cell_means(t_samples: np.ndarray, y_samples: np.ndarray, edges: np.ndarray,
                centres: np.ndarray) -> np.ndarray:
     """Mean of the samples in each cell [edges[i], edges[i+1]) (the last cell closed), one per

@@ -405,3 +405,20 @@ def test_benchrun_is_a_plain_record(tmp_path):
     run = read_bench(write(tmp_path, good_rows()))
     assert isinstance(run, BenchRun) and run.path == tmp_path / "run.csv" and run.name == "run"
     assert run.time_s.dtype == float and np.isnan(run.columns["speed_rpm"][1])
+
+
+def test_settled_speed_merges_drive_scatter_and_keeps_real_steps():
+    """A drive's +-5 rpm scatter around 1500 and 6000 rpm collapses to one level per step
+    (the median of the step's samples); a real step, however small beyond the band (1 % or
+    20 rpm), is kept; a standstill stays 0."""
+    from spindle.bench import settled_speed
+
+    rng = np.random.default_rng(0)
+    set_speed = np.repeat([0.0, 1500.0, 1530.0, 6000.0, 0.0], 50)
+    logged = set_speed + np.where(set_speed > 0, rng.integers(-5, 6, set_speed.size), 0)
+    out = settled_speed(logged)
+    for level in (1500.0, 1530.0, 6000.0):
+        step = out[set_speed == level]
+        assert np.unique(step).size == 1 and abs(step[0] - level) <= 5
+    assert np.all(out[set_speed == 0.0] == 0.0)
+    assert np.unique(out).size == 4  # 0, 1500, 1530, 6000: five steps, two at standstill

@@ -39,7 +39,15 @@ from compare.fit.calibrate import (
     resample,
 )
 from compare.fit.greybox import BASE_PARAMS, EFFECTS, GreyBox, Inputs, default_theta
-from spindle.bench import BenchRun, bench_grid, cell_means, check_against_spec, held, read_bench
+from spindle.bench import (
+    BenchRun,
+    bench_grid,
+    cell_means,
+    check_against_spec,
+    held,
+    read_bench,
+    settled_speed,
+)
 from spindle.drive import drive_for
 from spindle.errors import InputError
 from spindle.outputs import jsonable
@@ -64,7 +72,7 @@ def greybox_inputs(run: BenchRun, grid_s: float = 60.0) -> Inputs:
         ok = ~np.isnan(y)
         return run.time_s[ok], y[ok]
 
-    speed = held(*valid("speed_rpm"), grid[:-1])
+    speed = settled_speed(held(*valid("speed_rpm"), grid[:-1]))
     power = cell_means(*valid("power_kW"), grid, mids)
     torque = cell_means(*valid("load_torque_Nm"), grid, mids) if run.load_torque_measured \
         else np.zeros(len(mids))

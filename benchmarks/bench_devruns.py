@@ -1,0 +1,105 @@
+"""Bench-data loop on runs we did not make: ``fit`` on every run of a folder with a truth.json
+(default ../shared/bench-runs/, a peer's simulator of an SPL2782-family spindle that is not
+the shipped spec), against the truth.
+
+    python benchmarks/bench_devruns.py [--runs DIR] [--spec spl2782] [--only dev-01 dev-06]
+                                       [--workers 2] [--json OUT.json]
+
+Prints, per run: the true effect, what ``fit`` named (and how), whether the verdict is right
+(the true effect named alone; nothing named on a control run), the validation open-loop RMS
+after the fit per channel against the tolerances (1 K, 1.5 µm), the base parameters beyond
+their prior range, and the wall time; then the totals. Runs go through
+:func:`compare.executor.run_cases` (a process pool), one ``fit`` per run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT_RUNS = ROOT.parent / "shared" / "bench-runs"
+
+
+@dataclass(frozen=True)
+class DevRun:
+    path: Path
+    spec: str
+    truth: str | None
+
+    @property
+    def label(self) -> str:
+        return self.path.stem
+
+
+def fit_one(case: DevRun) -> dict:
+    """``fit`` on one run; the figures the table prints."""
+    from compare.fit.run import run_fit
+    from spindle.spec import load_spec
+
+    t = time.perf_counter()
+    rep = run_fit(case.path, load_spec(case.spec))
+    doc = rep.to_dict()
+    named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
+                          and e["parameters"].get("channel") else "") for e in doc["effects"]]
+    plain = [e["name"] for e in doc["effects"]]
+    unexplained = bool(doc["unexplained"]["unexplained"])
+    right = plain == ([case.truth] if case.truth else []) and (
+        case.truth is not None or not unexplained)
+    val = doc["error_after"]["validation"]
+    return {"run": case.label, "truth": case.truth, "named": named,
+            "unexplained": unexplained, "right": right,
+            "validation_rmse": {c: v["rmse"] for c, v in val.items()},
+            "within_tolerance": {c: v["rmse"] <= (1.5 if c == "P1" else 1.0)
+                                 for c, v in val.items()},
+            "implausible": {k: round(v, 2) for k, v in (doc.get("parameters_prior_z") or {})
+                            .items() if abs(v) > 2.58},
+            "seconds": time.perf_counter() - t}
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=Path, default=DEFAULT_RUNS,
+                    help="folder with RUN.csv files and truth.json (default: %(default)s)")
+    ap.add_argument("--spec", default="spl2782", help="spec the runs are fitted with")
+    ap.add_argument("--only", nargs="*", help="run labels to fit (default: all in truth.json)")
+    ap.add_argument("--workers", type=int, default=2, help="parallel fits (default 2)")
+    ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
+    args = ap.parse_args(argv)
+
+    from compare.executor import run_cases, stderr_progress
+
+    truth = json.loads((args.runs / "truth.json").read_text(encoding="utf-8"))
+    labels = args.only or sorted(truth)
+    cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"]) for k in labels]
+    t = time.perf_counter()
+    outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
+    rows = []
+    print(f"{'run':8} {'truth':24} {'named':30} ok  validation RMS after (T1 T2 Tst K, P1 µm)"
+          "   s")
+    for o in outcomes:
+        if o.error:
+            print(f"{o.label:8} failed: {o.error}")
+            continue
+        r = o.value
+        rows.append(r)
+        v = r["validation_rmse"]
+        named = ", ".join(r["named"]) or ("unexplained" if r["unexplained"] else "nothing")
+        print(f"{r['run']:8} {str(r['truth']):24} {named:30} {'yes' if r['right'] else 'NO ':3} "
+              + " ".join(f"{v.get(c, float('nan')):5.2f}" for c in ("T1", "T2", "T_stator", "P1"))
+              + f" {r['seconds']:5.0f}" + (f"  implausible {r['implausible']}"
+                                            if r["implausible"] else ""))
+    n_right = sum(r["right"] for r in rows)
+    print(f"right verdicts: {n_right} of {len(cases)}; wall time {time.perf_counter() - t:.0f} s "
+          f"on {args.workers} workers")
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main()
