@@ -6,7 +6,7 @@ the shipped spec), against the truth.
                                        [--workers 2] [--json OUT.json]
 
 Prints, per run: the true effect, what ``fit`` named (and how), whether the verdict is right
-(the true effect named alone; nothing named on a control run), the validation open-loop RMS
+(the true effect named alone; no effect named on a control run), the validation open-loop RMS
 after the fit per channel against the tolerances (1 K, 1.5 µm), the base parameters beyond
 their prior range, and the wall time; then the totals. Runs go through
 :func:`compare.executor.run_cases` (a process pool), one ``fit`` per run.
@@ -49,8 +49,8 @@ def fit_one(case: DevRun) -> dict:
                           and e["parameters"].get("channel") else "") for e in doc["effects"]]
     plain = [e["name"] for e in doc["effects"]]
     unexplained = bool(doc["unexplained"]["unexplained"])
-    right = plain == ([case.truth] if case.truth else []) and (
-        case.truth is not None or not unexplained)
+    # the verdict: the true effect named alone; nothing named on a control run
+    right = plain == ([case.truth] if case.truth else [])
     val = doc["error_after"]["validation"]
     return {"run": case.label, "truth": case.truth, "named": named,
             "unexplained": unexplained, "right": right,

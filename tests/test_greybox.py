@@ -109,7 +109,12 @@ def test_synth_then_fit_end_to_end(tmp_path, capsys):
     assert abs(k - truth["parameters"]["k_fix_um_K"]) < 0.3  # µm/K; lumped vs FEM model form
     for c, e in rep["error_after"]["validation"].items():  # RMS within the tolerances
         assert e["rmse"] <= (1.5 if c == "P1" else 1.0), (c, e)
-    assert set(rep) >= {"effects", "unexplained", "error_before", "error_after", "parameters"}
+    assert set(rep) >= {"effects", "unexplained", "error_before", "error_after", "parameters",
+                        "base_adequacy", "warnings"}
+    assert isinstance(rep["warnings"], list)
+    ad = rep["base_adequacy"]
+    assert isinstance(ad["adequate"], bool) and set(ad["channels"]) == set(rep["channels"])
+    assert "Base model:" in (out / "report.html").read_text()
     assert (out / "report.html").exists() and (out / "fit_channels.png").exists()
 
 

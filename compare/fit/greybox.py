@@ -14,6 +14,8 @@ name                    meaning                                                b
 ``h_rotating``          factor on the rotating surfaces' film conductances     0.2 .. 5
 ``contact``             factor on the interface conductances of contact links  0.2 .. 5
 ``alpha_eff``           factor on the expansion coefficients of the growth     0.5 .. 2
+``heat_capacity``       factor on every heat capacity of the network           0.1 .. 3
+``friction_exponent``   bearing friction x (n / 3000 rpm)^e                    -1 .. 1
 ======================  =====================================================  ===========
 
 Candidate effects (:data:`EFFECTS`, names fixed: users' scripts read them), each a physical
@@ -38,8 +40,8 @@ from spindle.spec import Spec
 
 ROTATING = ("shaft", "tool", "rotor")
 #: the parameters that change the conductance matrix K (the others change sources or read-outs)
-_K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "R_adv_K_W", "G_mount_W_K",
-             "k_preload_1_K")
+_K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "heat_capacity", "R_adv_K_W",
+             "G_mount_W_K", "k_preload_1_K")
 CHANNELS = ("T1", "T2", "T_stator", "P1")
 
 
@@ -65,7 +67,15 @@ class Param:
 # losses moves with slip by about half, 0.4; Dittus-Boelter / Gnielinski for the jacket
 # +-25 %, 0.25; natural and mixed convection correlations on the housing +-35 %, 0.35;
 # rotating-surface correlations +-50 %, 0.4; contact conductances scatter by a factor 2-4
-# between assemblies, 0.7; expansion coefficients of steels +-10 %, 0.1.
+# between assemblies, 0.7; expansion coefficients of steels +-10 %, 0.1. Two more freedoms for a
+# spindle its spec describes only approximately (issue 13; a peer's SPL2782-family runs need
+# both): the effective heat capacity, since how much of the CAD masses takes part on a cycle's
+# time scales depends on contacts and films the spec only approximates (a factor 2 at 1 sigma,
+# 0.7); and the speed dependence of the bearing friction, Palmgren's (nu n)^(2/3) law being
+# an average over lubrication regimes (exponent shift 0.5 at 1 sigma, per Harris's spread of
+# measured friction-speed curves).
+#: speed at which friction_exponent leaves the friction unchanged [rpm]
+FRICTION_REF_RPM = 3000.0
 BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
     Param("f0", "-", 0.30, 0.05, 3.0, "Palmgren bearing friction factor of all pairs",
           prior_sd=0.4),
@@ -80,6 +90,11 @@ BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
           prior_sd=0.7),
     Param("alpha_eff", "x", 1.0, 0.5, 2.0, "factor on the expansion coefficients of the "
           "thermoelastic chain (effective expansion coefficient)", prior_sd=0.1),
+    Param("heat_capacity", "x", 1.0, 0.1, 3.0, "factor on every heat capacity of the network "
+          "(effective thermal mass)", prior_sd=0.7),
+    Param("friction_exponent", "-", 0.0, -1.0, 1.0, "bearing friction times "
+          f"(n / {FRICTION_REF_RPM:g} rpm)^e: its speed dependence beyond Palmgren's",
+          log=False, prior_sd=0.5),
 )}
 
 
@@ -193,10 +208,14 @@ class GreyBox:
         return out
 
     # ------------------------------------------------------------------ sources
-    def sources(self, f0: float, rotor_share: float) -> dict[str, np.ndarray]:
-        key = ("src", round(f0, 12), round(rotor_share, 12))
+    def sources(self, f0: float, rotor_share: float, friction_exponent: float = 0.0
+                ) -> dict[str, np.ndarray]:
+        """Heat per source [W] and interval: the power balance with friction factor ``f0``
+        times (n / FRICTION_REF_RPM)^``friction_exponent`` and the rotor share of the motor
+        losses."""
+        key = ("src", round(f0, 12), round(rotor_share, 12), round(friction_exponent, 12))
         if key not in self._cache:
-            d = self.drive.with_f0(f0).with_rotor_share(rotor_share)
+            base = self.drive.with_rotor_share(rotor_share)
             inp = self.inputs
             memo: dict[tuple, dict[str, float]] = {}
             rows = []
@@ -206,6 +225,8 @@ class GreyBox:
                 k = (round(float(n), 3), round(float(M), 2),
                      None if np.isnan(P) else round(float(P), 2))
                 if k not in memo:  # P unknown (nan): the motor model gives the losses
+                    d = base.with_f0(f0 * (max(k[0], 1.0) / FRICTION_REF_RPM)
+                                     ** friction_exponent)
                     if k[2] is None:
                         memo[k] = d.heat_W(k[0], k[1], None)
                     else:  # measured P: standstill and P < P_mech handled as the bench does
@@ -293,7 +314,8 @@ class GreyBox:
             if len(systems) > 64:
                 for k in systems[:32]:
                     del self._cache[k]
-            system = dc_replace(base, edges=edges, _cache={})
+            system = dc_replace(base, edges=edges, _cache={},
+                                capacity=base.capacity * theta.get("heat_capacity", 1.0))
             if not preload:
                 self._cache[kkey] = system
         out = LumpedModel.__new__(LumpedModel)
@@ -310,7 +332,7 @@ class GreyBox:
         model = self._model(th)
         sys = model.system
         inp = self.inputs
-        src = self.sources(th["f0"], th["rotor_share"])
+        src = self.sources(th["f0"], th["rotor_share"], th["friction_exponent"])
         n_int = len(inp.grid_s) - 1
         cols = []
         for name in sys.source_names:

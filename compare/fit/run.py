@@ -23,11 +23,12 @@ import json
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from compare.fit.adequacy import base_adequacy, extrapolation_warnings
 from compare.fit.calibrate import (
     TOLERANCE,
     Calibrator,
@@ -102,6 +103,10 @@ class FitReport:
     prior_z: dict | None = None  # final base parameters, prior sds from the spec's values
     calibration_model: str = "lumped"  # "fem": base parameters calibrated on the FEM itself
     fem_calibration: dict | None = None  # with "fem": FEM runs, seconds, evaluations
+    #: compare.fit.adequacy.base_adequacy of the calibrated base model
+    base_adequacy: dict | None = None
+    #: operating points of the validation window the fit window never saw
+    warnings: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         sel = self.selection
@@ -129,6 +134,8 @@ class FitReport:
             "alpha": self.alpha,
             "calibration_model": self.calibration_model,
             "fem_calibration": self.fem_calibration,
+            "base_adequacy": self.base_adequacy,
+            "warnings": self.warnings,
             "effects": effects,
             "unexplained": {"unexplained": self.unexplained, "description": self.unexplained_text},
             "error_before": _errors(sel.base), "error_after": _errors(final),
@@ -272,9 +279,13 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                 + " but within the tolerances on the validation window (model-form error "
                 "below the tolerances: the lumped model's sensitivities and the FEM level); no "
                 "effect is named for it")
+    adequacy = base_adequacy(sel.base.errors, sel.base.theta, default_theta(BASE_PARAMS),
+                             cal.prior_z(sel.base))
+    warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
+                                   measured.split_s)
     return FitReport(run, spec, channels, measured, inputs, sel, diag_b, diag_a, unexplained,
                      text, signatures, time.perf_counter() - t0, alpha, anchor, cal.floor,
-                     cal.prior_z(final) or None, model, fem_cal_info)
+                     cal.prior_z(final) or None, model, fem_cal_info, adequacy, warns)
 
 
 #: least_squares function evaluations of the FEM fit with priors (each iteration adds a
@@ -319,7 +330,7 @@ def _calibrate_on_fem(cal: Calibrator, fem_level: int, say: Callable[[str], None
     # as in the lumped path: the fit without priors sets the data's weight against them
     free_fit, base = fcal.fit_with_prior(theta_spec, start=start.theta,
                                          free_nfev=FEM_FREE_NFEV, say=say)
-    theta_cal = {k: base.theta[k] for k in BASE_PARAMS}
+    theta_cal = {k: base.theta.get(k, p.default) for k, p in BASE_PARAMS.items()}
     # re-anchor: the lumped model plus [FEM - lumped] at the calibrated point is the FEM
     # there; the selection of effects runs on it, from the calibrated point
     fem_cal = fem.simulate(theta_cal)
@@ -505,6 +516,7 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
         f"<p>Channels {rep.channels}; fit window up to {rep.measured.split_s / 3600:.2f} h, "
         f"validation after; likelihood-ratio level {rep.alpha:g}; {rep.runtime_s:.1f} s.</p>",
         anchor_html,
+        _adequacy_html(doc),
         "<h2>Effects accepted (in order)</h2><ul>" + eff + "</ul>",
         f"<p><b>Unexplained:</b> {'yes' if unexpl['unexplained'] else 'no'}. "
         f"{html.escape(unexpl['description'])}</p>",
@@ -515,6 +527,22 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
         + "</table>",
         *[img(n, c) for n, c in pngs],
         "</body></html>\n"])
+
+
+def _adequacy_html(doc: dict) -> str:
+    """The base-adequacy verdict and the extrapolation warnings, first thing in the report."""
+    ad = doc.get("base_adequacy")
+    if not ad:
+        return ""
+    verdict = "adequate" if ad["adequate"] else "inadequate"
+    rows = "".join(f"<tr><td>{html.escape(c)}</td>" + "".join(
+        f"<td>{w.get(k, float('nan')):.2f}</td>" for k in ("fit", "validation")) + "</tr>"
+                   for c, w in ad["channels"].items())
+    warns = "".join(f"<li>{html.escape(w)}</li>" for w in doc.get("warnings") or [])
+    return (f"<h2>Base model: {verdict}</h2><p>{html.escape(ad['statement'])}.</p>"
+            "<table><tr><th>channel</th><th>fit RMS / tolerance</th>"
+            f"<th>validation RMS / tolerance</th></tr>{rows}</table>"
+            + (f"<p><b>Warnings</b></p><ul>{warns}</ul>" if warns else ""))
 
 
 def report_summary_text(rep: FitReport) -> str:
@@ -529,6 +557,12 @@ def report_summary_text(rep: FitReport) -> str:
                      "anchored there)")
     else:
         lines.append("  calibration model: lumped")
+    ad = doc.get("base_adequacy")
+    if ad:
+        lines.append(f"  base model: {'adequate' if ad['adequate'] else 'INADEQUATE'}: "
+                     f"{ad['statement']}")
+    for w in doc.get("warnings") or []:
+        lines.append(f"  warning: {w}")
     for e in doc["effects"]:
         lines.append(f"  effect {e['name']}: {json.dumps(e['parameters'])} "
                      f"(p = {e['p_value']:.2g}, delta BIC {e['delta_bic']:.1f}, needed by "

@@ -1,0 +1,123 @@
+"""Verdicts on the calibrated base model before any effect is named (docs/fit.md, issue 13 §4-5).
+
+- :func:`base_adequacy`: how well the calibrated base model alone explains the run (open-loop
+  RMS per channel against the paper's tolerances, 1 K and 1.5 µm), which base parameters
+  moved where (in prior standard deviations from the spec's values), and, where it falls
+  short, a plain statement: which channel, by how much, and what in the spec to look at.
+- :func:`extrapolation_warnings`: operating points of the validation window that the fit
+  window never saw, so a validation error there is an extrapolation, not a check.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+#: |z| beyond which a base parameter is outside its prior range (two-sided 1 %)
+IMPLAUSIBLE_Z = 2.576
+
+#: where in the spec (or drive file) each base parameter lives: what to look at when the
+#: calibration drives it out of its prior range
+WHERE_IN_SPEC = {
+    "f0": "the bearing friction factor f0 in the drive file ([bearings.*] f0)",
+    "friction_exponent": "the speed dependence of the bearing friction (the drive file's "
+                         "bearing sets: viscosity, pitch diameter, lubrication)",
+    "rotor_share": "the rotor's share of the motor losses in the drive file "
+                   "([motor] rotor_loss_share)",
+    "h_coolant": "the coolant-jacket films (surfaces with T_ref = \"coolant\") and the "
+                 "stator-to-jacket conduction path (stator material, its contact to the sleeve)",
+    "h_air": "the housing's films to the ambient air (surfaces with T_ref = \"ambient\" on the "
+             "housing)",
+    "h_rotating": "the rotating surfaces' film correlation (shaft and tool surfaces, "
+                  "correlation d_m)",
+    "contact": "the fitted-joint contact conductances ([[links]] kind = \"contact\", h_W_m2K)",
+    "alpha_eff": "the expansion coefficients of the growth chain's materials (alpha_1_K) and "
+                 "the P1 sensor's position",
+    "heat_capacity": "the parts' volumes and materials (rho_kg_m3, c_J_kgK): the thermal mass "
+                     "that takes part on the run's time scales",
+}
+
+
+def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
+                  theta: Mapping[str, float], spec_values: Mapping[str, float],
+                  prior_z: Mapping[str, float] | None) -> dict:
+    """The base-adequacy verdict of a calibrated base model.
+
+    ``errors``: :meth:`compare.fit.calibrate.Calibrator.errors` of the base fit (per window
+    and channel, with ``rmse_w``, the RMS in units of the channel's tolerance); ``theta`` its
+    parameters; ``spec_values`` the spec's values (prior centres); ``prior_z`` the parameters'
+    distances from them in prior standard deviations (empty without priors).
+
+    Returns ``{"adequate": bool, "channels": {c: {window: rmse_w}}, "inadequate_channels":
+    [...], "moved": [{name, spec, calibrated, z}], "implausible": [...], "statement": str}``.
+    A channel is inadequate when its open-loop RMS exceeds its tolerance on either window.
+    """
+    channels: dict[str, dict[str, float]] = {}
+    bad: list[tuple[str, str, float]] = []
+    for window in ("fit", "validation"):
+        for c, e in errors.get(window, {}).items():
+            if not e.get("n"):
+                continue
+            channels.setdefault(c, {})[window] = float(e["rmse_w"])
+            if e["rmse_w"] > 1.0:
+                bad.append((c, window, float(e["rmse_w"])))
+    z = dict(prior_z or {})
+    moved = [{"name": k, "spec": float(spec_values[k]), "calibrated": float(theta[k]),
+              "z": float(z[k]) if k in z else None}
+             for k in spec_values if k in theta]
+    implausible = sorted((k for k, v in z.items() if abs(v) > IMPLAUSIBLE_Z),
+                         key=lambda k: -abs(z[k]))
+    worst: dict[str, tuple[str, float]] = {}
+    for c, window, r in bad:
+        if r > worst.get(c, ("", 0.0))[1]:
+            worst[c] = (window, r)
+    parts = []
+    if worst:
+        parts.append("the calibrated base model alone misses " + "; ".join(
+            f"{c} by {r:.1f} times its tolerance (open-loop RMS, {w} window)"
+            for c, (w, r) in sorted(worst.items(), key=lambda kv: -kv[1][1])))
+    if implausible:
+        parts.append("to fit the run, " + "; ".join(
+            f"{k} moved to {theta[k]:.3g} (spec {spec_values[k]:.3g}, {z[k]:+.1f} prior sd): "
+            f"look at {WHERE_IN_SPEC.get(k, 'its value in the spec')}" for k in implausible))
+    adequate = not worst and not implausible
+    statement = ("the calibrated base model explains the run within the tolerances with every "
+                 "base parameter inside its prior range" if adequate else
+                 "base model inadequate for this run: " + ". ".join(parts)
+                 + ". An effect named on top of it is named against this misfit; fix the "
+                 "spec first where a parameter left its range")
+    return {"adequate": adequate, "channels": channels,
+            "inadequate_channels": sorted(worst), "moved": moved,
+            "implausible": implausible, "statement": statement}
+
+
+def extrapolation_warnings(grid_s: np.ndarray, speed_rpm: np.ndarray,
+                           load_torque_Nm: np.ndarray, split_s: float,
+                           rel: float = 0.05) -> list[str]:
+    """Operating points of the validation window (after ``split_s`` [s]) outside what the
+    fit window saw: speeds [rpm] or load torques [N m] beyond the fit window's largest by more
+    than ``rel``, or speed levels the fit window never held (none within ``rel``). Per
+    interval arrays, ``grid_s`` its edges."""
+    t = np.asarray(grid_s)[:-1]
+    fit, val = t <= split_s, t > split_s
+    out = []
+    for name, x, unit in (("speed", np.asarray(speed_rpm), "rpm"),
+                          ("load torque", np.asarray(load_torque_Nm), "N m")):
+        if not val.any() or not fit.any():
+            continue
+        top_fit, top_val = float(np.max(x[fit])), float(np.max(x[val]))
+        if top_val > (1.0 + rel) * top_fit + 1e-9:
+            out.append(f"the validation window reaches {name} {top_val:.0f} {unit}, above the "
+                       f"fit window's {top_fit:.0f} {unit}: the validation error there is an "
+                       "extrapolation")
+    levels_fit = np.unique(np.round(speed_rpm[fit]))
+    unseen = sorted({float(v) for v in np.unique(np.round(speed_rpm[val]))
+                     if v > 0 and not np.any(np.abs(levels_fit - v) <= rel * v)})
+    if unseen:
+        share = float(np.mean([np.any(np.abs(np.array(unseen) - v) <= 0.5)
+                               for v in np.round(speed_rpm[val])]))
+        out.append("speeds " + ", ".join(f"{v:.0f}" for v in unseen) + " rpm hold "
+                   f"{100 * share:.0f} % of the validation window and never occur in the fit "
+                   "window")
+    return out

@@ -1,0 +1,78 @@
+"""The base-adequacy verdict and the extrapolation warnings of ``fit`` (compare.fit.adequacy)."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from compare.fit.adequacy import IMPLAUSIBLE_Z, base_adequacy, extrapolation_warnings
+
+
+def _errors(rmse_w: dict[str, tuple[float, float]]) -> dict:
+    return {w: {c: {"n": 100, "rmse_w": v[i]} for c, v in rmse_w.items()}
+            for i, w in enumerate(("fit", "validation"))}
+
+
+SPEC = {"h_coolant": 1.0, "f0": 0.3}
+
+
+def test_adequate_when_within_tolerance_and_in_range():
+    ad = base_adequacy(_errors({"T1": (0.2, 0.3), "P1": (0.1, 0.4)}), {"h_coolant": 1.3, "f0": 0.31},
+                       SPEC, {"h_coolant": 1.0, "f0": 0.1})
+    assert ad["adequate"] and ad["inadequate_channels"] == [] and ad["implausible"] == []
+    assert ad["channels"]["T1"] == {"fit": 0.2, "validation": 0.3}
+
+
+def test_inadequate_names_the_channel_the_factor_and_where_to_look():
+    """A channel past its tolerance on either window and a parameter beyond the two-sided 1 %
+    prior range make the base inadequate; the statement names both, with the spec's place."""
+    z = IMPLAUSIBLE_Z + 0.5
+    ad = base_adequacy(_errors({"T1": (0.4, 2.5), "T_stator": (1.5, 0.9)}),
+                       {"h_coolant": 6.0, "f0": 0.3}, SPEC, {"h_coolant": z, "f0": 0.0})
+    assert not ad["adequate"]
+    assert ad["inadequate_channels"] == ["T1", "T_stator"]
+    assert ad["implausible"] == ["h_coolant"]
+    assert "T1 by 2.5 times its tolerance" in ad["statement"]
+    assert "T_stator by 1.5 times" in ad["statement"] and "coolant-jacket films" in ad["statement"]
+    assert {m["name"]: m["calibrated"] for m in ad["moved"]} == {"h_coolant": 6.0, "f0": 0.3}
+
+
+def test_no_priors_judges_the_channels_only():
+    ad = base_adequacy(_errors({"T1": (0.3, 0.2)}), {"h_coolant": 50.0}, SPEC, None)
+    assert ad["adequate"] and ad["moved"][0]["z"] is None
+
+
+def test_extrapolation_warnings():
+    """A cycle that ramps up warns (its last steps are beyond the fit window); one that
+    visits the same levels before and after the split does not."""
+    grid = np.arange(0.0, 10 * 3600.0 + 1.0, 60.0)
+    t = grid[:-1]
+    ramp = np.floor(t / 3600.0) * 600.0  # 0, 600, ..., 5400 rpm; 3600 starts at the split
+    w = extrapolation_warnings(grid, ramp, np.zeros_like(t), 6 * 3600.0)
+    assert any("speed 5400 rpm, above the fit window's 3600" in m for m in w)
+    assert any("never occur in the fit window" in m for m in w)
+    back_and_forth = np.where((t // 3600.0) % 2 == 0, 1500.0, 4500.0)
+    assert extrapolation_warnings(grid, back_and_forth, np.zeros_like(t), 6 * 3600.0) == []
+    torque = np.where(t > 6 * 3600.0, 40.0, 10.0)
+    assert any("load torque 40" in m for m in extrapolation_warnings(
+        grid, back_and_forth, torque, 6 * 3600.0))
+
+
+PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not (PEER_RUNS / "dev-09.csv").exists(),
+                    reason="the peer's bench runs are beside the project")
+def test_base_inadequacy_on_a_peer_control_run():
+    """On a peer's loaded control run (an SPL2782-family spindle that is not the spec, 26 kW
+    peaks), the calibrated base model misses the stator temperature by more than its
+    tolerance and moves the jacket film beyond its prior range: the verdict says both, and
+    where to look (slow: one fit, about 30 s; test_synth_then_fit_end_to_end covers the path)."""
+    from compare.fit.run import run_fit
+    from spindle.spec import load_spec
+
+    ad = run_fit(PEER_RUNS / "dev-09.csv", load_spec("spl2782")).base_adequacy
+    assert not ad["adequate"]
+    assert "T_stator" in ad["inadequate_channels"] and "h_coolant" in ad["implausible"]
+    assert "coolant-jacket films" in ad["statement"]
