@@ -1,0 +1,64 @@
+"""``spindle-verify fit``: fit a bench run: calibrate, diagnose the residual, name the effects it supports."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from compare.cli.common import progress as _progress
+from spindle.errors import InputError
+
+
+def _cmd_fit(args: argparse.Namespace) -> int:
+    from compare.fit.run import report_summary_text, run_fit, save_report
+    from spindle.outputs import output_dir
+    from spindle.spec import load_spec
+
+    if args.model == "fem" and args.lumped_only:
+        raise InputError("command line", "--model", "--model fem calibrates on the FEM "
+                         "reference, --lumped-only switches the FEM off",
+                         "drop one of the two options")
+    spec = load_spec(args.spec)
+    rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
+                  candidates=args.candidates, min_gain=args.min_gain / 100.0,
+                  progress=_progress(args.quiet),
+                  fem_level=None if args.lumped_only else args.fem_level, model=args.model)
+    out = Path(args.out or f"results/{spec.name}/fit-{Path(args.run).stem}")
+    with output_dir(out, inputs=[spec.path, args.run]) as tmp:
+        save_report(rep, tmp, pictures=not args.no_pictures)
+    print(report_summary_text(rep))
+    print(f"wrote {out}/report.json, {out}/report.html")
+    return 0
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the command's sub-parser."""
+    fp = subparsers.add_parser("fit", help="fit a bench run: calibrate, diagnose the residual, add the "
+                        "effects it supports, report the error before and after")
+    fp.add_argument("run", metavar="RUN.csv", help="bench export (format: docs/bench.md)")
+    fp.add_argument("--spec", default="spl2782", help="the spindle (default spl2782)")
+    fp.add_argument("--out", help="output folder (default results/<spec>/fit-<run>)")
+    fp.add_argument("--fit-fraction", type=float, default=0.6,
+                    help="fraction of the run used for fitting; the rest validates (0.6)")
+    fp.add_argument("--alpha", type=float, default=0.01,
+                    help="level of the likelihood-ratio test for adding an effect (0.01)")
+    fp.add_argument("--min-gain", type=float, default=25.0,
+                    help="an effect must remove at least this share [%%] of the validation "
+                    "error above the floor (lumped-model error against the FEM and sensor "
+                    "noise) (default 25)")
+    fp.add_argument("--fem-level", type=int, default=0,
+                    help="FEM reference level that anchors the model on the run's inputs "
+                    "(default 0; docs/fit.md)")
+    fp.add_argument("--lumped-only", action="store_true",
+                    help="no FEM anchor and no priors: the lumped model alone, factors from "
+                    "1 (faster; effects the base parameters can imitate go unnamed)")
+    fp.add_argument("--model", choices=("lumped", "fem"), default="lumped",
+                    help="model the base parameters are calibrated on (default lumped: the "
+                    "lumped model anchored to the FEM at the spec's values; fast). fem: "
+                    "calibrate the base parameters on the FEM reference itself (minutes), "
+                    "then select effects on the lumped model anchored there")
+    fp.add_argument("--nodes", type=int, default=11, help="lumped model nodes (default 11)")
+    fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
+    fp.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
+    fp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    fp.set_defaults(func=_cmd_fit)

@@ -1,0 +1,75 @@
+"""``spindle-verify baseline`` and ``check``: store a study's figures as a baseline, check
+them later."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from compare.cli.common import progress as _progress
+from spindle.errors import InputError
+
+
+def _cmd_baseline(args: argparse.Namespace) -> int:
+    from compare.verify.regression import make_baseline
+    from spindle.outputs import atomic_write
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)  # validates before the long run
+    out = Path(args.out)
+    if out.exists() and out.is_dir():
+        raise InputError(str(out), "--out", "is a folder", "give a file name, e.g. baseline.json")
+    if out.resolve() == Path(spec.path).resolve():
+        raise InputError(str(out), "--out", "would overwrite the spec", "choose another file")
+    settings = {"levels": sorted(set(args.levels)), "nodes": sorted(set(args.nodes)),
+                "dt_s": args.dt, "transient": not args.steady_only}
+    tolerances = {"temperature_K": args.tol_temp, "growth_um": args.tol_growth}
+    doc = make_baseline(args.spec, settings, tolerances, _progress(args.quiet))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(out, lambda tmp: tmp.write_text(json.dumps(doc, indent=1) + "\n", "utf-8"))
+    print(f"{spec.name}: {len(doc['figures'])} figures in {doc['created_with_runtime_s']:.1f} s; "
+          f"wrote {out}")
+    return 0
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from compare.verify.regression import check, read_baseline
+
+    doc = read_baseline(args.file)
+    changes = check(doc, progress=_progress(args.quiet))
+    moved = [c for c in changes if c.moved]
+    if moved:
+        print(f"{args.file}: {len(moved)} of {len(changes)} figures moved beyond their "
+              "tolerance:")
+        for c in moved:
+            print(c.line())
+        return 1
+    print(f"{args.file}: all {len(changes)} figures within their tolerances")
+    return 0
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the command's sub-parser."""
+    bp = subparsers.add_parser("baseline", help="store the figures of a study (values, errors, "
+                        "tolerances) as JSON for regression checks")
+    bp.add_argument("spec", metavar="SPEC")
+    bp.add_argument("--out", required=True, help="the JSON file to write")
+    bp.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2],
+                    help="FEM levels, three or more (default 0 1 2)")
+    bp.add_argument("--nodes", type=int, nargs="+", default=[5, 11],
+                    help="lumped node counts (default 5 11)")
+    bp.add_argument("--dt", type=float, default=300.0, help="transient time step [s] (300)")
+    bp.add_argument("--steady-only", action="store_true", help="skip the transient figures")
+    bp.add_argument("--tol-temp", type=float, default=0.01,
+                    help="how far a temperature may move [K] (default 0.01)")
+    bp.add_argument("--tol-growth", type=float, default=0.01,
+                    help="how far a growth may move [um] (default 0.01)")
+    bp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    bp.set_defaults(func=_cmd_baseline)
+
+    cp = subparsers.add_parser("check", help="recompute a baseline's figures; exit 1 with a diff when "
+                        "any moved beyond its tolerance")
+    cp.add_argument("file", metavar="FILE")
+    cp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    cp.set_defaults(func=_cmd_check)

@@ -1,0 +1,139 @@
+"""``spindle-verify solve``: one solve of the FEM reference or a lumped model, steady or transient."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from spindle.drive import load_case
+from spindle.units import ZERO_C_K
+
+
+def _print_sensor_table(table: dict, title: str) -> None:
+    print(title)
+    print(f"  {'sensor':<16} {'z_mm':>7} {'r_mm':>7} {'T_C':>9} {'rise_K':>8}")
+    for i, name in enumerate(table["sensor"]):
+        print(f"  {name:<16} {table['z_m'][i] * 1e3:7.1f} {table['r_m'][i] * 1e3:7.2f} "
+              f"{table['T_C'][i]:9.3f} {table['rise_K'][i]:8.3f}")
+
+
+def _cmd_solve(args: argparse.Namespace) -> int:
+    from compare.progress import Progress
+    from reference import ReferenceModel
+    from spindle.loads import TimeSeries
+    from spindle.outputs import output_dir
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)
+    t0 = time.perf_counter()
+    if args.model == "lumped":
+        from lumped import build
+
+        nodes = int(args.nodes) if args.nodes.isdigit() else args.nodes
+        ref = build(spec, nodes)
+        header = (f"{spec.name}: lumped function-block model, {ref.nodes} nodes along shaft "
+                  f"and housing, {ref.n_states} masses")
+    else:
+        ref = ReferenceModel(spec, args.level, args.order, centrifugal=args.centrifugal,
+                             elastic=not args.thermal_only)
+        c = ref.thermal.smesh.counts(args.order)
+        header = (f"{spec.name}: FEM P{args.order}, level {args.level}, {c['elements']} "
+                  f"elements, {ref.thermal.basis.N} DOFs")
+    t_asm = time.perf_counter() - t0
+    case = spec.default_load_case()
+    inputs = [spec.path]
+    if args.case:
+        case = load_case(spec, args.case, case)
+        if Path(args.case).is_file():
+            inputs.append(args.case)
+    if args.speed is not None:
+        case = replace(case, speed_rpm=TimeSeries.constant(args.speed))
+    quiet = args.quiet
+    if args.cycle:
+        case = load_case(spec, args.cycle, case)
+        if Path(args.cycle).is_file():
+            inputs.append(args.cycle)
+        if args.model == "lumped":  # exact zero-order hold: no theta, no fields
+            result = ref.transient(case, args.dt, T0=float(case.T_ambient_K(0.0)),
+                                   progress=Progress("transient", not quiet))
+        else:
+            result = ref.transient(case, args.dt, theta=args.theta,
+                                   T0=float(case.T_ambient_K(0.0)),
+                                   save_every=max(1, int(round(args.save_every / args.dt))),
+                                   progress=Progress("transient", not quiet))
+    else:
+        result = ref.steady(case)
+    t_solve = time.perf_counter() - t0 - t_asm
+    out = Path(args.out or f"results/{spec.name}")
+    with output_dir(out, inputs=inputs) as tmp:
+        files = result.save(tmp, pictures=not args.no_pictures)
+    print(f"{header}; {'build' if args.model == 'lumped' else 'assembly'} {t_asm:.2f} s, "
+          f"solve {t_solve:.2f} s")
+    if args.cycle:
+        s = result.summary()
+        scheme = "exact zero-order hold" if args.model == "lumped" else f"theta = {args.theta:g}"
+        print(f"transient '{case.name}': {s['steps']} steps over {s['duration_s'] / 3600:.2f} h, "
+              f"{scheme}")
+        print(f"  {'sensor':<16} {'peak_C':>9} {'final_C':>9}")
+        for n in result.names:
+            print(f"  {n:<16} {s['peak_C'][n]:9.3f} {s['final_C'][n]:9.3f}")
+        print(f"  {'growth':<16} {'peak_um':>9} {'final_um':>9}")
+        for n in result.growth_m:
+            print(f"  {n:<16} {s['peak_growth_um'][n]:9.3f} {s['final_growth_um'][n]:9.3f}")
+        e = result.energy
+        print(f"energy: in {e['energy_in_J'] / 3.6e6:.4f} kWh, out {e['energy_out_J'] / 3.6e6:.4f}"
+              f" kWh, stored {e['energy_stored_J'] / 3.6e6:.4f} kWh, relative imbalance "
+              f"{e['relative_imbalance']:.1e}")
+    else:
+        _print_sensor_table(result.sensor_table(),
+                            f"steady state at {result.speed_rpm:g} rpm, ambient "
+                            f"{case.T_ambient_K(0) - ZERO_C_K:.2f} degC:")
+        for n, v in result.growth_m.items():
+            print(f"  {n + '_um':<16} {v * 1e6:9.3f}  axial growth relative to the housing "
+                  "fixation below the front bearing")
+        e = result.energy
+        print(f"energy: in {e['heat_in_W']:.3f} W, out {e['heat_out_W']:.3f} W, relative "
+              f"imbalance {e['relative_imbalance']:.1e}; relative residual {result.residual:.1e}")
+    print("wrote " + ", ".join(str(out / f.name) for f in files))
+    return 0
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the command's sub-parser."""
+    so = subparsers.add_parser("solve", help="temperatures and axial growth (P1) from the FEM reference "
+                        "or a lumped model, steady or over a transient cycle")
+    so.add_argument("spec", metavar="SPEC")
+    so.add_argument("--model", choices=("fem", "lumped"), default="fem",
+                    help="fem: the FEM reference (default); lumped: the paper's function-block "
+                         "model")
+    so.add_argument("--nodes", default="11",
+                    help="lumped model: masses along shaft and housing, an integer >= 2 or "
+                         "paper5 / paper11 (default 11)")
+    so.add_argument("--level", type=int, default=2, help="mesh level (default 2)")
+    so.add_argument("--order", type=int, choices=(1, 2), default=2,
+                    help="element order (default 2)")
+    mode = so.add_mutually_exclusive_group()
+    mode.add_argument("--steady", action="store_true", help="steady state (the default)")
+    mode.add_argument("--cycle", metavar="CYCLE",
+                      help="transient: a shipped cycle (spl-16h, nominal), a cycle TOML, a "
+                           "step-table CSV (speed_rpm, duration_s, load_torque_Nm) or a time "
+                           "series CSV (time_s, speed_rpm, T_env_C, T_coolant_C, <source>_W)")
+    so.add_argument("--case", metavar="CYCLE",
+                    help="steady load case from a cycle's first step, e.g. 'nominal' "
+                         "(38 kW / 4300 rpm); heat sources from the power balance")
+    so.add_argument("--speed", type=float, help="spindle speed for a steady solve [rpm]")
+    so.add_argument("--dt", type=float, default=60.0, help="time step [s] (default 60)")
+    so.add_argument("--theta", type=float, default=1.0,
+                    help="1 = backward Euler (default), 0.5 = Crank-Nicolson")
+    so.add_argument("--save-every", type=float, default=1800.0,
+                    help="keep a field for ParaView every this many seconds (default 1800)")
+    so.add_argument("--centrifugal", action="store_true",
+                    help="add the centrifugal load of the rotating parts (off by default)")
+    so.add_argument("--thermal-only", action="store_true",
+                    help="skip the thermoelastic growth (P1, TCP)")
+    so.add_argument("--out", help="output folder (default results/<spec>)")
+    so.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
+    so.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    so.set_defaults(func=_cmd_solve)
