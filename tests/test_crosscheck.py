@@ -26,11 +26,11 @@ if shutil.which("ccx") is None:  # the importorskip of an executable
     pytest.skip("CalculiX (ccx) is not installed; apt-get install calculix-ccx",
                 allow_module_level=True)
 
-from compare.crosscheck.calculix import (  # noqa: E402 - after the skip
+from compare.cli.crosscheck import register  # noqa: E402 - after the skip
+from compare.crosscheck import (  # noqa: E402
     CCX_MISSING,
     crosscheck,
     read_frd,
-    register,
     run_ccx,
 )
 from spindle.errors import SolverError  # noqa: E402

@@ -40,11 +40,11 @@ def build_parser() -> argparse.ArgumentParser:
     synth.register(sub)
     measures.register(sub)
 
-    from compare.crosscheck import calculix
+    from compare.cli import crosscheck
     from compare.verify import sensors
 
     sensors.register(sub)
-    calculix.register(sub)
+    crosscheck.register(sub)
     return p
 
 

@@ -1,0 +1,65 @@
+"""``spindle-verify crosscheck``: the reference against CalculiX."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from compare.crosscheck.check import crosscheck
+from spindle.spec import load_spec
+from spindle.units import ZERO_C_K
+
+
+# --------------------------------------------------------------------------- command line
+def _cmd_crosscheck(args: argparse.Namespace) -> int:
+    """``spindle-verify crosscheck``: print the comparison table, write JSON and CSV."""
+    from spindle.drive import load_case
+    from spindle.outputs import output_dir
+
+    spec = load_spec(args.spec)
+    case = None if args.case is None else load_case(spec, args.case)
+    inputs = [args.case] if args.case is not None and Path(args.case).is_file() else []
+    out = Path(args.out or f"results/{spec.name}/crosscheck")
+    with output_dir(out, inputs=[spec.path, *inputs]) as tmp:
+        result = crosscheck(spec, args.level, case,
+                            keep_dir=(tmp / "ccx") if args.keep_deck else None)
+        files = result.save(tmp)
+    s = result.summary()
+    print(f"{spec.name}: scikit-fem reference against CalculiX {result.ccx_version}, P2 level "
+          f"{result.level} ({s['mesh']['nodes']} nodes, {s['mesh']['elements']} elements), "
+          f"case '{result.case}' at {result.speed_rpm:g} rpm")
+    print(f"  {'sensor':<16} {'T_skfem_C':>10} {'T_ccx_C':>10} {'diff_K':>10}")
+    for i, n in enumerate(result.sensors):
+        print(f"  {n:<16} {result.T_skfem_K[i] - ZERO_C_K:10.4f} {result.T_ccx_K[i] - ZERO_C_K:10.4f} "
+              f"{result.diff_K[i]:10.1e}")
+    if result.growth_skfem_m:
+        print(f"  {'reading':<16} {'skfem_um':>10} {'ccx_um':>10} {'diff_um':>10}")
+        for k, v in result.growth_skfem_m.items():
+            c = result.growth_ccx_m[k]
+            print(f"  {k + '_um':<16} {v * 1e6:10.4f} {c * 1e6:10.4f} {(c - v) * 1e6:10.1e}")
+    print(f"max |T_ccx - T_skfem| = {s['max_abs_diff_K']:.1e} K at the sensors, "
+          f"{result.nodal['max_abs_diff_K']:.1e} K over all nodes; against the reference "
+          f"with ccx's quadrature {result.nodal['max_abs_ccx_minus_twin_K']:.1e} K (print "
+          f"precision {result.nodal['max_print_bound_K']:.1e} K)")
+    print("wrote " + ", ".join(str(out / f.name) for f in files)
+          + (f", {out / 'ccx'}/" if args.keep_deck else ""))
+    return 0
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``crosscheck SPEC [--level N] [--case CYCLE] [--out DIR] [--keep-deck]``."""
+    cp = subparsers.add_parser(
+        "crosscheck", help="cross-check the FEM reference with CalculiX (ccx) on the same P2 "
+                           "mesh: sensor temperatures and axial growth (P1, TCP)",
+        description="Cross-check the FEM reference with CalculiX (ccx, Debian package "
+                    "calculix-ccx) on the same P2 mesh: sensor temperatures and axial growth "
+                    "(P1, TCP) from both codes and their differences.")
+    cp.add_argument("spec", metavar="SPEC")
+    cp.add_argument("--level", type=int, default=1, help="mesh level (default 1)")
+    cp.add_argument("--case", metavar="CYCLE",
+                    help="steady load case from a cycle's first step, e.g. 'nominal' (default: "
+                         "the spec's operating point)")
+    cp.add_argument("--out", help="output folder (default results/<spec>/crosscheck)")
+    cp.add_argument("--keep-deck", action="store_true",
+                    help="keep the ccx decks, result files and logs in <out>/ccx")
+    cp.set_defaults(func=_cmd_crosscheck)
