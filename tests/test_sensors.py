@@ -13,17 +13,11 @@ import math
 import numpy as np
 import pytest
 
+from compare.cli.sensors import register
 from compare.verify.accuracy import AccuracyResult, fem_entry, lumped_entries
-from compare.verify.sensors import (
-    Snapshots,
-    Target,
-    choose_nodes,
-    default_cases,
-    load_cases,
-    rank_sensors,
-    rank_snapshots,
-    register,
-)
+from compare.verify.cases import default_cases, load_cases
+from compare.verify.nodecount import choose_nodes
+from compare.verify.placement import Snapshots, Target, rank_sensors, rank_snapshots
 from spindle.errors import InputError
 from spindle.spec import load_spec
 

@@ -40,8 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     synth.register(sub)
     measures.register(sub)
 
-    from compare.cli import crosscheck
-    from compare.verify import sensors
+    from compare.cli import crosscheck, sensors
 
     sensors.register(sub)
     crosscheck.register(sub)

@@ -1,0 +1,107 @@
+"""``spindle-verify sensors``: how many lumped nodes a spec needs, and which sensors to measure."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from compare.verify.accuracy import (
+    NODES,
+    TOL_GROWTH_UM,
+    TOL_TEMP_K,
+)
+from compare.verify.cases import load_cases
+from compare.verify.nodecount import choose_nodes
+from compare.verify.placement import METHODS, TRAIN_FRACTION, rank_sensors
+from spindle.errors import InputError
+
+
+# ============================================================================ command line
+def run(args: argparse.Namespace) -> int:
+    """``spindle-verify sensors``: the node count, and with ``--rank K`` the sensor ranking.
+    Returns the exit status (0; bad input raises :class:`spindle.errors.InputError`)."""
+    from spindle.outputs import output_dir
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)
+    quiet = args.quiet
+
+    def say(msg: str) -> None:
+        if not quiet:
+            print(f"  ... {msg}", file=sys.stderr, flush=True)
+
+    cases = load_cases(spec, args.cases) if args.cases else None
+    if args.rank is not None and args.rank < 1:
+        raise InputError("command line", "--rank", f"{args.rank} sensors", "give --rank K >= 1")
+    choice = choose_nodes(spec, cases, args.tol_temp, args.tol_growth, args.nodes, args.level,
+                          args.dt, say)
+    ranking = None
+    if args.rank is not None:
+        rank_case = (load_cases(spec, [args.rank_case], steady_cycles=False)[0]
+                     if args.rank_case else None)
+        say(f"FEM level {args.rank_level} transient for the sensor ranking "
+            f"(dt {args.rank_dt:g} s)")
+        ranking = rank_sensors(spec, rank_case, args.rank, args.candidates, None, args.method,
+                               args.rank_level, args.rank_dt, args.tol_temp, args.tol_growth)
+    out = Path(args.out or f"results/{spec.name}/sensors")
+    with output_dir(out, inputs=[spec.path]) as tmp:
+        files = choice.save(tmp, pictures=not args.no_pictures)
+        if ranking is not None:
+            files += ranking.save(tmp, pictures=not args.no_pictures)
+    print(f"{spec.name}: lumped node count against {choice.curves[0].reference_label.split(',')[0]}"
+          f" ({choice.runtime_s:.1f} s)")
+    for c in choice.curves:
+        print(f"  case {c.name}: {c.kind}, reference {c.reference_label}")
+    print(choice.text())
+    print(choice.message())
+    if ranking is not None:
+        print(f"sensor ranking ({ranking.method}, {ranking.case_name}, FEM level "
+              f"{ranking.reference_level}, dt {ranking.dt_s:g} s): affine least squares fitted "
+              f"on the first {ranking.n_train} samples ({100 * TRAIN_FRACTION:g} %), errors on "
+              f"the last {ranking.n_valid} (from t = {ranking.split_time_s / 3600:.2f} h):")
+        print(ranking.text())
+    print("wrote " + ", ".join(str(out / f.name) for f in files))
+    return 0
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add the ``sensors`` command to ``subparsers`` (from ``add_subparsers``); its
+    ``func`` is :func:`run`."""
+    p = subparsers.add_parser(
+        "sensors", help="the lumped node count that meets the tolerances on every case, and "
+                        "a ranking of sensor positions that reconstruct shaft temperature and P1")
+    p.add_argument("spec", metavar="SPEC")
+    p.add_argument("--tol-temp", type=float, default=TOL_TEMP_K,
+                   help=f"tolerance on the worst sensor temperature error [K] (default "
+                        f"{TOL_TEMP_K:g})")
+    p.add_argument("--tol-growth", type=float, default=TOL_GROWTH_UM,
+                   help=f"tolerance on the P1 error [um] (default {TOL_GROWTH_UM:g})")
+    p.add_argument("--nodes", type=int, nargs="+", default=list(NODES),
+                   help="lumped node counts (default " + " ".join(map(str, NODES)) + ")")
+    p.add_argument("--cases", nargs="+", metavar="CYCLE",
+                   help="shipped cycle names or cycle files; a steady cycle (nominal) is a "
+                        "steady state, the others transients (default: the study's two cases, "
+                        "e.g. nominal and spl-16h)")
+    p.add_argument("--level", type=int, default=2,
+                   help="FEM level of the reference for the node count (default 2)")
+    p.add_argument("--dt", type=float, default=60.0,
+                   help="time step of the transient cases [s] (default 60)")
+    p.add_argument("--rank", type=int, metavar="K",
+                   help="also rank the first K sensor positions")
+    p.add_argument("--method", choices=METHODS, default="greedy",
+                   help="ranking: greedy forward selection (default) or pivoted QR")
+    p.add_argument("--candidates", nargs="+", metavar="NAME",
+                   help="ranking: candidate sensors or arrays (default: every temperature "
+                        "sensor of the spec)")
+    p.add_argument("--rank-case", metavar="CYCLE",
+                   help="ranking: transient cycle (default: the study's transient case)")
+    p.add_argument("--rank-level", type=int, default=1,
+                   help="ranking: FEM level (default 1)")
+    p.add_argument("--rank-dt", type=float, default=300.0,
+                   help="ranking: time step [s] (default 300)")
+    p.add_argument("--out", help="output folder (default results/<spec>/sensors)")
+    p.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.set_defaults(func=run)
+    return p
