@@ -1,4 +1,4 @@
-"""Design measures of paper section 4 (compare/design/measures.py): the simplified formulas
+"""Design measures of paper section 4 (compare/design/): the simplified formulas
 (eq. 22-32) against hand values, the FEM reference where their assumptions hold exactly and
 where they do not, the inverse problem, the sweeps, the measures file and the command.
 
@@ -25,15 +25,8 @@ from pathlib import Path
 import pytest
 
 from compare import cli
-from compare.design.measures import (
-    InverseTarget,
-    Measure,
-    MeasureCase,
-    MeasureFileError,
-    SweepCase,
-    SweepSpec,
-    apply_measure,
-    formula_lambda,
+from compare.design.cases import MeasureCase, SweepCase, measure_result, reference_model, solve_inverse
+from compare.design.formulas import (
     lambda_added,
     lambda_added_as_printed,
     lambda_added_equal_alpha,
@@ -42,13 +35,16 @@ from compare.design.measures import (
     lambda_from_xi,
     lambda_improved,
     lambda_improved_equal_alpha,
-    measure_result,
-    read_measures,
-    reference_model,
-    shipped_measures,
-    solve_inverse,
     temperature_drop_K,
     xi_pct,
+)
+from compare.design.measure import Measure, apply_measure, formula_lambda
+from compare.design.measure_file import (
+    InverseTarget,
+    MeasureFileError,
+    SweepSpec,
+    read_measures,
+    shipped_measures,
 )
 from reference import ReferenceModel
 from spindle.cycles import load_cycle
@@ -441,7 +437,8 @@ def test_command_input_errors_exit_2(tmp_path, capsys):
 
 
 def test_report_tables_as_rows_and_dataframes(body):
-    from compare.design.measures import MeasureFile, run_measures
+    from compare.design.measure_file import MeasureFile
+    from compare.design.report import run_measures
 
     mf = read_measures(DATA / "uniform_body_measures.toml", body)
     rep = run_measures(body, MeasureFile(mf.path, mf.measures[:1]), body.default_load_case(),

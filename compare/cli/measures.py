@@ -11,7 +11,8 @@ from spindle.errors import InputError
 
 
 def _cmd_measures(args: argparse.Namespace) -> int:
-    from compare.design.measures import read_measures, run_measures, shipped_measures
+    from compare.design.measure_file import read_measures, shipped_measures
+    from compare.design.report import run_measures
     from compare.executor import stderr_progress
     from lumped.build import PRESETS
     from spindle.outputs import output_dir

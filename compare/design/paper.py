@@ -32,7 +32,7 @@ import numpy as np
 
 from reference import ReferenceModel
 from spindle.cycles import load_cycle
-from spindle.drive import DRIVES, Drive, cycle_load_case
+from spindle.drive import Drive, cycle_load_case, drive_for
 from spindle.spec import AirGapLink, Spec, load_spec
 from spindle.units import ZERO_C_K
 
@@ -97,7 +97,7 @@ class PaperStudy:
         op.links = [(replace(lk, h_W_m2K=lk.h_W_m2K.scaled(factors.get("air_gap", 1.0)))
                      if isinstance(lk, AirGapLink) else lk, A) for lk, A in self._links]
         self.ref.thermal._lu.clear()
-        drive = DRIVES[self.spec.power_preset]
+        drive = drive_for(self.spec)  # a shipped preset or the spec's own drive file
         if "f0" in factors:
             drive = drive.with_f0(factors["f0"])
         if "rotor_share" in factors:

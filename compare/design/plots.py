@@ -1,5 +1,5 @@
 """Pictures of the thermal stiffness strategy (paper section 4); computing stays in
-:mod:`compare.design.measures`.
+:mod:`compare.design.report`.
 
 - :func:`fig15_png`: the paper's Fig. 15, the temperature drop Delta T = T1 (lambda - 1) /
   lambda (eq. 24) against the heat stiffness ratio lambda_tr, with each measure's lambda
@@ -17,7 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.design.measures import PAPER_LAMBDA_RANGE, SWEEP_UNITS, MeasuresReport, temperature_drop_K
+from compare.design.cases import SWEEP_UNITS
+from compare.design.formulas import PAPER_LAMBDA_RANGE, temperature_drop_K
+from compare.design.report import MeasuresReport
 from spindle.outputs import atomic_write
 from spindle.plots import pyplot
 
