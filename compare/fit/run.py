@@ -17,7 +17,6 @@
 
 from __future__ import annotations
 
-import base64
 import html
 import json
 import time
@@ -40,6 +39,7 @@ from compare.fit.calibrate import (
     resample,
 )
 from compare.fit.greybox import BASE_PARAMS, EFFECTS, GreyBox, Inputs, default_theta
+from compare.report import html_figure, html_page, html_table
 from spindle.bench import (
     BenchRun,
     bench_grid,
@@ -451,21 +451,13 @@ def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
 
 
 def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> str:
-    def img(name: str, caption: str) -> str:
-        data = base64.b64encode((out / name).read_bytes()).decode("ascii")
-        return (f'<figure><img style="max-width:100%" src="data:image/png;base64,{data}">'
-                f"<figcaption>{html.escape(caption)}</figcaption></figure>")
-
     def err_table(block: dict) -> str:
-        rows = []
-        for window in ("fit", "validation"):
-            for c, e in block.get(window, {}).items():
-                rows.append(f"<tr><td>{window}</td><td>{c}</td><td>{e['rmse']:.3f}</td>"
-                            f"<td>{e['max']:.3f}</td><td>{e['bias']:+.3f}</td><td>{e['unit']}</td>"
-                            f"<td>{100 * e['within_tolerance']:.1f} %</td></tr>")
-        return ("<table><tr><th>window</th><th>channel</th><th>RMSE</th><th>max</th>"
-                "<th>bias</th><th>unit</th><th>within tolerance</th></tr>" + "".join(rows)
-                + "</table>")
+        rows = [[window, c, e["rmse"], e["max"], e["bias"], e["unit"],
+                 100 * e["within_tolerance"]]
+                for window in ("fit", "validation") for c, e in block.get(window, {}).items()]
+        return html_table(["window", "channel", "RMSE", "max", "bias", "unit",
+                           "within tolerance [%]"], rows,
+                          ["s", "s", ".3f", ".3f", "+.3f", "s", ".1f"])
 
     eff = "".join(f"<li><b>{html.escape(e['name'])}</b> ({html.escape(str(e['parameters']))}; "
                   f"p = {e['p_value']:.2g}, ΔBIC = {e['delta_bic']:.1f}; needed by "
@@ -502,16 +494,13 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
     else:
         anchor_html = ("<p>Calibration model: lumped. Model: the lumped model alone, no "
                        "priors (--lumped-only).</p>")
-    params = "".join(f"<tr><td>{html.escape(p['name'])}</td><td>{p['value']:.4g}</td>"
-                     f"<td>{p['ci95'][0]:.4g} .. {p['ci95'][1]:.4g}</td><td>{p['unit']}</td>"
-                     f"<td>{'yes' if p['identifiable'] else 'NO'}</td>"
-                     f"<td>{html.escape(p['meaning'])}</td></tr>" for p in doc["parameters"])
+    params = html_table(
+        ["name", "value", "95 %", "unit", "identifiable", "meaning"],
+        [[p["name"], p["value"], f"{p['ci95'][0]:.4g} .. {p['ci95'][1]:.4g}", p["unit"],
+          "yes" if p["identifiable"] else "NO", p["meaning"]] for p in doc["parameters"]],
+        ["s", ".4g", "s", "s", "s", "s"])
     unexpl = doc["unexplained"]
-    return "\n".join([
-        "<!doctype html><html><head><meta charset='utf-8'><title>spindle-verify fit</title>",
-        "<style>body{font-family:sans-serif;max-width:1300px;margin:2em auto}table{border-"
-        "collapse:collapse;font-size:12px}td,th{border:1px solid #ccc;padding:2px 6px}</style>",
-        "</head><body>",
+    return html_page("spindle-verify fit", [
         f"<h1>Fit of {html.escape(str(rep.run.path))} to {html.escape(rep.spec.name)}</h1>",
         f"<p>Channels {rep.channels}; fit window up to {rep.measured.split_s / 3600:.2f} h, "
         f"validation after; likelihood-ratio level {rep.alpha:g}; {rep.runtime_s:.1f} s.</p>",
@@ -522,11 +511,8 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
         f"{html.escape(unexpl['description'])}</p>",
         "<h2>Error before</h2>" + err_table(doc["error_before"]),
         "<h2>Error after</h2>" + err_table(doc["error_after"]),
-        "<h2>Calibrated parameters (95 % intervals)</h2><table><tr><th>name</th><th>value</th>"
-        "<th>95 %</th><th>unit</th><th>identifiable</th><th>meaning</th></tr>" + params
-        + "</table>",
-        *[img(n, c) for n, c in pngs],
-        "</body></html>\n"])
+        "<h2>Calibrated parameters (95 % intervals)</h2>" + params,
+        *[html_figure(out / n, c) for n, c in pngs]])
 
 
 def _adequacy_html(doc: dict) -> str:

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from compare.report import fmt
 from spindle.loads import LoadCase
 from spindle.spec import Spec
 
@@ -204,9 +205,9 @@ class ConvergenceResult:
         for i in range(len(t["quantity"])):
             cells = [t["quantity"][i], t["unit"][i]]
             cells += [f"{t[c][i]:.5g}" for c in lv]
-            cells += [_fmt(t["p"][i], ".3f"), _fmt(t["p_previous"][i], ".3f"),
-                      _fmt(t["extrapolated"][i], ".5g"),
-                      _fmt(t["GCI_fine_pct"][i], ".3g"), _fmt(t["asymptotic_ratio"][i], ".3f"),
+            cells += [fmt(t["p"][i], ".3f"), fmt(t["p_previous"][i], ".3f"),
+                      fmt(t["extrapolated"][i], ".5g"),
+                      fmt(t["GCI_fine_pct"][i], ".3g"), fmt(t["asymptotic_ratio"][i], ".3f"),
                       t["flag"][i]]
             out.append("| " + " | ".join(cells) + " |")
         return "\n".join(out)
@@ -255,9 +256,6 @@ class ConvergenceResult:
             files.append("convergence.png")
         return [out / f for f in files]
 
-
-def _fmt(v: float, spec: str) -> str:
-    return "—" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
 
 
 def quantities(spec: Spec, res, case: LoadCase) -> tuple[dict[str, float], dict[str, str]]:

@@ -19,7 +19,6 @@ pickle) and the reference level's result draws the 3-D picture.
 
 from __future__ import annotations
 
-import base64
 import html
 import math
 import time
@@ -27,6 +26,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from compare.report import html_figure, html_page, markdown_to_html_table
 from compare.verify.accuracy import (
     NODES,
     TOL_GROWTH_UM,
@@ -110,21 +110,9 @@ class StudyResult:
     # ------------------------------------------------------------------ report
     def _html(self, out: Path, pictures: bool) -> str:
         def img(name: str, alt: str) -> str:
-            path = out / name
-            if not pictures or not path.exists():
-                return ""
-            data = base64.b64encode(path.read_bytes()).decode("ascii")
-            return f'<figure><img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">' \
-                   f"<figcaption>{html.escape(alt)}</figcaption></figure>"
+            return html_figure(out / name, alt) if pictures else ""
 
-        def table(md: str) -> str:
-            lines = [ln for ln in md.splitlines() if ln.startswith("|")]
-            head = [c.strip() for c in lines[0].strip("|").split("|")]
-            rows = [[c.strip() for c in ln.strip("|").split("|")] for ln in lines[2:]]
-            th = "".join(f"<th>{html.escape(h)}</th>" for h in head)
-            body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>"
-                           for r in rows)
-            return f"<table><thead><tr>{th}</tr></thead><tbody>{body}</tbody></table>"
+        table = markdown_to_html_table
 
         conv = self.convergence
         gt = self.ground_truth_level
@@ -136,13 +124,6 @@ class StudyResult:
         verdicts = "".join(f"<tr><td>{html.escape(c)}</td><td>{html.escape(m)}</td>"
                            f"<td>{html.escape(v)}</td></tr>" for c, m, v in self.verdicts())
         parts = [
-            "<!doctype html><html><head><meta charset='utf-8'>",
-            f"<title>spindle-verify study: {html.escape(self.spec.name)}</title>",
-            "<style>body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}"
-            "table{border-collapse:collapse;font-size:12px;margin:1em 0}"
-            "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
-            "th{background:#f2f2f2}img{max-width:100%}figcaption{font-size:12px;color:#555}"
-            "</style></head><body>",
             f"<h1>Verification study: {html.escape(self.spec.name)}</h1>",
             f"<p>{html.escape(self.spec.description)}<br>Source: {html.escape(self.spec.source)}"
             f"<br>Run time {self.runtime_s:.1f} s. Tolerances (paper): {TOL_TEMP_K:g} K, "
@@ -174,8 +155,7 @@ class StudyResult:
                 img("accuracy_transient_error.png", "error against unknowns"),
                 img("accuracy_transient_shaft_profile.png", "shaft sensors at the peak"),
             ]
-        parts.append("</body></html>\n")
-        return "\n".join(parts)
+        return html_page(f"spindle-verify study: {self.spec.name}", parts)
 
     def _failures_html(self) -> str:
         if not self.failures:
