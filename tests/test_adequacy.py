@@ -76,3 +76,20 @@ def test_base_inadequacy_on_a_peer_control_run():
     assert not ad["adequate"]
     assert "T_stator" in ad["inadequate_channels"] and "h_coolant" in ad["implausible"]
     assert "coolant-jacket films" in ad["statement"]
+    assert "inadequate for this run" in ad["verdict"]
+
+
+def test_verdict_text_separates_a_missing_effect_from_an_inadequate_model():
+    """A base that needs an effect to be plausible, then is adequate with it, is not called
+    inadequate; a model still off after its effects is, with the advice to fix the spec."""
+    from compare.fit.adequacy import verdict_text
+
+    off = base_adequacy(_errors({"P1": (0.3, 0.4)}), {"alpha_eff": 1.5}, {"alpha_eff": 1.0},
+                        {"alpha_eff": 3.8})
+    fine = base_adequacy(_errors({"P1": (0.1, 0.1)}), {"alpha_eff": 1.02}, {"alpha_eff": 1.0},
+                         {"alpha_eff": 0.2})
+    text = verdict_text(off, fine, ["fixture_expansion"])
+    assert "alpha_eff moved to 1.5" in text and "With fixture_expansion the model explains" in text
+    assert "inadequate for this run" not in text
+    assert "inadequate for this run" in verdict_text(off, off, ["fixture_expansion"])
+    assert "inadequate for this run" in verdict_text(off, off, [])

@@ -52,6 +52,7 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     Returns ``{"adequate": bool, "channels": {c: {window: rmse_w}}, "inadequate_channels":
     [...], "moved": [{name, spec, calibrated, z}], "implausible": [...], "statement": str}``.
     A channel is inadequate when its open-loop RMS exceeds its tolerance on either window.
+    The statement is a clause to follow a subject ("the base model ...").
     """
     channels: dict[str, dict[str, float]] = {}
     bad: list[tuple[str, str, float]] = []
@@ -74,7 +75,7 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
             worst[c] = (window, r)
     parts = []
     if worst:
-        parts.append("the calibrated base model alone misses " + "; ".join(
+        parts.append("misses " + "; ".join(
             f"{c} by {r:.1f} times its tolerance (open-loop RMS, {w} window)"
             for c, (w, r) in sorted(worst.items(), key=lambda kv: -kv[1][1])))
     if implausible:
@@ -82,11 +83,8 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
             f"{k} moved to {theta[k]:.3g} (spec {spec_values[k]:.3g}, {z[k]:+.1f} prior sd): "
             f"look at {WHERE_IN_SPEC.get(k, 'its value in the spec')}" for k in implausible))
     adequate = not worst and not implausible
-    statement = ("the calibrated base model explains the run within the tolerances with every "
-                 "base parameter inside its prior range" if adequate else
-                 "base model inadequate for this run: " + ". ".join(parts)
-                 + ". An effect named on top of it is named against this misfit; fix the "
-                 "spec first where a parameter left its range")
+    statement = ("explains the run within the tolerances with every base parameter inside its "
+                 "prior range" if adequate else "; ".join(parts))
     return {"adequate": adequate, "channels": channels,
             "inadequate_channels": sorted(worst), "moved": moved,
             "implausible": implausible, "statement": statement}
@@ -121,3 +119,18 @@ def extrapolation_warnings(grid_s: np.ndarray, speed_rpm: np.ndarray,
                    f"{100 * share:.0f} % of the validation window and never occur in the fit "
                    "window")
     return out
+
+
+def verdict_text(base: dict, final: dict, effects: list[str]) -> str:
+    """One paragraph: the base model's verdict, then, if effects were named, the verdict with
+    them; where the model stays inadequate, what to look at in the spec."""
+    text = f"The calibrated base model {base['statement']}."
+    if effects:
+        names = ", ".join(effects)
+        text += (f" With {names}: the model {final['statement']}." if not final["adequate"]
+                 else f" With {names} the model explains the run within the tolerances with "
+                 "every base parameter inside its prior range.")
+    if not final["adequate"]:
+        text += (" The model is inadequate for this run: an effect is named only against this "
+                 "misfit, so correct the spec where a parameter left its range first.")
+    return text

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.fit.adequacy import base_adequacy, extrapolation_warnings
+from compare.fit.adequacy import base_adequacy, extrapolation_warnings, verdict_text
 from compare.fit.calibrate import (
     TOLERANCE,
     Calibrator,
@@ -281,6 +281,10 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                 "effect is named for it")
     adequacy = base_adequacy(sel.base.errors, sel.base.theta, default_theta(BASE_PARAMS),
                              cal.prior_z(sel.base))
+    adequacy_final = base_adequacy(final.errors, final.theta, default_theta(BASE_PARAMS),
+                                   cal.prior_z(final))
+    adequacy["with_effects"] = adequacy_final
+    adequacy["verdict"] = verdict_text(adequacy, adequacy_final, list(final.effects))
     warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
                                    measured.split_s)
     return FitReport(run, spec, channels, measured, inputs, sel, diag_b, diag_a, unexplained,
@@ -525,7 +529,7 @@ def _adequacy_html(doc: dict) -> str:
         f"<td>{w.get(k, float('nan')):.2f}</td>" for k in ("fit", "validation")) + "</tr>"
                    for c, w in ad["channels"].items())
     warns = "".join(f"<li>{html.escape(w)}</li>" for w in doc.get("warnings") or [])
-    return (f"<h2>Base model: {verdict}</h2><p>{html.escape(ad['statement'])}.</p>"
+    return (f"<h2>Base model: {verdict}</h2><p>{html.escape(ad['verdict'])}</p>"
             "<table><tr><th>channel</th><th>fit RMS / tolerance</th>"
             f"<th>validation RMS / tolerance</th></tr>{rows}</table>"
             + (f"<p><b>Warnings</b></p><ul>{warns}</ul>" if warns else ""))
@@ -545,8 +549,8 @@ def report_summary_text(rep: FitReport) -> str:
         lines.append("  calibration model: lumped")
     ad = doc.get("base_adequacy")
     if ad:
-        lines.append(f"  base model: {'adequate' if ad['adequate'] else 'INADEQUATE'}: "
-                     f"{ad['statement']}")
+        lines.append(f"  base model {'adequate' if ad['adequate'] else 'INADEQUATE'}: "
+                     f"{ad['verdict']}")
     for w in doc.get("warnings") or []:
         lines.append(f"  warning: {w}")
     for e in doc["effects"]:

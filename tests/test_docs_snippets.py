@@ -1,0 +1,37 @@
+"""Every Python snippet in the docs runs (the rest of the API is in docs/examples/, run by
+tests/test_examples.py)."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BLOCK = re.compile(r"```python\n(.*?)```", re.S)
+
+
+def _snippets() -> list[tuple[str, str]]:
+    out = []
+    for md in sorted([ROOT / "README.md", *(ROOT / "docs").glob("*.md")]):
+        for k, code in enumerate(BLOCK.findall(md.read_text(encoding="utf-8"))):
+            out.append((f"{md.relative_to(ROOT)}#{k}", code))
+    return out
+
+
+SNIPPETS = _snippets()
+
+
+def test_the_docs_have_snippets():
+    """The reader below finds the docs' snippets (so the parametrised test is not empty)."""
+    assert len(SNIPPETS) >= 3
+
+
+@pytest.mark.parametrize("where,code", SNIPPETS, ids=[w for w, _ in SNIPPETS])
+def test_snippet_runs(where, code, tmp_path, monkeypatch):
+    if "crosscheck" in code and shutil.which("ccx") is None:
+        pytest.skip("CalculiX (ccx) is not installed; apt-get install calculix-ccx")
+    monkeypatch.chdir(tmp_path)  # snippets write to relative folders such as out/
+    exec(compile(code, where, "exec"), {"__name__": "__snippet__"})
