@@ -10,7 +10,6 @@ file, the field and the fix. The loss models that use the set are in spindle.pow
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -18,6 +17,7 @@ from typing import Any
 from spindle.checks import omega_rad_s
 from spindle.errors import Problem, SpecError
 from spindle.power import BearingParams, MotorParams, PowerBalance, bearing_friction, power_balance
+from spindle.spec import read_toml
 
 
 @dataclass(frozen=True)
@@ -259,14 +259,5 @@ def read_drive_toml(path: str | Path) -> Drive:
     """Read and check a drive file (format: docs/power.md). Raises SpecError listing every
     problem, each with the file, the field and the fix."""
     path = Path(path)
-    file = str(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError([Problem(file, "syntax", str(exc), "fix the TOML syntax at that line")]) \
-            from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SpecError([Problem(file, "file", f"cannot be read ({exc})",
-                                 "check the path and that the file is UTF-8 text")]) from None
-    return _read(file, data, path.stem)
+    return _read(str(path), read_toml(path), path.stem)
 

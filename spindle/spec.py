@@ -445,19 +445,24 @@ def resolve_spec_path(name_or_path: str | Path) -> Path:
                              f"give a path to a .toml spec or one of: {', '.join(sorted(shipped))}")])
 
 
-def load_spec(name_or_path: str | Path) -> Spec:
-    """Read and validate a spec (a file path or a shipped name). Raises SpecError."""
-    path = resolve_spec_path(name_or_path)
+def read_toml(path: Path) -> dict:
+    """A TOML file's tables; a syntax error or an unreadable file raises SpecError naming the
+    file and the fix (every TOML input of the project reads through here)."""
     file = str(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise SpecError([Problem(file, "syntax", str(exc), "fix the TOML syntax at that line")]) \
             from None
     except (OSError, UnicodeDecodeError) as exc:
         raise SpecError([Problem(file, "file", f"cannot be read ({exc})",
                                  "check the path and that the file is UTF-8 text")]) from None
-    return _build(_Reader(file), data)
+
+
+def load_spec(name_or_path: str | Path) -> Spec:
+    """Read and validate a spec (a file path or a shipped name). Raises SpecError."""
+    path = resolve_spec_path(name_or_path)
+    return _build(_Reader(str(path)), read_toml(path))
 
 
 def _build(r: _Reader, data: dict[str, Any]) -> Spec:
