@@ -696,7 +696,8 @@ def interval_heat_W(drive: Drive, speed_rpm: float, load_torque_Nm: float,
     try:
         return drive.heat_W(speed_rpm, load_torque_Nm, P), False
     except ValueError:
-        pb = power_balance(drive.motor, drive.bearings, speed_rpm, load_torque_Nm, drive.T_winding_K)
+        pb = power_balance(drive.motor, drive.bearings_at(speed_rpm), speed_rpm, load_torque_Nm,
+                           drive.T_winding_K)
         return drive.heat_W(speed_rpm, load_torque_Nm, pb.motor.P_mech_W / 1e3), True
 
 

@@ -30,6 +30,10 @@ class NominalPoint:
     losses_W: float | None = None
 
 
+#: speed at which a drive's friction_exponent leaves the friction factors unchanged [rpm]
+FRICTION_REF_RPM = 3000.0
+
+
 @dataclass(frozen=True)
 class Drive:
     """Motor and bearings of a spindle. ``T_winding_K`` [K] is the winding temperature used
@@ -41,14 +45,28 @@ class Drive:
     T_winding_K: float
     nominal: NominalPoint | None = None
     description: str = ""
+    #: the bearings' friction factors times (n / FRICTION_REF_RPM)^e: a speed dependence of
+    #: the friction beyond Palmgren's (nu n)^(2/3) (0: Palmgren's law as it stands)
+    friction_exponent: float = 0.0
+
+    def bearings_at(self, speed_rpm: float) -> dict[str, BearingParams]:
+        """The bearing sets at ``speed_rpm`` [rpm], with the friction exponent applied."""
+        if self.friction_exponent == 0.0:
+            return self.bearings
+        scale = (max(float(speed_rpm), 1.0) / FRICTION_REF_RPM) ** self.friction_exponent
+        return {k: replace(b, f0=b.f0 * scale) for k, b in self.bearings.items()}
 
     def heat_W(self, speed_rpm: float, load_torque_Nm: float = 0.0,
                power_kW: float | None = None) -> dict[str, float]:
         """Heat per source [W] at one operating point."""
-        pb = power_balance(self.motor, self.bearings, speed_rpm, load_torque_Nm,
+        pb = power_balance(self.motor, self.bearings_at(speed_rpm), speed_rpm, load_torque_Nm,
                            self.T_winding_K,
                            P_el_W=None if power_kW is None else power_kW * 1e3)
         return pb.heat_sources_W()
+
+    def with_friction_exponent(self, exponent: float) -> Drive:
+        """The same drive with friction factors times (n / FRICTION_REF_RPM)^``exponent``."""
+        return replace(self, friction_exponent=float(exponent))
 
     def with_f0(self, f0: float) -> Drive:
         """The same drive with bearing friction factor f0 on every pair."""

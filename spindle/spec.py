@@ -7,9 +7,10 @@ naming the file, the field and the fix (:class:`~spindle.errors.SpecError`).
 
 from __future__ import annotations
 
+import math
 import tomllib
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -906,3 +907,17 @@ def _check_heat_paths(r: _Reader, parts: list[Part], surfaces: list[Surface],
             r.add("surfaces", f"parts {sorted(group)} have no heat path to a fixed temperature "
                   "(the problem would be singular)", "add a [[surfaces]] entry with h_W_m2K > 0 "
                   "and T_ref = \"ambient\" or \"coolant\" on one of them")
+
+
+def stretch_axially(spec: Spec, factor: float) -> Spec:
+    """The spec stretched along the axis by ``factor`` (every z: sections, surface limits,
+    sensors); radii, materials, links, powers and the mesh size h0 stay."""
+    def z(v: float) -> float:
+        return v * factor if math.isfinite(v) else v
+
+    parts = tuple(replace(p, sections=tuple(replace(s, z_start=z(s.z_start), z_end=z(s.z_end))
+                                            for s in p.sections)) for p in spec.parts)
+    surfaces = tuple(replace(s, z_min=z(s.z_min), z_max=z(s.z_max)) for s in spec.surfaces)
+    sensors = tuple(replace(s, z=z(s.z), z_ref=None if s.z_ref is None else z(s.z_ref))
+                    for s in spec.sensors)
+    return replace(spec, parts=parts, surfaces=surfaces, sensors=sensors)

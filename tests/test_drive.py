@@ -208,3 +208,18 @@ def test_drive_file_structure_problems(tmp_path, text, field):
     with pytest.raises(SpecError) as err:
         read_drive_toml(path)
     assert field in {p.field for p in err.value.problems}
+
+
+def test_friction_exponent_scales_the_bearing_friction_with_speed():
+    """A drive's friction_exponent e multiplies every pair's f0 by (n / 3000 rpm)^e: the
+    bearing heat is unchanged at 3000 rpm, and at 6000 rpm with e = 0.5 it is the heat of a
+    drive whose f0 is sqrt(2) times larger (Palmgren's no-load heat is linear in f0)."""
+    drive = DRIVES["spl2782"]
+    steep = drive.with_friction_exponent(0.5)
+    assert steep.heat_W(3000.0)["front_bearing"] == drive.heat_W(3000.0)["front_bearing"]
+    f0 = drive.bearings["front_bearing"].f0
+    ref = drive.with_f0(f0 * 2 ** 0.5).heat_W(6000.0)
+    got = steep.heat_W(6000.0)
+    for k in ("front_bearing", "rear_bearing"):
+        assert got[k] == pytest.approx(ref[k], rel=1e-12)
+    assert drive.with_friction_exponent(0.0).heat_W(6000.0) == drive.heat_W(6000.0)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from compare.cli.common import add_no_pictures, add_quiet
 from compare.cli.common import progress as _progress
 from spindle.errors import InputError
 
@@ -59,6 +60,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "then select effects on the lumped model anchored there")
     fp.add_argument("--nodes", type=int, default=11, help="lumped model nodes (default 11)")
     fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
-    fp.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
-    fp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    add_no_pictures(fp)
+    add_quiet(fp)
     fp.set_defaults(func=_cmd_fit)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from spindle.drive import load_case
+from compare.cli.common import add_no_pictures, add_out, add_quiet, add_spec, load_case_input
 from spindle.errors import InputError
 
 
@@ -15,6 +15,7 @@ def _cmd_measures(args: argparse.Namespace) -> int:
     from compare.design.report import run_measures
     from compare.executor import stderr_progress
     from lumped.build import PRESETS
+    from spindle.drive import load_case
     from spindle.outputs import output_dir
     from spindle.spec import load_spec
 
@@ -37,9 +38,7 @@ def _cmd_measures(args: argparse.Namespace) -> int:
     case = spec.default_load_case()
     inputs = [spec.path, str(mpath)]
     if args.case:
-        case = load_case(spec, args.case, case)
-        if Path(args.case).is_file():
-            inputs.append(args.case)
+        case = load_case_input(spec, args.case, case, inputs)
     elif spec.power_preset:
         case = load_case(spec, "nominal", case)
     rep = run_measures(spec, mfile, case, args.level, tuple(args.lumped_nodes),
@@ -85,7 +84,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "indicators K_alpha, K_T, K_Q from the FEM and lumped models; design "
                         "measures by the formulas (eq. 25-30) and by the FEM; inverse problem; "
                         "Fig. 15 and Fig. 16-style sensitivity sweeps")
-    me.add_argument("spec", metavar="SPEC")
+    add_spec(me)
     me.add_argument("--measures", metavar="FILE",
                     help="measures TOML (docs/measures.md); default: the spec's shipped file, "
                          "spindle/data/measures/<spec>.toml (there is one for spl2782)")
@@ -104,7 +103,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          "pip install \"spindle-verify[dask]\" (default: a local process pool)")
     me.add_argument("--workers", type=int,
                     help="processes (default min(2, CPUs)); 1 runs the cases serially")
-    me.add_argument("--out", help="output folder (default results/<spec>-measures)")
-    me.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
-    me.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    add_out(me, "results/<spec>-measures")
+    add_no_pictures(me)
+    add_quiet(me)
     me.set_defaults(func=_cmd_measures)

@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from compare.cli.common import add_no_pictures, add_out, add_spec
+
 
 def _cmd_mesh(args: argparse.Namespace) -> int:
     from meshes import build_mesh
@@ -38,8 +40,8 @@ def _cmd_mesh(args: argparse.Namespace) -> int:
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the command's sub-parser."""
     mp = subparsers.add_parser("mesh", help="mesh a spec at refinement levels 0..N; VTU and PNG")
-    mp.add_argument("spec", metavar="SPEC")
+    add_spec(mp)
     mp.add_argument("--level", type=int, default=2, help="finest level (default 2)")
-    mp.add_argument("--out", help="output folder (default results/<spec>/mesh)")
-    mp.add_argument("--no-pictures", action="store_true", help="skip the PNG")
+    add_out(mp, "results/<spec>/mesh")
+    add_no_pictures(mp, "PNG")
     mp.set_defaults(func=_cmd_mesh)

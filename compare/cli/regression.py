@@ -7,6 +7,7 @@ import argparse
 import json
 from pathlib import Path
 
+from compare.cli.common import add_quiet, add_spec
 from compare.cli.common import progress as _progress
 from spindle.errors import InputError
 
@@ -53,7 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the command's sub-parser."""
     bp = subparsers.add_parser("baseline", help="store the figures of a study (values, errors, "
                         "tolerances) as JSON for regression checks")
-    bp.add_argument("spec", metavar="SPEC")
+    add_spec(bp)
     bp.add_argument("--out", required=True, help="the JSON file to write")
     bp.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2],
                     help="FEM levels, three or more (default 0 1 2)")
@@ -65,11 +66,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="how far a temperature may move [K] (default 0.01)")
     bp.add_argument("--tol-growth", type=float, default=0.01,
                     help="how far a growth may move [um] (default 0.01)")
-    bp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    add_quiet(bp)
     bp.set_defaults(func=_cmd_baseline)
 
     cp = subparsers.add_parser("check", help="recompute a baseline's figures; exit 1 with a diff when "
                         "any moved beyond its tolerance")
     cp.add_argument("file", metavar="FILE")
-    cp.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    add_quiet(cp)
     cp.set_defaults(func=_cmd_check)

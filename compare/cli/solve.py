@@ -7,7 +7,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from spindle.drive import load_case
+from compare.cli.common import add_no_pictures, add_out, add_quiet, add_spec, load_case_input
 from spindle.units import ZERO_C_K
 
 
@@ -45,16 +45,12 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     case = spec.default_load_case()
     inputs = [spec.path]
     if args.case:
-        case = load_case(spec, args.case, case)
-        if Path(args.case).is_file():
-            inputs.append(args.case)
+        case = load_case_input(spec, args.case, case, inputs)
     if args.speed is not None:
         case = replace(case, speed_rpm=TimeSeries.constant(args.speed))
     quiet = args.quiet
     if args.cycle:
-        case = load_case(spec, args.cycle, case)
-        if Path(args.cycle).is_file():
-            inputs.append(args.cycle)
+        case = load_case_input(spec, args.cycle, case, inputs)
         if args.model == "lumped":  # exact zero-order hold: no theta, no fields
             result = ref.transient(case, args.dt, T0=float(case.T_ambient_K(0.0)),
                                    progress=Progress("transient", not quiet))
@@ -104,7 +100,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the command's sub-parser."""
     so = subparsers.add_parser("solve", help="temperatures and axial growth (P1) from the FEM reference "
                         "or a lumped model, steady or over a transient cycle")
-    so.add_argument("spec", metavar="SPEC")
+    add_spec(so)
     so.add_argument("--model", choices=("fem", "lumped"), default="fem",
                     help="fem: the FEM reference (default); lumped: the paper's function-block "
                          "model")
@@ -133,7 +129,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="add the centrifugal load of the rotating parts (off by default)")
     so.add_argument("--thermal-only", action="store_true",
                     help="skip the thermoelastic growth (P1, TCP)")
-    so.add_argument("--out", help="output folder (default results/<spec>)")
-    so.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
-    so.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    add_out(so, "results/<spec>")
+    add_no_pictures(so)
+    add_quiet(so)
     so.set_defaults(func=_cmd_solve)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from compare.cli.common import add_no_pictures, add_out, add_quiet, add_spec
 from compare.cli.common import progress as _progress
 from spindle.errors import InputError
 
@@ -66,7 +67,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the command's sub-parser."""
     st = subparsers.add_parser("study", help="verification study: FEM grid convergence (GCI), accuracy "
                         "of eq. 14, the lumped models and the FEM levels, HTML report")
-    st.add_argument("spec", metavar="SPEC")
+    add_spec(st)
     st.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3],
                     help="nested FEM levels, three or more (default 0 1 2 3)")
     st.add_argument("--nodes", type=int, nargs="+", default=[2, 3, 5, 7, 11, 15, 21, 31, 41],
@@ -85,7 +86,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          "transients): 1 runs them serially in this process, so the runtimes "
                          "in the tables are not disturbed by other runs (default 1); 2 runs "
                          "the independent runs in a process pool")
-    st.add_argument("--out", help="output folder (default results/<spec>/study)")
-    st.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
-    st.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    add_out(st, "results/<spec>/study")
+    add_no_pictures(st)
+    add_quiet(st)
     st.set_defaults(func=_cmd_study)

@@ -14,20 +14,17 @@ A **measure** changes the spec's heat dissipation (docs/measures.md):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 from compare.design.formulas import lambda_added, lambda_both, lambda_improved
-from compare.design.stiffness import (
-    surface_films,
-)
+from compare.design.stiffness import surface_films
 from spindle.faces import exposed_faces, surface_faces
 from spindle.loads import SpeedTable
-from spindle.spec import Spec
+from spindle.spec import Spec, stretch_axially
 
 KINDS = ("added_surface", "improved_coefficient", "both")
 
-
+#: what a sensitivity sweep of the measures file may vary (Fig. 16)
 SWEEPS = ("area", "length", "film", "heat")
 
 
@@ -55,6 +52,7 @@ class Measure:
 
     @property
     def size_text(self) -> str:
+        """The measure's sizes for a report cell, e.g. ``A_M=0.1 m2 at 20 W/m2K``."""
         parts = []
         if self.A_M_m2 is not None:
             parts.append(f"A_M={self.A_M_m2:.4g} m2 at {self.alpha_M_W_m2K:.4g} W/m2K")
@@ -114,18 +112,9 @@ def formula_lambda(spec: Spec, measure: Measure, speed_rpm: float) -> tuple[floa
 
 
 def scale_axially(spec: Spec, factor: float) -> Spec:
-    """The spec stretched along the axis by ``factor`` (every z: sections, surface limits,
-    sensors); radii, materials, links, powers and the mesh size h0 stay. For the length
-    sensitivity of Fig. 16."""
-    def z(v: float) -> float:
-        return v * factor if math.isfinite(v) else v
-
-    parts = tuple(replace(p, sections=tuple(replace(s, z_start=z(s.z_start), z_end=z(s.z_end))
-                                            for s in p.sections)) for p in spec.parts)
-    surfaces = tuple(replace(s, z_min=z(s.z_min), z_max=z(s.z_max)) for s in spec.surfaces)
-    sensors = tuple(replace(s, z=z(s.z), z_ref=None if s.z_ref is None else z(s.z_ref))
-                    for s in spec.sensors)
-    return replace(spec, parts=parts, surfaces=surfaces, sensors=sensors)
+    """The spec stretched along the axis by ``factor`` (spindle.spec.stretch_axially); for the
+    length sensitivity of Fig. 16."""
+    return stretch_axially(spec, factor)
 
 
 def axial_length_m(spec: Spec) -> float:

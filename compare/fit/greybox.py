@@ -36,6 +36,7 @@ from lumped.realtime import modal_recursion
 from lumped.simulation import LumpedModel
 from spindle.bench import interval_heat_W
 from spindle.drive import Drive
+from spindle.drive_file import FRICTION_REF_RPM
 from spindle.spec import Spec
 
 ROTATING = ("shaft", "tool", "rotor")
@@ -74,8 +75,6 @@ class Param:
 # 0.7); and the speed dependence of the bearing friction, Palmgren's (nu n)^(2/3) law being
 # an average over lubrication regimes (exponent shift 0.5 at 1 sigma, per Harris's spread of
 # measured friction-speed curves).
-#: speed at which friction_exponent leaves the friction unchanged [rpm]
-FRICTION_REF_RPM = 3000.0
 BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
     Param("f0", "-", 0.30, 0.05, 3.0, "Palmgren bearing friction factor of all pairs",
           prior_sd=0.4),
@@ -211,11 +210,12 @@ class GreyBox:
     def sources(self, f0: float, rotor_share: float, friction_exponent: float = 0.0
                 ) -> dict[str, np.ndarray]:
         """Heat per source [W] and interval: the power balance with friction factor ``f0``
-        times (n / FRICTION_REF_RPM)^``friction_exponent`` and the rotor share of the motor
-        losses."""
+        times (n / FRICTION_REF_RPM)^``friction_exponent`` (Drive.with_friction_exponent) and
+        the rotor share of the motor losses."""
         key = ("src", round(f0, 12), round(rotor_share, 12), round(friction_exponent, 12))
         if key not in self._cache:
-            base = self.drive.with_rotor_share(rotor_share)
+            d = (self.drive.with_f0(f0).with_rotor_share(rotor_share)
+                 .with_friction_exponent(friction_exponent))
             inp = self.inputs
             memo: dict[tuple, dict[str, float]] = {}
             rows = []
@@ -225,8 +225,6 @@ class GreyBox:
                 k = (round(float(n), 3), round(float(M), 2),
                      None if np.isnan(P) else round(float(P), 2))
                 if k not in memo:  # P unknown (nan): the motor model gives the losses
-                    d = base.with_f0(f0 * (max(k[0], 1.0) / FRICTION_REF_RPM)
-                                     ** friction_exponent)
                     if k[2] is None:
                         memo[k] = d.heat_W(k[0], k[1], None)
                     else:  # measured P: standstill and P < P_mech handled as the bench does
