@@ -29,9 +29,9 @@ from compare.design.stiffness import (
 from spindle.loads import LoadCase, TimeSeries
 from spindle.spec import Spec
 
+#: assembled reference models by everything but the film coefficients (reference_model),
+#: with their original films; at most _MAX_MODELS, oldest dropped first
 _MODELS: dict[tuple, tuple[Any, list]] = {}
-
-
 _MAX_MODELS = 4
 
 
@@ -72,6 +72,7 @@ def reference_model(spec: Spec, level: int = 1, elastic: bool = True):
 
 
 def case_speed_rpm(case: LoadCase) -> float:
+    """The steady case's speed [rpm] (at t = 0)."""
     return float(case.speed_rpm(0.0))
 
 

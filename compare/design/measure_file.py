@@ -13,9 +13,7 @@ from typing import Any
 import numpy as np
 
 from compare.design.measure import KINDS, SIZE_FIELDS, SWEEPS, Measure, axial_length_m
-from compare.design.stiffness import (
-    surface_films,
-)
+from compare.design.stiffness import surface_films
 from spindle.errors import Problem, SpindleVerifyError
 from spindle.spec import Spec
 

@@ -125,15 +125,12 @@ class MeasuresReport:
 
 
 def _csv(v: Any) -> Any:
+    """One CSV cell: None and NaN empty, floats with 6 significant digits."""
     if v is None:
         return ""
     if isinstance(v, float):
         return "" if math.isnan(v) else f"{v:.6g}"
     return v
-
-
-
-
 
 
 def _markdown(rep: MeasuresReport) -> str:
@@ -145,23 +142,24 @@ def _markdown(rep: MeasuresReport) -> str:
            f"`{rep.measures_file}`. Run time {rep.runtime_s:.1f} s.", "",
            "## Indicators (paper section 4)", ""]
     ind = rep.indicator_rows()
-    out.append(markdown_table(["model", "Q W", "mean rise K", "max rise K", "K_alpha mean K/W",
-                       "K_alpha max K/W", "shaft rise K", "growth um", "K_T K/um", "K_Q W/um"],
-                      [[r.get("model"), r.get("losses_W"), r.get("mean_rise_K"),
-                        r.get("max_rise_K"), r.get("K_alpha_mean_K_W"), r.get("K_alpha_max_K_W"),
-                        r.get("shaft_rise_K"), r.get("growth_um"), r.get("K_T_K_um"),
-                        r.get("K_Q_W_um")] for r in ind],
-                      ["", ".1f", ".2f", ".2f", ".3g", ".3g", ".2f", ".2f", ".3f", ".2f"]))
+    out.append(markdown_table(
+        ["model", "Q W", "mean rise K", "max rise K", "K_alpha mean K/W", "K_alpha max K/W",
+         "shaft rise K", "growth um", "K_T K/um", "K_Q W/um"],
+        [[r.get("model"), r.get("losses_W"), r.get("mean_rise_K"), r.get("max_rise_K"),
+          r.get("K_alpha_mean_K_W"), r.get("K_alpha_max_K_W"), r.get("shaft_rise_K"),
+          r.get("growth_um"), r.get("K_T_K_um"), r.get("K_Q_W_um")] for r in ind],
+        ["", ".1f", ".2f", ".2f", ".3g", ".3g", ".2f", ".2f", ".3f", ".2f"]))
     out += ["", f"The paper's K_T = 0.52 and K_Q = 64.53 follow from its own figures "
             f"(41.6 K / 79.7 um = {pc['K_T_K_um']:.3f}; 5146 W / 79.7 um = "
             f"{pc['K_Q_W_um']:.2f}); its K_alpha = 0.00019 K/W does not (41.6 K / 5146 W = "
             f"{pc['K_alpha_shaft_K_W']:.4f}, 46.1 K / 5146 W = {pc['K_alpha_housing_K_W']:.4f}) "
             f"and equals 1 K / 5146 W = {pc['one_kelvin_per_losses_K_W']:.3g} K/W.", "",
             "## Convective surfaces: what sum(alpha_i A_i) runs over", ""]
-    out.append(markdown_table(["surface", "T_ref", "alpha W/m2K", "A m2", "alpha A W/K", "share"],
-                      [[f.name, f.T_ref, f.h_W_m2K, f.A_m2, f.G_W_K,
-                        f"{100 * f.G_W_K / rep.sum_alpha_A_W_K:.2f} %"] for f in rep.films],
-                      ["", "", ".4g", ".4g", ".4g", ""]))
+    out.append(markdown_table(
+        ["surface", "T_ref", "alpha W/m2K", "A m2", "alpha A W/K", "share"],
+        [[f.name, f.T_ref, f.h_W_m2K, f.A_m2, f.G_W_K,
+          f"{100 * f.G_W_K / rep.sum_alpha_A_W_K:.2f} %"] for f in rep.films],
+        ["", "", ".4g", ".4g", ".4g", ""]))
     out += ["", "## Measures: formulas (eq. 25-30) against the reference", ""]
     mrows = [m.to_row() for m in rep.measures]
     lumped = [k for k in (mrows[0] if mrows else {}) if k.startswith("lambda_lumped_")]
@@ -183,15 +181,16 @@ def _markdown(rep: MeasuresReport) -> str:
             "formulas predict the same lambda for the growth as for the temperature.", ""]
     if rep.inverse:
         out += ["## Inverse problem (smallest measure reaching a target, on the reference)", ""]
-        out.append(markdown_table(["target", "measure", "vary", "goal", "reached", "size (reference)",
-                           "size (formula)", "formula / reference", "FEM solves", "note"],
-                          [[i.target.name, i.target.measure, i.target.vary,
-                            f"xi {i.target.xi_pct:g} %" if i.target.xi_pct is not None
-                            else f"growth {i.target.growth_um:g} um", str(i.reached),
-                            f"{fmt(i.size_ref)} {i.unit}", f"{fmt(i.size_formula)} {i.unit}",
-                            i.to_row()["formula_over_ref"], i.solves, i.note]
-                           for i in rep.inverse],
-                          ["", "", "", "", "", "", "", ".3g", "d", ""]))
+        out.append(markdown_table(
+            ["target", "measure", "vary", "goal", "reached", "size (reference)",
+             "size (formula)", "formula / reference", "FEM solves", "note"],
+            [[i.target.name, i.target.measure, i.target.vary,
+              f"xi {i.target.xi_pct:g} %" if i.target.xi_pct is not None
+              else f"growth {i.target.growth_um:g} um", str(i.reached),
+              f"{fmt(i.size_ref)} {i.unit}", f"{fmt(i.size_formula)} {i.unit}",
+              i.to_row()["formula_over_ref"], i.solves, i.note]
+             for i in rep.inverse],
+            ["", "", "", "", "", "", "", ".3g", "d", ""]))
         out.append("")
     if rep.failures:
         out += ["## Failed cases", ""] + [f"- {f['label']}: {f['error']}" for f in rep.failures]
