@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from compare.report import markdown_table
 from spindle.loads import LoadCase
 from spindle.spec import Spec
 from spindle.units import ZERO_C_K
@@ -141,20 +142,11 @@ class AccuracyResult:
         return pd.DataFrame(self.table())
 
     def markdown(self) -> str:
+        """The table as Markdown (without the ``kind`` column); runtimes to the millisecond."""
         t = self.table()
-        cols = [c for c in t if c not in ("kind",)]
-        out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-        for i in range(len(t["model"])):
-            cells = []
-            for c in cols:
-                v = t[c][i]
-                if isinstance(v, float):
-                    cells.append("—" if math.isnan(v) else (f"{v:.3g}" if c != "runtime_s"
-                                                             else f"{v:.3f}"))
-                else:
-                    cells.append(str(v))
-            out.append("| " + " | ".join(cells) + " |")
-        return "\n".join(out)
+        cols = [c for c in t if c != "kind"]
+        fmts = [".3f" if c == "runtime_s" else ".3g" for c in cols]
+        return markdown_table(cols, list(zip(*(t[c] for c in cols), strict=True)), fmts)
 
     def summary(self) -> dict:
         t = self.table()

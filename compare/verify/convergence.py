@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.report import fmt
+from compare.report import markdown_table
 from spindle.loads import LoadCase
 from spindle.spec import Spec
 
@@ -197,20 +197,14 @@ class ConvergenceResult:
                 "worst_GCI_pct_per_level": worst, "flagged": flagged}
 
     def markdown(self) -> str:
+        """The table as Markdown: values per level, and the finest level's analysis."""
         t = self.table()
         lv = [f"level_{x}" for x in self.levels]
         head = ["quantity", "unit", *lv, "p", "p_previous", "extrapolated", "GCI_fine_pct",
                 "asymptotic_ratio", "flag"]
-        out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        for i in range(len(t["quantity"])):
-            cells = [t["quantity"][i], t["unit"][i]]
-            cells += [f"{t[c][i]:.5g}" for c in lv]
-            cells += [fmt(t["p"][i], ".3f"), fmt(t["p_previous"][i], ".3f"),
-                      fmt(t["extrapolated"][i], ".5g"),
-                      fmt(t["GCI_fine_pct"][i], ".3g"), fmt(t["asymptotic_ratio"][i], ".3f"),
-                      t["flag"][i]]
-            out.append("| " + " | ".join(cells) + " |")
-        return "\n".join(out)
+        fmts = ["s", "s", *[".5g"] * len(lv), ".3f", ".3f", ".5g", ".3g", ".3f", "s"]
+        rows = zip(*(t[c] for c in head), strict=True)
+        return markdown_table(head, list(rows), fmts)
 
     def plot(self, ax=None):
         """Difference to the extrapolated value against element size, log-log."""

@@ -26,7 +26,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from compare.report import html_figure, html_page, markdown_to_html_table
+from compare.report import html_figure, html_page, html_table, markdown_to_html_table
 from compare.verify.accuracy import (
     NODES,
     TOL_GROWTH_UM,
@@ -110,9 +110,8 @@ class StudyResult:
     # ------------------------------------------------------------------ report
     def _html(self, out: Path, pictures: bool) -> str:
         def img(name: str, alt: str) -> str:
+            # without pictures, a PNG left in ``out`` by an earlier run must not be shown
             return html_figure(out / name, alt) if pictures else ""
-
-        table = markdown_to_html_table
 
         conv = self.convergence
         gt = self.ground_truth_level
@@ -121,15 +120,13 @@ class StudyResult:
                    f"none of levels {conv.analysed_levels} has GCI ≤ {100 * conv.threshold:g} % "
                    f"for every quantity; the finest, level {self.reference_level}, is used")
         flagged = conv.summary()["flagged"]
-        verdicts = "".join(f"<tr><td>{html.escape(c)}</td><td>{html.escape(m)}</td>"
-                           f"<td>{html.escape(v)}</td></tr>" for c, m, v in self.verdicts())
         parts = [
             f"<h1>Verification study: {html.escape(self.spec.name)}</h1>",
             f"<p>{html.escape(self.spec.description)}<br>Source: {html.escape(self.spec.source)}"
             f"<br>Run time {self.runtime_s:.1f} s. Tolerances (paper): {TOL_TEMP_K:g} K, "
             f"±{TOL_GROWTH_UM:g} µm.</p>",
-            "<h2>Verdicts</h2><table><thead><tr><th>case</th><th>model</th><th>verdict</th>"
-            f"</tr></thead><tbody>{verdicts}</tbody></table>",
+            "<h2>Verdicts</h2>" + html_table(["case", "model", "verdict"], self.verdicts(),
+                                             ["s"] * 3),
             self._failures_html(),
             "<h2>1. Grid convergence of the FEM reference</h2>",
             f"<p>Case: {html.escape(conv.case_name)}; levels {conv.levels} "
@@ -137,12 +134,12 @@ class StudyResult:
             f"{html.escape(gt_text)}. Temperatures as rises above ambient [K], growth in µm. "
             + (f"Flagged: {html.escape(str(flagged))}." if flagged else "No quantity is flagged "
                "oscillatory or divergent on the finest triplet.") + "</p>",
-            table(conv.markdown()), img("convergence.png", "grid convergence"),
+            markdown_to_html_table(conv.markdown()), img("convergence.png", "grid convergence"),
             img("reference_3d.png", "reference temperature field, revolved"),
             img("reference_section.png", "reference temperature on the half-section"),
             f"<h2>2. Steady accuracy ({html.escape(self.steady.case_name)})</h2>",
             f"<p>Reference: {html.escape(self.steady.reference_label)}.</p>",
-            table(self.steady.markdown()),
+            markdown_to_html_table(self.steady.markdown()),
             img("accuracy_steady_error.png", "error against unknowns"),
             img("accuracy_steady_shaft_profile.png", "shaft sensors per model (paper Fig. 4)"),
         ]
@@ -151,7 +148,7 @@ class StudyResult:
                 f"<h2>3. Transient accuracy ({html.escape(self.transient.case_name)})</h2>",
                 f"<p>Reference: {html.escape(self.transient.reference_label)}. Errors are "
                 "over the sensors and over time.</p>",
-                table(self.transient.markdown()),
+                markdown_to_html_table(self.transient.markdown()),
                 img("accuracy_transient_error.png", "error against unknowns"),
                 img("accuracy_transient_shaft_profile.png", "shaft sensors at the peak"),
             ]
