@@ -1,0 +1,27 @@
+"""Sensor probes on the mesh boundary (reference.thermal.ThermalModel.probe_matrix)."""
+
+import numpy as np
+import pytest
+
+from reference import ReferenceModel
+from reference.thermal import PROBE_NUDGE_M
+from spindle.spec import load_spec
+
+
+def test_a_point_a_rounding_outside_the_boundary_is_probed_at_the_boundary():
+    """A P2 field linear in z is interpolated exactly; a point 1e-12 m beyond the shaft's end
+    face (a sensor on an end face after a stretched spec's rounding) reads the end face's
+    value to within the nudge; a point 1 mm outside is still an error."""
+    model = ReferenceModel(load_spec("fin-shaft"), level=0)
+    th = model.thermal
+    mesh = th.basis.mesh
+    z_end = float(mesh.p[0].max())
+    r = 0.5 * float(mesh.p[1].max())
+    T = th.basis.project(lambda x: x[0])  # T = z [K]
+    outside = np.array([[z_end + 1e-12], [r]])
+    with pytest.raises(ValueError):  # scikit-fem alone: outside the mesh
+        th.basis.probes(outside)
+    P = th.probe_matrix(outside)
+    assert (P @ T)[0] == pytest.approx(z_end, abs=2 * PROBE_NUDGE_M)
+    with pytest.raises(ValueError):
+        th.probe_matrix(np.array([[z_end + 1e-3], [r]]))
