@@ -28,6 +28,7 @@ from scipy.spatial import cKDTree
 from skfem import Basis, ElementTriP0, ElementVector, asm
 
 from reference.forms import centrifugal, elasticity, thermal_coupling
+from reference.probes import probe_matrix
 from reference.thermal import ELEMENTS, ThermalModel, factorize
 from spindle.spec import ContactLink
 from spindle.units import RPM_TO_RAD_S
@@ -145,8 +146,7 @@ class ThermoelasticModel:
 
     def axial_probe(self, z: float, r: float) -> sp.csr_matrix:
         """Row that reads u_z [m] at (z, r) from the displacement vector."""
-        pm = self.basis.probes(np.array([[z], [r]])).tocsr()
-        return pm[0]
+        return probe_matrix(self.basis, np.array([[z], [r]]))[0]
 
     def growth_points(self) -> dict[str, tuple[float, float, float, float]]:
         """Axial-displacement readings (see :meth:`spindle.spec.Spec.growth_points`)."""

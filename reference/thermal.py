@@ -23,6 +23,7 @@ from skfem import Basis, ElementTriP0, ElementTriP1, ElementTriP2, FacetBasis, a
 
 from meshes import SpindleMesh
 from reference.forms import capacity, conduction, film, surface_flux, volume_source
+from reference.probes import probe_matrix
 from spindle.errors import SolverError
 from spindle.loads import LoadCase, time_grid
 from spindle.spec import BearingLink, ContactLink
@@ -102,10 +103,6 @@ class Operator:
         """Heat stored since T0 [J]: 2 pi 1^T M (T - T0)."""
         return TWO_PI * float(np.asarray(self.M.sum(axis=0)).ravel() @ (T - T0))
 
-
-#: how far a sensor point on the boundary may be moved into the mesh [m] (1 nm: far below any
-#: element, far above the rounding of a stretched geometry)
-PROBE_NUDGE_M = 1e-9
 
 
 class ThermalModel:
@@ -205,33 +202,9 @@ class ThermalModel:
         return w / w.sum()
 
     def probe_matrix(self, points: np.ndarray) -> sp.csr_matrix:
-        """Interpolation (not nearest node) of the field at points (2 x n, z and r in m). A
-        point on the boundary that rounding puts a few ulps outside the mesh (a sensor on an
-        end face of a stretched spec) is moved inside by at most PROBE_NUDGE_M first."""
-        pts = np.asarray(points, dtype=float)
-        try:
-            return self.basis.probes(pts).tocsr()
-        except ValueError:
-            return self.basis.probes(self._nudged_inside(pts)).tocsr()
-
-    def _nudged_inside(self, pts: np.ndarray) -> np.ndarray:
-        """Points outside the mesh moved towards the centroid of the nearest element by at most
-        PROBE_NUDGE_M; farther ones stay (and the finder then names them)."""
-        mesh = self.basis.mesh
-        finder = mesh.element_finder()
-        centroids = mesh.p[:, mesh.t].mean(axis=1)
-        out = pts.copy()
-        for k in range(pts.shape[1]):
-            try:
-                finder(pts[0:1, k], pts[1:2, k])
-                continue
-            except ValueError:
-                pass
-            d = centroids - pts[:, k:k + 1]
-            j = int(np.argmin((d * d).sum(axis=0)))
-            step = d[:, j] / np.linalg.norm(d[:, j]) * PROBE_NUDGE_M
-            out[:, k] = pts[:, k] + step
-        return out
+        """Interpolation (not nearest node) of the field at points (2 x n, z and r in m);
+        boundary points as :func:`reference.probes.probe_matrix` treats them."""
+        return probe_matrix(self.basis, points)
 
     def sensor_points(self) -> tuple[list[str], np.ndarray]:
         sensors = self.spec.temperature_sensors()

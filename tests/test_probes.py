@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from reference import ReferenceModel
-from reference.thermal import PROBE_NUDGE_M
+from reference.probes import PROBE_NUDGE_M
 from spindle.spec import load_spec
 
 

@@ -21,7 +21,8 @@ def _cmd_synth(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.suffix.lower() != ".csv":
         raise InputError(str(out), "--out", "is not a .csv file name", "give e.g. run.csv")
-    truth = synth(spec, args.cycle, args.effect, args.seed, out, level=args.level)
+    truth = synth(spec, args.cycle, args.effect, args.seed, out, level=args.level,
+                  mismatch=args.mismatch)
     print(f"wrote {out} and {out.with_suffix('.truth.json')} (effect {truth['effect']}, "
           f"seed {truth['seed']})")
     return 0
@@ -32,9 +33,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     sy = subparsers.add_parser("synth", help="a synthetic bench run from the FEM reference with one "
                         "effect injected; the truth goes to RUN.truth.json")
     sy.add_argument("--spec", default="spl2782")
-    sy.add_argument("--cycle", default="spl-16h", help="cycle (default spl-16h)")
+    sy.add_argument("--cycle", default="spl-16h",
+                    help="cycle: a shipped name or cycle file, or random / random-loaded (non-"
+                         "monotonic steps up to 6000 rpm drawn from the seed) (default spl-16h)")
     sy.add_argument("--effect", default="clean", help="effect to inject (default clean)")
     sy.add_argument("--seed", type=int, default=0)
     sy.add_argument("--level", type=int, default=1, help="FEM level (default 1)")
+    sy.add_argument("--mismatch", action="store_true",
+                    help="make the data with a spindle that differs from the spec (films, "
+                         "contacts, axial length, friction, loss split, FEM level; drawn from "
+                         "the seed and recorded in the truth; docs/fit.md)")
     sy.add_argument("--out", required=True, help="the CSV to write")
     sy.set_defaults(func=_cmd_synth)

@@ -1,0 +1,98 @@
+"""Synthetic runs from a spindle the spec describes only approximately (compare.fit.mismatch,
+issue 13 §2): the mismatch does what it declares, random cycles are what they claim."""
+
+import json
+
+import numpy as np
+import pytest
+
+from compare.fit.greybox import film_groups
+from compare.fit.mismatch import Mismatch, draw_mismatch, random_cycle
+from spindle.drive import drive_for
+from spindle.faces import exposed_faces, surface_faces
+from spindle.spec import ContactLink, load_spec
+
+
+@pytest.fixture(scope="module")
+def spl():
+    spec = load_spec("spl2782")
+    return spec, drive_for(spec)
+
+
+def _film_conductance(spec, group: str, speed_rpm: float = 3000.0) -> float:
+    """sum h A [W/K] over the surfaces of one film group, at a speed."""
+    faces = exposed_faces(spec)
+    groups = film_groups(spec)
+    return sum(s.h_W_m2K(speed_rpm) * sum(f.area_m2 for f in surface_faces(s, faces))
+               for s in spec.surfaces if s.h_W_m2K is not None and groups[s.name] == group)
+
+
+def test_draws_stay_in_their_declared_ranges():
+    for seed in range(30):
+        mm = draw_mismatch(np.random.default_rng(seed))
+        assert all(0.5 <= f <= 2.0 for f in mm.films.values()) and 0.5 <= mm.contact <= 2.0
+        assert 0.10 <= abs(mm.axial_scale - 1.0) <= 0.15
+        assert 0.7 <= mm.f0_factor <= 1.4 and abs(mm.friction_exponent) <= 0.3
+        assert 0.03 <= mm.rotor_share <= 0.15 and mm.fem_level in (1, 2)
+
+
+def test_apply_changes_what_it_declares(spl):
+    """Film conductances per group scale by their factor times the axial stretch (lateral
+    areas grow with length; end faces do not: bounded), contacts by theirs, the axial extent
+    by the stretch; the drive's f0, exponent and loss split are the drawn ones."""
+    spec, drive = spl
+    mm = Mismatch(films={"h_coolant": 2.0, "h_air": 0.5, "h_rotating": 1.0}, contact=0.5,
+                  axial_scale=1.1, f0_factor=1.2, friction_exponent=0.2, rotor_share=0.1,
+                  fem_level=1)
+    out, d = mm.apply(spec, drive)
+    for group, factor in mm.films.items():
+        ratio = _film_conductance(out, group) / _film_conductance(spec, group)
+        assert factor * (1 - 1e-9) <= ratio <= factor * 1.1 * (1 + 1e-9), (group, ratio)
+    before = [lk.h_W_m2K for lk in spec.links if isinstance(lk, ContactLink)]
+    after = [lk.h_W_m2K for lk in out.links if isinstance(lk, ContactLink)]
+    assert after == pytest.approx([0.5 * h for h in before], rel=1e-12)
+    z = [s.z_end for p in out.parts for s in p.sections]
+    z0 = [s.z_end for p in spec.parts for s in p.sections]
+    assert max(z) == pytest.approx(1.1 * max(z0), rel=1e-12)
+    f0 = drive.bearings["front_bearing"].f0
+    assert d.bearings["front_bearing"].f0 == pytest.approx(1.2 * f0, rel=1e-12)
+    assert d.friction_exponent == 0.2 and d.motor.rotor_loss_share == 0.1
+
+
+def test_random_cycles():
+    """16 h, a standstill start and a 2 h standstill end, non-monotonic steps that reach the
+    top speed; loaded ones hold 0-40 N m; the same seed gives the same cycle."""
+    for seed in range(5):
+        c = random_cycle(np.random.default_rng(seed), 6000.0, loaded=seed % 2 == 1)
+        assert c.duration_s == pytest.approx(16 * 3600.0)
+        speeds = [s.speed_rpm for s in c.steps]
+        assert speeds[0] == 0.0 and speeds[-1] == 0.0 and c.steps[-1].duration_s >= 7200.0
+        assert max(speeds) == 6000.0
+        inner = speeds[1:-1]
+        assert any(b < a for a, b in zip(inner, inner[1:], strict=False))  # goes down somewhere
+        torques = [s.load_torque_Nm for s in c.steps]
+        assert (max(torques) > 0) == (seed % 2 == 1) and max(torques) <= 40.0
+    a = random_cycle(np.random.default_rng(7), 6000.0)
+    b = random_cycle(np.random.default_rng(7), 6000.0)
+    assert a.steps == b.steps
+
+
+def test_synth_with_mismatch_records_it(tmp_path, spl):
+    """A short run on a mismatched spindle: the truth sidecar holds the mismatch and its FEM
+    level, and the run reads as a bench export."""
+    from compare.fit.synth import synth
+    from spindle.bench import read_bench
+
+    cycle = tmp_path / "short.toml"
+    cycle.write_text('[cycle]\nname = "short"\ndescription = "1 h"\nsource = "test"\n'
+                     'steps = [ { speed_rpm = 0.0, duration_h = 0.1 },\n'
+                     '  { speed_rpm = 3000.0, duration_h = 0.5 },\n'
+                     '  { speed_rpm = 1500.0, duration_h = 0.4 } ]\n'
+                     '[ambient]\nT_C = 20.0\n[coolant]\nT_C = 20.0\n')
+    run = tmp_path / "run.csv"
+    truth = synth(spl[0], str(cycle), "clean", 4, run, mismatch=True)
+    saved = json.loads(run.with_suffix(".truth.json").read_text())
+    assert saved["mismatch"] == truth["mismatch"]
+    assert saved["fem_level"] == saved["mismatch"]["fem_level"]
+    bench = read_bench(run)
+    assert bench.duration_s > 0.9 * 3600.0
