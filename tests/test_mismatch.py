@@ -78,15 +78,16 @@ def test_random_cycles():
 
 
 def test_synth_with_mismatch_records_it(tmp_path, spl):
-    """A short run on a mismatched spindle: the truth sidecar holds the mismatch and its FEM
-    level, and the run reads as a bench export."""
+    """A short loaded run on a mismatched spindle: the truth sidecar holds the mismatch and its
+    FEM level; the run reads as a bench export and logs the load torque, without which a fit
+    would take the whole electrical power for losses."""
     from compare.fit.synth import synth
     from spindle.bench import read_bench
 
     cycle = tmp_path / "short.toml"
     cycle.write_text('[cycle]\nname = "short"\ndescription = "1 h"\nsource = "test"\n'
                      'steps = [ { speed_rpm = 0.0, duration_h = 0.1 },\n'
-                     '  { speed_rpm = 3000.0, duration_h = 0.5 },\n'
+                     '  { speed_rpm = 3000.0, duration_h = 0.5, load_torque_Nm = 20.0 },\n'
                      '  { speed_rpm = 1500.0, duration_h = 0.4 } ]\n'
                      '[ambient]\nT_C = 20.0\n[coolant]\nT_C = 20.0\n')
     run = tmp_path / "run.csv"
@@ -96,3 +97,6 @@ def test_synth_with_mismatch_records_it(tmp_path, spl):
     assert saved["fem_level"] == saved["mismatch"]["fem_level"]
     bench = read_bench(run)
     assert bench.duration_s > 0.9 * 3600.0
+    assert bench.load_torque_measured
+    t, M = bench.time_s, bench.columns["load_torque_Nm"]
+    assert set(np.unique(M[np.isfinite(M)])) == {0.0, 20.0}

@@ -212,8 +212,11 @@ def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0:
 
 
 def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, power_W,
-               rng: np.random.Generator, rate_hz: float = 1.0) -> tuple[list[str], np.ndarray]:
-    """Sample like a bench: irregular times, a 20 min gap, noise, quantisation, empty cells."""
+               rng: np.random.Generator, rate_hz: float = 1.0, torque_Nm=None
+               ) -> tuple[list[str], np.ndarray]:
+    """Sample like a bench: irregular times, a 20 min gap, noise, quantisation, empty cells.
+    ``torque_Nm(t)``: the process load torque [N m], logged as ``load_torque_Nm`` (None: a
+    no-load run, no such column, as the bench format has it)."""
     dur = float(t_model[-1])
     n = int(dur * rate_hz * 1.05) + 10
     t = np.cumsum(rng.uniform(0.5, 1.5, n) / rate_hz)
@@ -223,6 +226,8 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
     cols: dict[str, np.ndarray] = {"time_s": t}
     cols["speed_rpm"] = np.asarray(case.speed_rpm(t), dtype=float)
     cols["power_kW"] = np.asarray(power_W(t), dtype=float) / 1e3 * (1 + rng.normal(0, 0.01, len(t)))
+    if torque_Nm is not None:
+        cols["load_torque_Nm"] = np.asarray(torque_Nm(t), dtype=float)
     cols["T_env_C"] = np.asarray(case.T_ambient_K(t)) - ZERO_C_K
     cols["T_coolant_C"] = np.asarray(case.T_coolant_K(t)) - ZERO_C_K
     for name, y in ch.items():
@@ -289,11 +294,15 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
         heat = sum(drive.heat_W(s.speed_rpm, s.load_torque_Nm, s.power_kW).values())
         p_el.append(heat + s.load_torque_Nm * s.speed_rpm * RPM_TO_RAD_S)
 
-    def power_W(t: np.ndarray) -> np.ndarray:
-        i = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(p_el) - 1)
-        return np.asarray(p_el)[i]
+    def step_values(values: list[float]):
+        def at(t: np.ndarray) -> np.ndarray:
+            i = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(values) - 1)
+            return np.asarray(values)[i]
+        return at
 
-    header, data = bench_rows(t_model, ch, case, power_W, rng)
+    torques = [s.load_torque_Nm for s in cycle.steps]
+    header, data = bench_rows(t_model, ch, case, step_values(p_el), rng,
+                              torque_Nm=step_values(torques) if any(torques) else None)
     lines = [f"# spindle: {spec.name}", "# bench: synthetic run (spindle-verify synth)",
              f"# cycle: {cycle_name}", f"# rows: {len(data)}", ",".join(header)]
     fmt = {h: ("{:.2f}" if h in ("time_s", "speed_rpm") else "{:.4f}") for h in header}
