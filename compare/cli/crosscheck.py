@@ -1,31 +1,22 @@
-"""``spindle-verify crosscheck``: the reference against CalculiX."""
+"""``spindle-verify crosscheck``: the FEM reference against CalculiX (ccx) on the same P2 mesh."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from compare.crosscheck.check import crosscheck
-from spindle.spec import load_spec
+from compare.cli.common import add_out, add_spec, load_case_input
 from spindle.units import ZERO_C_K
 
+if TYPE_CHECKING:
+    from compare.crosscheck import CrosscheckResult
 
-# --------------------------------------------------------------------------- command line
-def _cmd_crosscheck(args: argparse.Namespace) -> int:
-    """``spindle-verify crosscheck``: print the comparison table, write JSON and CSV."""
-    from spindle.drive import load_case
-    from spindle.outputs import output_dir
 
-    spec = load_spec(args.spec)
-    case = None if args.case is None else load_case(spec, args.case)
-    inputs = [args.case] if args.case is not None and Path(args.case).is_file() else []
-    out = Path(args.out or f"results/{spec.name}/crosscheck")
-    with output_dir(out, inputs=[spec.path, *inputs]) as tmp:
-        result = crosscheck(spec, args.level, case,
-                            keep_dir=(tmp / "ccx") if args.keep_deck else None)
-        files = result.save(tmp)
+def _print_comparison(spec_name: str, result: CrosscheckResult) -> None:
+    """Sensor temperatures [°C] and growth readings [µm] of both codes and their differences."""
     s = result.summary()
-    print(f"{spec.name}: scikit-fem reference against CalculiX {result.ccx_version}, P2 level "
+    print(f"{spec_name}: scikit-fem reference against CalculiX {result.ccx_version}, P2 level "
           f"{result.level} ({s['mesh']['nodes']} nodes, {s['mesh']['elements']} elements), "
           f"case '{result.case}' at {result.speed_rpm:g} rpm")
     print(f"  {'sensor':<16} {'T_skfem_C':>10} {'T_ccx_C':>10} {'diff_K':>10}")
@@ -41,6 +32,25 @@ def _cmd_crosscheck(args: argparse.Namespace) -> int:
           f"{result.nodal['max_abs_diff_K']:.1e} K over all nodes; against the reference "
           f"with ccx's quadrature {result.nodal['max_abs_ccx_minus_twin_K']:.1e} K (print "
           f"precision {result.nodal['max_print_bound_K']:.1e} K)")
+
+
+def _cmd_crosscheck(args: argparse.Namespace) -> int:
+    """``spindle-verify crosscheck``: print the comparison table, write JSON and CSV."""
+    # imported here so that building the parser stays fast (compare/cli/common.py)
+    from compare.crosscheck import crosscheck
+    from spindle.outputs import output_dir
+    from spindle.spec import load_spec
+
+    spec = load_spec(args.spec)
+    inputs: list[str] = []
+    case = (None if args.case is None
+            else load_case_input(spec, args.case, spec.default_load_case(), inputs))
+    out = Path(args.out or f"results/{spec.name}/crosscheck")
+    with output_dir(out, inputs=[spec.path, *inputs]) as tmp:
+        result = crosscheck(spec, args.level, case,
+                            keep_dir=(tmp / "ccx") if args.keep_deck else None)
+        files = result.save(tmp)
+    _print_comparison(spec.name, result)
     print("wrote " + ", ".join(str(out / f.name) for f in files)
           + (f", {out / 'ccx'}/" if args.keep_deck else ""))
     return 0
@@ -54,12 +64,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Cross-check the FEM reference with CalculiX (ccx, Debian package "
                     "calculix-ccx) on the same P2 mesh: sensor temperatures and axial growth "
                     "(P1, TCP) from both codes and their differences.")
-    cp.add_argument("spec", metavar="SPEC")
+    add_spec(cp)
     cp.add_argument("--level", type=int, default=1, help="mesh level (default 1)")
     cp.add_argument("--case", metavar="CYCLE",
                     help="steady load case from a cycle's first step, e.g. 'nominal' (default: "
                          "the spec's operating point)")
-    cp.add_argument("--out", help="output folder (default results/<spec>/crosscheck)")
+    add_out(cp, "results/<spec>/crosscheck")
     cp.add_argument("--keep-deck", action="store_true",
                     help="keep the ccx decks, result files and logs in <out>/ccx")
     cp.set_defaults(func=_cmd_crosscheck)

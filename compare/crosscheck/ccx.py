@@ -46,6 +46,7 @@ def run_ccx(deck_path: str | Path, timeout_s: float = 600) -> Path:
 
 
 def ccx_version(log: Path) -> str:
+    """The version ccx printed in its log (e.g. ``2.20``), or "" if it cannot be read."""
     try:
         for line in log.read_text(encoding="utf-8", errors="replace").splitlines():
             if "CalculiX Version" in line:

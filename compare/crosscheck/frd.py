@@ -1,4 +1,5 @@
-"""Reading CalculiX's ASCII result file (.frd): nodal temperatures and displacements."""
+"""Reading CalculiX's ASCII result file (.frd): nodal temperatures and displacements, and the
+precision that file holds them to."""
 
 from __future__ import annotations
 
@@ -69,4 +70,15 @@ def read_frd(path: str | Path) -> dict:
         r = results["DISP"]
         U[r["node_ids"] - 1] = r["values"][:, :3]
         out["U"] = U
+    return out
+
+
+def half_ulp(values: np.ndarray) -> np.ndarray:
+    """Bound of the rounding of a value in ccx's result file: ccx casts to single precision
+    (relative 2^-24) and prints ``%12.5E`` (6 significant digits: half a unit 0.5e-5 of the
+    leading digit's place)."""
+    v = np.abs(np.asarray(values, dtype=float))
+    out = np.zeros_like(v)
+    nz = v > 0
+    out[nz] = 0.5 * 10.0 ** (np.floor(np.log10(v[nz])) - 5) + 2.0 ** -24 * v[nz]
     return out

@@ -9,33 +9,23 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 from skfem import Basis, ElementTriP0, ElementTriP2, ElementVector, FacetBasis, asm
 
-from compare.crosscheck.deck import (
-    CCX_CONTACT_INTORDER,
-    CCX_FACE_INTORDER,
-    CCX_VOLUME_INTORDER,
-    CcxMesh,
-    ThermalData,
-    elastic_materials,
-    load_vector,
-    reduction,
-    vector_dofs,
-)
+from compare.crosscheck.ccx_mesh import CcxMesh
+from compare.crosscheck.elastic_data import elastic_materials, reduction, vector_dofs
+from compare.crosscheck.thermal_data import ThermalData, load_vector
 from reference.elastic import FLOATING_SHEAR
 from reference.forms import conduction, elasticity, film, thermal_coupling
 from reference.simulation import ReferenceModel
 from reference.thermal import factorize
 from spindle.errors import SolverError
 
-
-def half_ulp(values: np.ndarray) -> np.ndarray:
-    """Bound of the rounding of a value in ccx's result file: ccx casts to single precision
-    (relative 2^-24) and prints ``%12.5E`` (6 significant digits: half a unit 0.5e-5 of the
-    leading digit's place)."""
-    v = np.abs(np.asarray(values, dtype=float))
-    out = np.zeros_like(v)
-    nz = v > 0
-    out[nz] = 0.5 * 10.0 ** (np.floor(np.log10(v[nz])) - 5) + 2.0 ** -24 * v[nz]
-    return out
+#: Quadrature of ccx's DCAX6/CAX6 (found by reproducing single-element ccx results with
+#: scikit-fem): the 3-point rule of degree 2 over the triangle ...
+CCX_VOLUME_INTORDER = 2
+#: ... and 2-point Gauss (degree 3) on a face
+CCX_FACE_INTORDER = 3
+#: ccx's face-to-face gap conductance integrates the matching interface exactly (as the
+#: reference does)
+CCX_CONTACT_INTORDER = 5
 
 
 def _pair_matrix(cm: CcxMesh, fa: np.ndarray, fb: np.ndarray, n: int) -> sp.csr_matrix:
