@@ -136,8 +136,7 @@ def test_contact_means_the_same_joints(setup):
 def test_variant_refuses_effects(setup):
     _, _, fem = setup
     assert fem.variant(()) is fem
-    # every base parameter but the two the FEM path holds at the spec's values
-    assert set(fem.parameters()) == set(BASE_PARAMS) - {"heat_capacity", "friction_exponent"}
+    assert set(fem.parameters()) == set(BASE_PARAMS)
     with pytest.raises(ValueError, match="base parameters only"):
         fem.variant(("mount_conduction",))
     with pytest.raises(ValueError, match="base parameters only"):
@@ -154,7 +153,7 @@ def test_calibration_on_fem_data_recovers_the_factors(setup):
     spec = setup[0]
     grid = np.arange(0.0, 8 * 3600.0 + 1.0, 600.0)
     fem = FemGreyBox(spec, DRIVE, inputs_from_cycle(load_cycle("spl-16h"), grid))
-    truth = {**{k: BASE_PARAMS[k].default for k in fem.parameters()}, "h_air": 2.0, "f0": 0.4}
+    truth = {**{k: p.default for k, p in BASE_PARAMS.items()}, "h_air": 2.0, "f0": 0.4}
     out = fem.simulate(truth)
     rng = np.random.default_rng(0)
     vals = {c: out[c] + rng.normal(0, 0.05e-6 if c == "P1" else 0.03, len(grid))
@@ -220,11 +219,6 @@ def test_fit_model_fem_end_to_end(setup, tmp_path):
     assert doc["calibration_model"] == "fem" and rep.calibration_model == "fem"
     assert doc["fem_calibration"]["fem_runs"] > 7
     before = {p["name"]: p["value"] for p in doc["parameters_before"]}
-    # the FEM path calibrates every base parameter but two, which it holds at the spec's values
-    held = {"heat_capacity", "friction_exponent"}
-    assert set(before) == set(BASE_PARAMS) - held
-    assert {k: rep.anchor.theta_ref[k] for k in held} == {k: BASE_PARAMS[k].default for k in held}
-    before.update({k: BASE_PARAMS[k].default for k in held})
     assert before == pytest.approx(rep.anchor.theta_ref, rel=1e-12)
     assert doc["fem_anchor"]["anchored_at"] == pytest.approx(before, rel=1e-12)
     assert doc["fem_anchor"]["prior_centre"] == {k: p.default for k, p in BASE_PARAMS.items()}

@@ -98,5 +98,5 @@ def test_synth_with_mismatch_records_it(tmp_path, spl):
     bench = read_bench(run)
     assert bench.duration_s > 0.9 * 3600.0
     assert bench.load_torque_measured
-    t, M = bench.time_s, bench.columns["load_torque_Nm"]
+    M = bench.columns["load_torque_Nm"]
     assert set(np.unique(M[np.isfinite(M)])) == {0.0, 20.0}

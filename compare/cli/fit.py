@@ -23,7 +23,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
                   progress=_progress(args.quiet),
-                  fem_level=None if args.lumped_only else args.fem_level, model=args.model)
+                  fem_level=None if args.lumped_only else args.fem_level, model=args.model,
+                  base_extra=tuple(args.base_extra or ()))
     out = Path(args.out or f"results/{spec.name}/fit-{Path(args.run).stem}")
     with output_dir(out, inputs=[spec.path, args.run]) as tmp:
         save_report(rep, tmp, pictures=not args.no_pictures)
@@ -58,6 +59,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "lumped model anchored to the FEM at the spec's values; fast). fem: "
                     "calibrate the base parameters on the FEM reference itself (minutes), "
                     "then select effects on the lumped model anchored there")
+    fp.add_argument("--base-extra", nargs="+", metavar="PARAM",
+                    choices=("heat_capacity", "friction_exponent"),
+                    help="calibrate these too, for a spindle its spec describes only "
+                    "approximately: heat_capacity (a factor on every heat capacity), "
+                    "friction_exponent (bearing friction times (n / 3000 rpm)^e) (default: "
+                    "neither; docs/fit.md)")
     fp.add_argument("--nodes", type=int, default=11, help="lumped model nodes (default 11)")
     fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
     add_no_pictures(fp)

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from compare.fit.greybox import BASE_PARAMS, EFFECTS, GreyBox, Param
+from compare.fit.greybox import BASE_PARAMS, EFFECTS, EXTRA_BASE_PARAMS, GreyBox, Param
 
 #: |z| of every base parameter after an effect that is needed for plausibility (95 % central)
 RESTORED_Z = 1.96
@@ -480,7 +480,8 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
 
 
 def parameters_table(fit: Fit) -> list[dict]:
-    params = {**BASE_PARAMS, **{p.name: p for e in EFFECTS.values() for p in e.params}}
+    params = {**BASE_PARAMS, **EXTRA_BASE_PARAMS,
+              **{p.name: p for e in EFFECTS.values() for p in e.params}}
     rows = []
     for k in fit.free:
         p = params[k]

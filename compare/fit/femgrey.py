@@ -41,11 +41,7 @@ from spindle.drive import Drive
 from spindle.spec import Spec
 
 #: parameters that enter the thermal solve (alpha_eff only scales P1 afterwards)
-#: the base parameters the FEM path calibrates: films, contacts and sources on the one assembled
-#: FEM; heat_capacity and friction_exponent stay at the spec's values there (the FEM's mass
-#: matrix and the friction law are not swapped per run)
-FEM_PARAMS = tuple(k for k in BASE_PARAMS if k not in ("heat_capacity", "friction_exponent"))
-_THERMAL = tuple(k for k in FEM_PARAMS if k != "alpha_eff")
+_THERMAL = tuple(k for k in BASE_PARAMS if k != "alpha_eff")
 #: FEM results kept (a Jacobian of the six thermal parameters, its centre and a step)
 _KEEP = 10
 
@@ -82,7 +78,7 @@ class FemGreyBox:
         return self
 
     def parameters(self) -> dict[str, Param]:
-        return {k: BASE_PARAMS[k] for k in FEM_PARAMS}
+        return dict(BASE_PARAMS)
 
     @property
     def fem_runs(self) -> int:
@@ -161,7 +157,7 @@ class FemGreyBox:
         parameters ``theta`` (missing names take their defaults)."""
         if x0_K is not None:
             raise ValueError("FemGreyBox starts from the inputs' start temperature only")
-        th = {k: float(theta.get(k, BASE_PARAMS[k].default)) for k in FEM_PARAMS}
+        th = {k: float(theta.get(k, p.default)) for k, p in BASE_PARAMS.items()}
         out = {c: v.copy() for c, v in self._thermal_run(th).items()}
         if "P1" in out:
             # the thermoelastic growth is linear in a uniform scale of the expansion

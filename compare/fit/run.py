@@ -38,7 +38,14 @@ from compare.fit.calibrate import (
     parameters_table,
     resample,
 )
-from compare.fit.greybox import BASE_PARAMS, EFFECTS, GreyBox, Inputs, default_theta
+from compare.fit.greybox import (
+    BASE_PARAMS,
+    EFFECTS,
+    EXTRA_BASE_PARAMS,
+    GreyBox,
+    Inputs,
+    default_theta,
+)
 from compare.report import html_figure, html_page, html_table
 from spindle.bench import (
     BenchRun,
@@ -179,14 +186,26 @@ def _residuals(measured: Measured, model: dict[str, np.ndarray], channels) -> di
     return {c: (measured.values[c] - model[c]) / TOLERANCE[c] for c in channels}
 
 
+def _check_base_extra(base_extra: tuple[str, ...], model: str) -> None:
+    unknown = [k for k in base_extra if k not in EXTRA_BASE_PARAMS]
+    if unknown:
+        raise InputError("command line", "--base-extra", f"unknown parameter {unknown[0]}",
+                         f"use {' or '.join(EXTRA_BASE_PARAMS)}")
+    if base_extra and model == "fem":
+        raise InputError("command line", "--base-extra", "the FEM calibration swaps films, "
+                         "contacts and sources only", "drop --base-extra or --model fem")
+
+
 def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
             nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
             min_gain: float = 0.25, progress: Callable[[str], None] | None = None,
-            fem_level: int | None = 0, model: str = "lumped") -> FitReport:
+            fem_level: int | None = 0, model: str = "lumped",
+            base_extra: tuple[str, ...] = ()) -> FitReport:
     """The whole loop (module docstring). ``model``: "lumped" calibrates the base parameters
     on the lumped grey box anchored to the FEM at the spec's values; "fem" calibrates them on
     the FEM reference itself (level ``fem_level``), then anchors the lumped grey box there
-    and selects effects on it."""
+    and selects effects on it. ``base_extra``: names of EXTRA_BASE_PARAMS calibrated with
+    the base (lumped calibration only)."""
     from compare.fit.discrepancy import fem_discrepancy
     from compare.fit.residuals import diagnose
 
@@ -199,6 +218,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         raise InputError("command line", "--model", "--model fem calibrates on the FEM "
                          "reference, --lumped-only switches the FEM off",
                          "drop one of the two options")
+    _check_base_extra(base_extra, model)
     if not 0.2 <= fit_fraction <= 0.9:
         raise InputError("command line", "--fit-fraction", f"{fit_fraction} is outside 0.2..0.9",
                          "fit on 20 % to 90 % of the run, e.g. 0.6")
@@ -221,7 +241,9 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         if measured.mask(c, "fit").sum() < 10 or measured.mask(c, "validation").sum() < 5:
             raise InputError(str(path), c, "has too few samples in the fit or validation window",
                              "export a run that measures this channel throughout, or drop it")
-    cal = Calibrator(GreyBox(spec, drive, inputs, nodes), measured, channels, progress=say)
+    cal = Calibrator(GreyBox(spec, drive, inputs, nodes, base_extra=tuple(base_extra)),
+                     measured, channels, progress=say)
+    spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
     anchor = None
     fem_cal_info = None
     if fem_level is None:  # the lumped model alone, factors of 1, no priors (older behaviour)
@@ -234,7 +256,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         anchor = fem_discrepancy(cal.gb, channels, fem_level)
         cal.gb.discrepancy = anchor.offsets
         say("calibrating the base model")
-        _, base = cal.fit_with_prior(anchor.theta_ref)
+        _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref})
     sel = forward_selection(cal, candidates, alpha, base=base, min_gain=min_gain)
     final = sel.final
     ins = {"speed": np.concatenate([[inputs.speed_rpm[0]], inputs.speed_rpm]),
@@ -279,10 +301,9 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                 + " but within the tolerances on the validation window (model-form error "
                 "below the tolerances: the lumped model's sensitivities and the FEM level); no "
                 "effect is named for it")
-    adequacy = base_adequacy(sel.base.errors, sel.base.theta, default_theta(BASE_PARAMS),
+    adequacy = base_adequacy(sel.base.errors, sel.base.theta, spec_values,
                              cal.prior_z(sel.base))
-    adequacy_final = base_adequacy(final.errors, final.theta, default_theta(BASE_PARAMS),
-                                   cal.prior_z(final))
+    adequacy_final = base_adequacy(final.errors, final.theta, spec_values, cal.prior_z(final))
     adequacy["with_effects"] = adequacy_final
     adequacy["verdict"] = verdict_text(adequacy, adequacy_final, list(final.effects))
     warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
