@@ -4,6 +4,7 @@ the shipped spec), against the truth.
 
     python benchmarks/bench_devruns.py [--runs DIR] [--spec spl2782] [--only dev-01 dev-06]
                                        [--workers 2] [--json OUT.json]
+                                       [--base-extra heat_capacity friction_exponent]
 
 Prints, per run: the true effect, what ``fit`` named (and how), whether the verdict is right
 (the true effect named alone; no effect named on a control run), the validation open-loop RMS
@@ -31,6 +32,7 @@ class DevRun:
     path: Path
     spec: str
     truth: str | None
+    base_extra: tuple[str, ...] = ()
 
     @property
     def label(self) -> str:
@@ -43,7 +45,7 @@ def fit_one(case: DevRun) -> dict:
     from spindle.spec import load_spec
 
     t = time.perf_counter()
-    rep = run_fit(case.path, load_spec(case.spec))
+    rep = run_fit(case.path, load_spec(case.spec), base_extra=case.base_extra)
     doc = rep.to_dict()
     named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
                           and e["parameters"].get("channel") else "") for e in doc["effects"]]
@@ -69,6 +71,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--spec", default="spl2782", help="spec the runs are fitted with")
     ap.add_argument("--only", nargs="*", help="run labels to fit (default: all in truth.json)")
     ap.add_argument("--workers", type=int, default=2, help="parallel fits (default 2)")
+    ap.add_argument("--base-extra", nargs="+", default=[], metavar="PARAM",
+                    help="as fit --base-extra (heat_capacity, friction_exponent)")
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
 
@@ -76,7 +80,8 @@ def main(argv: list[str] | None = None) -> None:
 
     truth = json.loads((args.runs / "truth.json").read_text(encoding="utf-8"))
     labels = args.only or sorted(truth)
-    cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"]) for k in labels]
+    cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"], tuple(args.base_extra))
+             for k in labels]
     t = time.perf_counter()
     outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
     rows = []

@@ -4,8 +4,10 @@
 
 Loads the SPL2782.1 spec, takes the ``nominal`` operating point (38 kW / 4300 rpm, heat
 sources from the power balance), solves the axisymmetric FEM (heat conduction and
-thermoelasticity) on mesh level 1, prints the front-bearing temperature T1, the axial growth
-P1 and the energy balance, and writes summary.json, sensors.csv and the VTU field.
+thermoelasticity, P2) on mesh level 1, prints every temperature sensor in °C, the axial
+growth P1 and TCP in µm and the energy balance, and writes summary.json, sensors.csv and the
+VTU field (for ParaView) to OUT_DIR (a new temporary folder if not given). The same as
+``spindle-verify solve spl2782 --level 1 --case nominal --out OUT_DIR``.
 """
 
 from __future__ import annotations
@@ -20,18 +22,37 @@ from spindle.spec import load_spec
 from spindle.units import ZERO_C_K
 
 
-def main(out: Path) -> dict:
-    spec = load_spec("spl2782")                 # a shipped name, or the path of your TOML
+def main(out: Path, spec_ref: str = "spl2782", level: int = 1) -> dict:
+    """Solve, print, save to ``out``; returns the printed figures (°C, µm, W)."""
+    spec = load_spec(spec_ref)                  # a shipped name, or the path of your TOML
     case = load_case(spec, "nominal")           # any shipped cycle name or cycle file
-    result = ReferenceModel(spec, level=1).steady(case)
-    figures = {"T1_C": result.sensors["T1"] - ZERO_C_K,
-               "P1_um": result.growth_m["P1"] * 1e6,
-               "relative_imbalance": result.energy["relative_imbalance"]}
-    print(f"T1 = {figures['T1_C']:.2f} °C, P1 = {figures['P1_um']:.2f} µm, energy balance "
-          f"closes to {figures['relative_imbalance']:.1e}")
-    result.save(out, pictures=False)            # pictures=True adds the PNGs (pyvista)
-    print(f"wrote {out}")
-    return figures
+    result = ReferenceModel(spec, level=level).steady(case)  # level 2 is the study's truth
+
+    sensors_C = {n: T - ZERO_C_K for n, T in result.sensors.items()}  # the model works in K
+    growth_um = {n: g * 1e6 for n, g in result.growth_m.items()}      # ... and in m
+    energy = result.energy
+    print(f"{spec.name}, {case.name}: {result.speed_rpm:g} rpm, {energy['heat_in_W']:.0f} W "
+          f"of losses; FEM P{result.model.order}, mesh level {level}")
+    # single sensors one per line; the shaft and housing arrays (front to rear) one line each
+    arrays: dict[str, list[float]] = {}
+    for s in spec.temperature_sensors():
+        if s.array:
+            arrays.setdefault(s.array, []).append(sensors_C[s.name])
+        else:
+            print(f"  {s.name:<16} {sensors_C[s.name]:7.2f} °C")
+    for name, values in arrays.items():
+        print(f"  {name} array °C: " + " ".join(f"{v:.1f}" for v in values))
+    print("  growth: " + ", ".join(f"{n} = {g:.2f} µm" for n, g in growth_um.items()))
+    # heat in = heat out at steady state; the FEM closes it to round-off
+    print(f"  energy balance: in {energy['heat_in_W']:.1f} W, out {energy['heat_out_W']:.1f} W, "
+          f"relative imbalance {energy['relative_imbalance']:.1e}")
+
+    files = result.save(out, pictures=False)    # pictures=True adds the PNGs (pyvista)
+    print(f"wrote {', '.join(f.name for f in files)} to {out}")
+    return {"T_ambient_C": float(case.T_ambient_K(0.0)) - ZERO_C_K, "sensors_C": sensors_C,
+            "T1_C": sensors_C["T1"], "P1_um": growth_um["P1"],
+            "heat_in_W": energy["heat_in_W"],
+            "relative_imbalance": energy["relative_imbalance"]}
 
 
 if __name__ == "__main__":
