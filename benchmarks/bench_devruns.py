@@ -61,6 +61,9 @@ def fit_one(case: DevRun) -> dict:
                                  for c, v in val.items()},
             "implausible": {k: round(v, 2) for k, v in (doc.get("parameters_prior_z") or {})
                             .items() if abs(v) > 2.58},
+            "events": {k: {f: v.get(f) for f in ("estimate", "se", "z", "p_value",
+                                                 "model_reference", "scale", "scales")}
+                       for k, v in doc.get("events", {}).items()},
             "seconds": time.perf_counter() - t}
 
 

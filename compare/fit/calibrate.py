@@ -31,11 +31,12 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from compare.fit.events import EventTest
 from compare.fit.greybox import BASE_PARAMS, EFFECTS, EXTRA_BASE_PARAMS, GreyBox, Param
 
 #: |z| of every base parameter after an effect that is needed for plausibility (95 % central)
@@ -149,6 +150,9 @@ class Calibrator:
     #: per channel, the validation RMS [tolerance units] no effect can remove: the sensor
     #: noise (set_floor); None counts the whole validation error
     floor: dict[str, float] | None = None
+    #: priors on effect parameters read from the run's events (compare.fit.events): name ->
+    #: (centre in the parameter's units, sd on its fitted scale)
+    event_prior: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     def set_floor(self, fit: Fit) -> None:
         """The floor from the noise of ``fit``'s residual, estimated from its second
@@ -216,14 +220,26 @@ class Calibrator:
 
     def _prior_terms(self, params: dict[str, Param], free: Sequence[str],
                      z: np.ndarray) -> np.ndarray:
-        if not self.prior:
-            return np.zeros(0)
         out = []
         for k, v in zip(free, z, strict=True):
             p = params[k]
-            if p.prior_sd and k in self.prior:
+            if self.prior and p.prior_sd and k in self.prior:
                 out.append((v - _to_z(p, self.prior[k])) / p.prior_sd)
+            elif k in self.event_prior:
+                centre, sd = self.event_prior[k]
+                out.append((v - _to_z(p, centre)) / sd)
         return np.asarray(out)
+
+    def set_event_prior(self, name: str, value: float, ci95: Sequence[float]) -> None:
+        """A prior on effect parameter ``name`` from an event test: centred on ``value``
+        (clipped into the bounds), with the sd of its 95 % interval ``ci95`` on the fitted
+        scale."""
+        p = next(q for e in EFFECTS.values() for q in e.params if q.name == name)
+        lo, hi = (min(max(v, p.lo), p.hi) for v in ci95)
+        centre = min(max(value, p.lo), p.hi)
+        sd = (_to_z(p, hi) - _to_z(p, lo)) / 3.92 if not p.log else \
+            (_to_z(p, max(hi, 1e-12)) - _to_z(p, max(lo, 1e-12))) / 3.92
+        self.event_prior[name] = (centre, max(sd, 1e-3))
 
     def residuals(self, out: dict[str, np.ndarray], window: str) -> dict[str, np.ndarray]:
         res = {}
@@ -365,7 +381,7 @@ class Step:
     delta_bic: float
     validation_before: float
     validation_after: float
-    needed_by: str = "validation"  # or "plausibility" (compare.fit.forward_selection)
+    needed_by: str = "validation"  # or "plausibility", "event" (forward_selection)
 
 
 @dataclass
@@ -396,11 +412,65 @@ def lr_test(before: Fit, after: Fit) -> tuple[float, float]:
     return lr, float(chi2.sf(lr, k))
 
 
+#: effects with an instantaneous signature, judged on the run's events where a test applies
+#: (compare.fit.events) rather than on the open-loop fit, whose slow misfit they cannot mimic
+EVENT_EFFECTS = ("centrifugal_shortening", "sensor_lag")
+
+
+def event_supported(events: Mapping[str, EventTest], alpha: float
+                    ) -> list[tuple[str, str | None, EventTest]]:
+    """The event-signature effects the run's events support at level ``alpha``: the
+    centrifugal jump test, and the most significant lag test of the channels where one
+    applies, at alpha over their number (Bonferroni: one lag is looked for in several
+    channels). (effect, lag channel, test) in that order."""
+    out: list[tuple[str, str | None, EventTest]] = []
+    c = events.get("centrifugal_shortening")
+    if c is not None and c.significant(alpha):
+        out.append(("centrifugal_shortening", None, c))
+    lags = [t for k, t in events.items() if k.startswith("sensor_lag(")
+            and math.isfinite(t.p_value)]
+    if lags:
+        best = max(lags, key=lambda t: t.z)
+        if best.significant(alpha / len(lags)):
+            out.append(("sensor_lag", best.channel, best))
+    return out
+
+
+def _accept_events(cal: Calibrator, current: Fit, events: Mapping[str, EventTest],
+                   alpha: float, steps: list[Step], tried: list[dict],
+                   say: Callable[[str], None]) -> Fit:
+    """Adds the event-supported effects (:func:`event_supported`) to ``current``, each with
+    a prior on its parameter from its event test, and returns the extended fit."""
+    for name, channel, test in event_supported(events, alpha):
+        say(f"adding {name}" + (f" ({channel})" if channel else "") + " from its events")
+        par = test.parameter or {}
+        start = dict(current.theta)
+        if par:
+            cal.set_event_prior(par["name"], par["value"], par["ci95"])
+            p = next(q for q in EFFECTS[name].params if q.name == par["name"])
+            start[p.name] = min(max(par["value"], p.lo), p.hi)
+        v0 = current.validation_score()
+        full = cal.fit(current.effects + (name,), start=start,
+                       lag_channel=channel or current.lag_channel)
+        steps.append(Step(name, full, test.z ** 2, test.p_value, full.bic() - current.bic(),
+                          v0, full.validation_score(), "event"))
+        tried.append({"effect": name, "channel": channel, "round": 0,
+                      "p_value": test.p_value, "event_test": test.to_dict(),
+                      "validation_before": v0, "validation_after": full.validation_score(),
+                      "needed_by": "event", "qualifies": True, "accepted": True})
+        current = full
+    return current
+
+
 def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                       alpha: float = 0.01, base: Fit | None = None,
                       min_gain: float = 0.25, refit_top: int = 3,
-                      screen_nfev: int = 12) -> Selection:
-    """Bacher-Madsen forward selection over the candidate effects."""
+                      screen_nfev: int = 12,
+                      events: Mapping[str, EventTest] | None = None) -> Selection:
+    """Bacher-Madsen forward selection over the candidate effects. With ``events`` (the
+    run's event tests, compare.fit.events.event_tests) the event-signature effects are
+    judged on them where a test applies: added first when it is significant, never
+    otherwise."""
     say = cal.progress or (lambda _m: None)
     candidates = list(candidates or EFFECTS)
     if base is None:
@@ -409,6 +479,12 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
     current = base
     steps: list[Step] = []
     tried: list[dict] = []
+    judged: set[str] = set()
+    if events:
+        judged = {k for k, t in events.items() if math.isfinite(t.p_value)
+                  and k.split("(")[0] in candidates}
+        cands = {k: t for k, t in events.items() if k in judged}
+        current = _accept_events(cal, current, cands, alpha, steps, tried, say)
     while True:
         screens = []
         for name in candidates:
@@ -417,6 +493,8 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
             variants = [c for c in cal.channels] if name == "sensor_lag" else [None]
             for lag_ch in variants:
                 label = name + (f"({lag_ch})" if lag_ch else "")
+                if label in judged:
+                    continue
                 say(f"trying {label}")
                 effects = current.effects + (name,)
                 # screen: a short joint fit (the base parameters may already have absorbed

@@ -38,6 +38,7 @@ from compare.fit.calibrate import (
     parameters_table,
     resample,
 )
+from compare.fit.events import event_tests
 from compare.fit.greybox import (
     BASE_PARAMS,
     EFFECTS,
@@ -114,6 +115,8 @@ class FitReport:
     base_adequacy: dict | None = None
     #: operating points of the validation window the fit window never saw
     warnings: list[str] = field(default_factory=list)
+    #: compare.fit.events tests of the raw samples, by candidate label
+    events: dict[str, dict] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         sel = self.selection
@@ -121,11 +124,13 @@ class FitReport:
         effects = []
         for st in sel.steps:
             e = EFFECTS[st.effect]
-            params = {p.name: st.fit.theta[p.name] for p in e.params}
+            # the final model's values (it holds every accepted effect), as in the parameter
+            # table; the step's own fit is the one its test was made on
+            params = {p.name: final.theta[p.name] for p in e.params}
             if st.effect == "sensor_lag":
-                params["channel"] = st.fit.lag_channel
+                params["channel"] = final.lag_channel
             effects.append({"name": st.effect, "parameters": params,
-                            "confidence_intervals": {p.name: list(st.fit.ci95[p.name])
+                            "confidence_intervals": {p.name: list(final.ci95[p.name])
                                                      for p in e.params},
                             "p_value": st.p_value, "delta_bic": st.delta_bic,
                             "explanation": e.explanation,
@@ -143,6 +148,7 @@ class FitReport:
             "fem_calibration": self.fem_calibration,
             "base_adequacy": self.base_adequacy,
             "warnings": self.warnings,
+            "events": self.events,
             "effects": effects,
             "unexplained": {"unexplained": self.unexplained, "description": self.unexplained_text},
             "error_before": _errors(sel.base), "error_after": _errors(final),
@@ -257,7 +263,9 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         cal.gb.discrepancy = anchor.offsets
         say("calibrating the base model")
         _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref})
-    sel = forward_selection(cal, candidates, alpha, base=base, min_gain=min_gain)
+    say("reading the events (speed steps) of the raw samples")
+    events = event_tests(run, cal.gb, base.theta, channels)
+    sel = forward_selection(cal, candidates, alpha, base=base, min_gain=min_gain, events=events)
     final = sel.final
     ins = {"speed": np.concatenate([[inputs.speed_rpm[0]], inputs.speed_rpm]),
            "power": np.concatenate([[inputs.power_kW[0]], inputs.power_kW]),
@@ -310,7 +318,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                                    measured.split_s)
     return FitReport(run, spec, channels, measured, inputs, sel, diag_b, diag_a, unexplained,
                      text, signatures, time.perf_counter() - t0, alpha, anchor, cal.floor,
-                     cal.prior_z(final) or None, model, fem_cal_info, adequacy, warns)
+                     cal.prior_z(final) or None, model, fem_cal_info, adequacy, warns,
+                     {k: t.to_dict() for k, t in events.items()})
 
 
 #: least_squares function evaluations of the FEM fit with priors (each iteration adds a

@@ -86,8 +86,10 @@ def _with_mount(spec: Spec, G_W_K: float) -> Spec:
 
 
 def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: int = 1,
-                  dt_s: float = 60.0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Times [s] and the channels T1, T2, T_stator [K], P1 [m] of the FEM with the effect."""
+                  dt_s: float = 60.0) -> tuple[np.ndarray, dict[str, np.ndarray], dict]:
+    """Times [s] and the channels T1, T2, T_stator [K], P1 [m] of the FEM with the effect, and
+    the parts that follow the speed at once, by channel, as functions of the sample times [m]
+    (the centrifugal shortening; added by :func:`bench_rows` at the bench's own times)."""
     from reference import ReferenceModel
 
     T0 = float(case.T_ambient_K(0.0))
@@ -107,10 +109,14 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
     else:
         res = ref.transient(case, dt_s, T0=T0)
     ch = {n: res.sensor(n) for n in ("T1", "T2", "T_stator") if n in res.names}
-    P1 = res.growth_m["P1"].copy()
-    if effect == "centrifugal_shortening":  # the FEM's centrifugal part, scaled
-        P1 = P1 + truth["scale"] * ref.centrifugal_m(case, res.times_s, "P1")
-    ch["P1"] = P1
+    ch["P1"] = res.growth_m["P1"].copy()
+    instant = {}
+    if effect == "centrifugal_shortening":
+        # the FEM's centrifugal part, scaled, follows the speed at once: it is evaluated at the
+        # bench's own sample times (bench_rows), not interpolated from the model grid, where
+        # it would ramp over a whole time step after every speed step
+        scale = truth["scale"]
+        instant["P1"] = lambda ts: scale * ref.centrifugal_m(case, ts, "P1")
     t = res.times_s
     if effect == "fixture_expansion":
         env = np.asarray(case.T_ambient_K(t))
@@ -120,7 +126,7 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
     if effect == "electronics_drift":
         ch["P1"] = ch["P1"] + truth["amplitude_um"] * 1e-6 * np.sin(
             2 * np.pi * t / (truth["period_h"] * 3600.0))
-    return t, ch
+    return t, ch, instant
 
 
 def _anderson(G, x0: np.ndarray, tol: float, max_iter: int = 25, memory: int = 5
@@ -212,11 +218,13 @@ def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0:
 
 
 def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, power_W,
-               rng: np.random.Generator, rate_hz: float = 1.0, torque_Nm=None
-               ) -> tuple[list[str], np.ndarray]:
+               rng: np.random.Generator, rate_hz: float = 1.0, torque_Nm=None,
+               instant: dict | None = None) -> tuple[list[str], np.ndarray]:
     """Sample like a bench: irregular times, a 20 min gap, noise, quantisation, empty cells.
     ``torque_Nm(t)``: the process load torque [N m], logged as ``load_torque_Nm`` (None: a
-    no-load run, no such column, as the bench format has it)."""
+    no-load run, no such column, as the bench format has it). ``instant``: parts of channels
+    evaluated at the sample times rather than interpolated from ``t_model``
+    (:func:`reference_run`)."""
     dur = float(t_model[-1])
     n = int(dur * rate_hz * 1.05) + 10
     t = np.cumsum(rng.uniform(0.5, 1.5, n) / rate_hz)
@@ -232,6 +240,8 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
     cols["T_coolant_C"] = np.asarray(case.T_coolant_K(t)) - ZERO_C_K
     for name, y in ch.items():
         v = np.interp(t, t_model, y)
+        if instant and name in instant:
+            v = v + instant[name](t)
         cols[f"{name}_um" if name == "P1" else f"{name}_C"] = v * 1e6 if name == "P1" else v - ZERO_C_K
     cols["P1_um"] = cols["P1_um"] - cols["P1_um"][0]
     for key, (sd, q) in NOISE.items():
@@ -286,7 +296,7 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
         truth["mismatch"] = mm.to_dict()
         truth["fem_level"] = level
     case = cycle_load_case(spec, cycle, drive)
-    t_model, ch = reference_run(spec, case, effect, truth["parameters"], level, dt_s)
+    t_model, ch, instant = reference_run(spec, case, effect, truth["parameters"], level, dt_s)
     # electrical power: losses plus mechanical output, per step (no-load cycles: losses)
     starts = np.asarray(cycle.boundaries_s[:-1])
     p_el = []
@@ -302,7 +312,8 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
 
     torques = [s.load_torque_Nm for s in cycle.steps]
     header, data = bench_rows(t_model, ch, case, step_values(p_el), rng,
-                              torque_Nm=step_values(torques) if any(torques) else None)
+                              torque_Nm=step_values(torques) if any(torques) else None,
+                              instant=instant)
     lines = [f"# spindle: {spec.name}", "# bench: synthetic run (spindle-verify synth)",
              f"# cycle: {cycle_name}", f"# rows: {len(data)}", ",".join(header)]
     fmt = {h: ("{:.2f}" if h in ("time_s", "speed_rpm") else "{:.4f}") for h in header}
