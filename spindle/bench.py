@@ -23,6 +23,7 @@ import csv
 import io
 import math
 import re
+import sys
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -36,9 +37,11 @@ from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
 from spindle.power import power_balance
 from spindle.spec import Spec
+from spindle.units import CYCLE_MAX_S, SPEED_MAX_RPM, ZERO_C_K
 
-#: 0 °C in K.
-from spindle.units import ZERO_C_K
+# a bench export may hold long cells in columns the tool does not read (notes, JSON): the
+# csv module's default 128 kB field limit would refuse valid files
+csv.field_size_limit(min(sys.maxsize, 2**31 - 1))
 
 #: µm -> m
 UM_TO_M = 1e-6
@@ -62,7 +65,6 @@ TEMPERATURE_COLUMNS: tuple[str, ...] = ("T_env_C", "T_coolant_C", "T1_C", "T2_C"
 T_MIN_C = -60.0
 T_KELVIN_MEDIAN_C = 150.0
 T_KELVIN_MAX_C = 250.0
-SPEED_MAX_RPM = 100_000.0
 POWER_LIMIT_KW = 1000.0
 #: What a fit needs: rows with at least one measured channel, and their time span [s].
 MIN_ROWS = 50
@@ -463,6 +465,11 @@ def _read_time(table: _Table, j: int, error: _ErrorFor) -> np.ndarray:
         raise error(f"time_s (line {line_no[k]})", f"{t[k]:g} s is not after {t[k - 1]:g} s on line "
                     f"{line_no[k - 1]}: time must increase strictly",
                     "export the rows in time order without duplicate rows")
+    if t[-1] - t[0] > CYCLE_MAX_S:
+        k = len(t) - 1
+        raise error(f"time_s (line {line_no[k]})", f"the run spans {(t[-1] - t[0]) / 3600:.4g} h, "
+                    f"more than {CYCLE_MAX_S / 3600:g} h: not a bench run in seconds",
+                    "export time_s in seconds since the start of the run")
     return t
 
 

@@ -40,7 +40,7 @@ if TYPE_CHECKING:  # only for the annotation: spec.py is not imported at run tim
     from spindle.spec import Spec
 
 #: 0 degC in K.
-from spindle.units import ZERO_C_K
+from spindle.units import CYCLE_MAX_S, SPEED_MAX_RPM, ZERO_C_K
 
 #: Temperatures accepted in cycle files [degC] (as spindle.loads.read_cycle_csv).
 T_MIN_C, T_MAX_C = -60.0, 200.0
@@ -526,6 +526,9 @@ def read_cycle_steps_csv(path: str | Path, *, T_ambient_C: float | None = None,
 
 def _check_steps_header(f: _File, header: list[str], hline: int) -> None:
     """The required step columns are there; every column is a step column, once."""
+    if len(header) == 1 and ";" in header[0]:
+        raise f.error(f"header (line {hline})", "the columns are separated by ';'",
+                      "export comma-separated values with '.' as the decimal separator")
     for col in _CSV_REQUIRED:
         if col not in header:
             raise f.error(col, f"required column is missing from the header (line {hline})",
@@ -589,6 +592,22 @@ def _meta_temperature(f: _File, meta: dict[str, tuple[str, int]], key: str,
 # --------------------------------------------------------------------------- shipped cycles
 
 
+def check_cycle_limits(cycle: Cycle, file: str) -> Cycle:
+    """``cycle`` if its speeds and duration are those of a spindle's test cycle
+    (``spindle.units.SPEED_MAX_RPM``, ``CYCLE_MAX_S``); otherwise an InputError naming the
+    step: the work of simulating it would be absurd, and so would the result."""
+    for k, s in enumerate(cycle.steps):
+        if s.speed_rpm > SPEED_MAX_RPM:
+            raise InputError(file, f"steps[{k}].speed_rpm", f"{s.speed_rpm:g} rpm is above "
+                             f"{SPEED_MAX_RPM:g} rpm, faster than any motor spindle",
+                             "give the speed in rpm (1/min)")
+    if cycle.duration_s > CYCLE_MAX_S:
+        raise InputError(file, "duration_s", f"the steps last {cycle.duration_s / 3600:.4g} h, "
+                         f"more than {CYCLE_MAX_S / 3600:g} h", "give step durations in seconds "
+                         "(duration_s) or hours (duration_h) for a run of hours to days")
+    return cycle
+
+
 def shipped_cycles() -> dict[str, Path]:
     """Shipped cycles (spindle/data/cycles/*.toml and *.csv) by name (the file stem)."""
     root = resources.files("spindle").joinpath("data/cycles")
@@ -607,8 +626,8 @@ def load_cycle(name_or_path: str | Path) -> Cycle:
         p = shipped[str(name_or_path)]
     suffix = p.suffix.lower()
     if suffix == ".toml":
-        return read_cycle_toml(p)
+        return check_cycle_limits(read_cycle_toml(p), str(p))
     if suffix == ".csv":
-        return read_cycle_steps_csv(p)
+        return check_cycle_limits(read_cycle_steps_csv(p), str(p))
     raise InputError(str(p), "file", f"unknown cycle file type '{p.suffix}'",
                      "give a .toml cycle or a .csv step table")

@@ -16,7 +16,7 @@ import numpy as np
 
 from spindle.commented_csv import CommentedCsv, split_commented_csv
 from spindle.errors import InputError
-from spindle.units import ZERO_C_K
+from spindle.units import CYCLE_MAX_S, SPEED_MAX_RPM, ZERO_C_K
 
 Interpolation = Literal["linear", "previous"]
 
@@ -144,10 +144,13 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
     path = Path(path)
     name = str(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except OSError as exc:
         raise InputError(name, "file", f"cannot be read ({exc.strerror})",
                          "check the path given to --cycle") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(name, "file", f"is not UTF-8 text (byte {exc.start})",
+                         "export the cycle as a UTF-8 (or ASCII) CSV file") from None
     table = split_commented_csv(text)
     if not table.line_no:
         raise InputError(name, "header", "the file has no header row",
@@ -160,10 +163,19 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
     def series(col: str, offset: float = 0.0, interp: Interpolation = "linear") -> TimeSeries:
         return TimeSeries(times, tuple(v + offset for v in data[col]), interp)
 
+    if times[-1] > CYCLE_MAX_S:
+        raise InputError(name, f"time_s (line {line_no[-1]})", f"the run lasts "
+                         f"{times[-1] / 3600:.4g} h, more than {CYCLE_MAX_S / 3600:g} h",
+                         "give time_s in seconds since the start")
     case = replace(base, name=path.stem, duration_s=times[-1])
     if "speed_rpm" in data:
         if min(data["speed_rpm"]) < 0:
             raise InputError(name, "speed_rpm", "is negative", "give the speed as |n| [rpm]")
+        if max(data["speed_rpm"]) > SPEED_MAX_RPM:
+            k = int(np.argmax(np.asarray(data["speed_rpm"]) > SPEED_MAX_RPM))
+            raise InputError(name, f"speed_rpm (line {line_no[k + 1]})",
+                             f"{data['speed_rpm'][k]:g} rpm is above {SPEED_MAX_RPM:g} rpm, "
+                             "faster than any motor spindle", "give the speed in rpm (1/min)")
         case = replace(case, speed_rpm=series("speed_rpm", interp="previous"))
     for col, attr in (("T_env_C", "T_ambient_K"), ("T_coolant_C", "T_coolant_K")):
         if col in data:

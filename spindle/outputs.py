@@ -8,6 +8,7 @@ import csv
 import json
 import math
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Iterator, Mapping, Sequence
@@ -37,15 +38,67 @@ def atomic_write(path: Path, write) -> None:
             os.unlink(tmp)
 
 
-@contextmanager
-def output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[Path]:
-    """Yield a temporary folder to write into; on success move its files into ``path``."""
+def safe_name(name: str) -> str:
+    """``name`` (a spec's or a run's) made safe as one folder name: no path separators, no
+    leading dots, nothing but letters, digits, ``-``, ``_`` and ``.`` (a spec named
+    ``../../etc/evil`` must not write outside ``results/``)."""
+    text = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).lstrip(".")
+    return text[:100] or "unnamed"
+
+
+def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Path:
+    """Refuse, before any work is done, an output folder that cannot be one: a file, an input,
+    a folder holding one of the inputs, or a place that cannot be created or written."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise InputError(str(path), "--out", "is a file, not a folder",
                          "give a folder for the outputs")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.tmp-", dir=path.parent))
+    target = path.resolve()
+    for p in inputs:
+        q = Path(p).resolve()
+        if q == target or target in q.parents:
+            raise InputError(str(path), "--out", f"holds the input {p}, which an output could "
+                             "overwrite", "choose an output folder apart from the inputs")
+    # nothing is created here (a run refused later must leave nothing behind): the nearest
+    # existing folder on the way must be one we can write into
+    base = target
+    while not base.exists() and base != base.parent:
+        base = base.parent
+    if not base.is_dir():
+        raise InputError(str(path), "--out", f"cannot be created: {base} is a file",
+                         "give a folder in a place you can write to")
+    if not os.access(base, os.W_OK | os.X_OK):
+        raise InputError(str(path), "--out", f"cannot be written ({base} is not writable)",
+                         "give a folder in a place you can write to")
+    return path
+
+
+def _clean_leftovers(parent: Path, name: str) -> None:
+    """Remove the temporary folders of earlier runs into ``name`` that were killed before they
+    could clean up (their process is gone)."""
+    for old in parent.glob(f".{name}.tmp-*"):
+        m = re.match(rf"\.{re.escape(name)}\.tmp-(\d+)-", old.name)
+        if not m or not old.is_dir():
+            continue
+        try:
+            os.kill(int(m.group(1)), 0)
+        except ProcessLookupError:
+            shutil.rmtree(old, ignore_errors=True)
+        except (PermissionError, OverflowError):
+            pass
+
+
+@contextmanager
+def output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[Path]:
+    """Yield a temporary folder to write into; on success move its files into ``path``."""
+    path = check_output_dir(path, inputs)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(str(path), "--out", f"cannot be created ({exc.strerror})",
+                         "give a folder in a place you can write to") from None
+    _clean_leftovers(path.parent, path.name)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.tmp-{os.getpid()}-", dir=path.parent))
     try:
         yield tmp
         files = [f for f in tmp.rglob("*") if f.is_file()]

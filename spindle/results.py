@@ -6,7 +6,30 @@ from __future__ import annotations
 
 import numpy as np
 
+from spindle.errors import SolverError
 from spindle.units import ZERO_C_K
+
+#: the largest relative energy imbalance a written result may have: the solvers close the
+#: balance to round-off (steady, 1e-12) or to the time integration's bookkeeping (1e-9);
+#: beyond this the problem is ill-conditioned (a conductance of 1e300 W/K gave 47 %)
+MAX_RELATIVE_IMBALANCE = 1e-3
+
+
+def check_plausible(T_K: np.ndarray, relative_imbalance: float, file: str) -> None:
+    """Refuse a result that cannot be physical before anything is written: temperatures that
+    are not finite or not above 0 K, or an energy balance that does not close."""
+    T = np.asarray(T_K, dtype=float)
+    if not np.isfinite(T).all() or T.min() <= 0.0:
+        bad = "not finite" if not np.isfinite(T).all() else f"down to {T.min():.4g} K"
+        raise SolverError(f"{file}: result: the temperatures are {bad}, which is not physical; "
+                          "fix: check the spec's conductances, films and sources for values "
+                          "many orders of magnitude off (docs/spec.md lists plausible ranges)")
+    if not relative_imbalance <= MAX_RELATIVE_IMBALANCE:
+        raise SolverError(f"{file}: result: the energy balance is off by "
+                          f"{relative_imbalance:.2g} of the heat flows (limit "
+                          f"{MAX_RELATIVE_IMBALANCE:g}): the problem is ill-conditioned; fix: "
+                          "check the spec for conductances or films many orders of magnitude "
+                          "apart (docs/spec.md lists plausible ranges)")
 
 
 class SteadyTable:
@@ -22,6 +45,10 @@ class SteadyTable:
         return {"heat_in_W": self.heat_in_W, "heat_out_W": out, "imbalance_W": imbalance,
                 "relative_imbalance": abs(imbalance) / scale,
                 **{f"out_{k}_W": v for k, v in self.heat_out_W.items()}}
+
+    def check_plausible(self, file: str) -> None:
+        """SolverError unless the field is above 0 K and the balance closes (before writing)."""
+        check_plausible(self.T, self.energy["relative_imbalance"], file)
 
     def sensor_table(self) -> dict[str, list]:
         T_amb = float(self.case.T_ambient_K(self.time_s))
@@ -62,6 +89,10 @@ class TransientTable:
         return {"energy_in_J": self.energy_in_J, "energy_out_J": self.energy_out_J,
                 "energy_stored_J": self.energy_stored_J, "imbalance_J": imb,
                 "relative_imbalance": abs(imb) / scale}
+
+    def check_plausible(self, file: str) -> None:
+        """SolverError unless every sensor stays above 0 K and the balance closes."""
+        check_plausible(self.sensor_K, self.energy["relative_imbalance"], file)
 
     def sensor(self, name: str) -> np.ndarray:
         """History of one sensor [K]."""

@@ -29,6 +29,33 @@ T_REFS = ("ambient", "coolant")
 LINK_TYPES = ("bearing", "air_gap", "contact")
 #: A rotor-stator gap wider than this is not an air gap of a built-in motor [m].
 MAX_AIR_GAP_M = 5e-3
+#: the fields every table of a spec may hold (docs/spec.md); ``description``, ``source`` and
+#: ``note`` document an entry anywhere
+_DOC = ("description", "source", "note")
+KNOWN_FIELDS: dict[str, tuple[str, ...]] = {
+    "": ("spindle", "operating", "power_balance", "mesh", "materials", "parts", "links",
+         "surfaces", "heat_sources", "sensors", "sensor_arrays"),
+    "spindle": ("name", *_DOC),
+    "operating": ("speed_rpm", "T_ambient_K", "T_coolant_K", "T_initial_K", *_DOC),
+    "power_balance": ("preset", *_DOC),
+    "mesh": ("h0_m", *_DOC),
+    "materials": ("k_W_mK", "k_r_W_mK", "k_z_W_mK", "rho_kg_m3", "c_J_kgK", "E_Pa", "nu",
+                  "alpha_1_K", *_DOC),
+    "parts": ("name", "role", "material", "sections", *_DOC),
+    "sections": ("z_start", "z_end", "r_inner", "r_outer", "material", "name", *_DOC),
+    "links.bearing": ("type", "part", "section", "G_W_K", *_DOC),
+    "links.air_gap": ("type", "inner", "outer", "h_W_m2K", *_DOC),
+    "links.contact": ("type", "parts", "h_W_m2K", *_DOC),
+    "surfaces": ("name", "parts", "part", "side", "z_min", "z_max", "h_W_m2K", "T_ref", *_DOC),
+    "heat_sources": ("name", "power_W", "part", "section", "surface", *_DOC),
+    "sensors": ("name", "kind", "z", "r", "z_ref", "r_ref", *_DOC),
+    "sensor_arrays": ("name", "part", "count", "radius", *_DOC),
+}
+#: the largest dimension [m] of a motor spindle (the SPL2782 is 0.6 m long); beyond this a
+#: spec is taken to be in millimetres
+MAX_SIZE_M = 5.0
+#: the most elements a spec's level-0 mesh may have (spl2782: 1379); every level adds 4x
+MAX_LEVEL0_ELEMENTS = 200_000
 
 
 @dataclass(frozen=True)
@@ -217,24 +244,88 @@ class Spec:
 # --------------------------------------------------------------------------- reading
 
 
+def _finite(v: Any) -> float | None:
+    """``v`` as a finite float, or None (not a number, a bool, NaN, inf, or an integer too
+    large for a float)."""
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        return None
+    try:
+        f = float(v)
+    except OverflowError:
+        return None
+    return f if math.isfinite(f) else None
+
+
+def _show(v: Any) -> str:
+    """A short text for a bad value in a message (no 400-digit integers)."""
+    text = repr(v)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+#: plausibility limits of a motor spindle's description, with the reason (docs/spec.md)
+MAX_POWER_W = 1e6
+#: film coefficients: forced water convection reaches 1e4-1e5 W/m2/K; 1e6 is boiling
+MAX_FILM_W_M2K = 1e6
+PLAUSIBLE_FILM = "air films are 5-500 W/m2/K, water jackets up to 1e5"
+#: bearing conductances: a pair conducts 5-50 W/K (docs/spec.md)
+MAX_G_W_K = 1e5
+PLAUSIBLE_POWER = "a motor spindle's losses are watts to kilowatts (SPL2782: 5.1 kW in all)"
+
+
 class _Reader:
     """Collects problems while reading nested TOML tables; never stops at the first."""
 
     def __init__(self, file: str):
         self.file = file
         self.problems: list[Problem] = []
+        #: fields whose problems follow from one already reported (a misspelt or missing
+        #: table): not reported again
+        self.quiet: set[str] = set()
+        #: names of parts, surfaces and materials that are defined but could not be read:
+        #: a reference to one is not a second problem
+        self.broken: dict[str, set[str]] = {"part": set(), "surface": set(), "material": set()}
 
     def add(self, fld: str, message: str, fix: str) -> None:
+        if any(fld == q or fld.startswith(q + ".") or fld.startswith(q + "[")
+               for q in self.quiet):
+            return
         self.problems.append(Problem(self.file, fld, message, fix))
+
+    def unknown(self, kind: str, name: str, fld: str, fix: str) -> None:
+        """An unknown ``kind`` (part, surface, material) named ``name`` at ``fld``; nothing
+        when that name is defined but broken (its own problem is the root cause)."""
+        if name not in self.broken[kind]:
+            self.add(fld, f"unknown {kind} '{name}'", fix)
+
+    def keys(self, data: dict, known: tuple[str, ...], path: str) -> None:
+        """Every key of ``data`` must be one of ``known``: an unknown one (a misspelling) is a
+        problem with the nearest known name; the field it was meant for is then not reported
+        missing as well."""
+        import difflib
+
+        for k in data:
+            if k in known:
+                continue
+            near = difflib.get_close_matches(str(k), known, n=1, cutoff=0.6)
+            where = f"{path}.{k}" if path else str(k)
+            what = "table" if not path and isinstance(data[k], dict | list) else "field"
+            if near:
+                self.add(where, f"unknown {what} '{k}'", f"did you mean '{near[0]}'?")
+                self.quiet.add(f"{path}.{near[0]}" if path else near[0])
+            else:
+                self.add(where, f"unknown {what} '{k}'",
+                         f"use one of: {', '.join(known)} (docs/spec.md)")
 
     def table(self, data: dict, key: str, path: str, required: bool = True) -> dict | None:
         v = data.get(key)
         if v is None:
             if required:
                 self.add(f"{path}{key}", "required table is missing", f"add a [{path}{key}] table")
+                self.quiet.add(f"{path}{key}")  # its fields are not missing a second time
             return None
         if not isinstance(v, dict):
             self.add(f"{path}{key}", "must be a table", f"write it as [{path}{key}]")
+            self.quiet.add(f"{path}{key}")
             return None
         return v
 
@@ -274,11 +365,11 @@ class _Reader:
                 self.add(f"{path}.{key}", "required field is missing",
                          f"add {key} = <number in {unit}>")
             return default
-        if isinstance(v, bool) or not isinstance(v, int | float) or not np.isfinite(v):
-            self.add(f"{path}.{key}", f"must be a finite number in {unit}, not {v!r}",
-                     f"write {key} = <number in {unit}>")
+        v = _finite(v)
+        if v is None:
+            self.add(f"{path}.{key}", f"must be a finite number in {unit}, not "
+                     f"{_show(data.get(key))}", f"write {key} = <number in {unit}>")
             return default
-        v = float(v)
         if lo is not None and (v <= lo if lo_open else v < lo):
             rel = ">" if lo_open else ">="
             self.add(f"{path}.{key}", f"{v:g} {unit} is not physical (must be {rel} {lo:g})",
@@ -292,18 +383,17 @@ class _Reader:
 
     def radius(self, data: dict, key: str, path: str) -> tuple[float, float] | None:
         v = data.get(key)
-        if isinstance(v, list) and len(v) == 2 and all(
-                isinstance(x, int | float) and not isinstance(x, bool) for x in v):
-            pair = (float(v[0]), float(v[1]))
-        elif isinstance(v, int | float) and not isinstance(v, bool):
-            pair = (float(v), float(v))
+        if isinstance(v, list) and len(v) == 2 and None not in (_finite(v[0]), _finite(v[1])):
+            pair = (_finite(v[0]), _finite(v[1]))
+        elif _finite(v) is not None:
+            pair = (_finite(v), _finite(v))
         elif v is None:
             self.add(f"{path}.{key}", "required field is missing",
                      f"add {key} = <radius in m> (or [start, end] for a cone)")
             return None
         else:
-            self.add(f"{path}.{key}", f"must be a radius in m or [start, end], not {v!r}",
-                     f"write {key} = 0.04 or {key} = [0.04, 0.05]")
+            self.add(f"{path}.{key}", f"must be a finite radius in m or [start, end], not "
+                     f"{_show(v)}", f"write {key} = 0.04 or {key} = [0.04, 0.05]")
             return None
         if min(pair) < 0:
             self.add(f"{path}.{key}", "a radius cannot be negative", "give radii >= 0 m")
@@ -324,8 +414,7 @@ class _Reader:
         if isinstance(v, dict):
             n, vals = v.get("speed_rpm"), v.get("value")
             ok = (isinstance(n, list) and isinstance(vals, list) and len(n) == len(vals) >= 1
-                  and all(isinstance(x, int | float) and not isinstance(x, bool)
-                          for x in [*n, *vals]))
+                  and all(_finite(x) is not None for x in [*n, *vals]))
             if not ok:
                 self.add(f"{path}.{key}", "a speed table needs lists speed_rpm and value of "
                          "equal length", f"write {key} = {{speed_rpm = [0, 4300], value = [10, 60]}}")
@@ -385,30 +474,42 @@ class _Reader:
         if isinstance(v, dict):
             t, vals = v.get("time_s"), v.get("value")
             ok = (isinstance(t, list) and isinstance(vals, list) and len(t) == len(vals) >= 1
-                  and all(isinstance(x, int | float) and not isinstance(x, bool)
-                          for x in [*t, *vals]))
+                  and all(_finite(x) is not None for x in [*t, *vals]))
             if not ok or any(b <= a for a, b in zip(t or [], (t or [])[1:], strict=False)):
                 self.add(f"{path}.power_W", "a power series needs increasing time_s and value "
                          "lists of equal length",
                          "write power_W = {time_s = [0, 3600], value = [40, 60]}")
                 return None
+            if min(vals) < 0 or max(vals) > MAX_POWER_W:
+                self.add(f"{path}.power_W.value", f"values from {min(vals):g} to {max(vals):g} W "
+                         f"are not plausible: {PLAUSIBLE_POWER}", "give values from 0 to "
+                         f"{MAX_POWER_W:g} W")
+                return None
             return TimeSeries(tuple(map(float, t)), tuple(map(float, vals)))
-        num = self.number(data, "power_W", path, "W")
+        num = self.number(data, "power_W", path, "W", lo=0.0, hi=MAX_POWER_W)
         return None if num is None else TimeSeries.constant(num)
 
 
 def _read_material(r: _Reader, name: str, d: dict, path: str) -> Material | None:
+    # upper limits: beyond every engineering solid (diamond conducts 2200 W/m/K, osmium is
+    # 22600 kg/m3, E of diamond 1.2e12 Pa, thermal expansion of polymers 2e-4 1/K); k up to
+    # 1e6 W/m/K for the near-ideal conductors of verification cases
     n0 = len(r.problems)
-    if "k_W_mK" in d:
-        kr = kz = r.number(d, "k_W_mK", path, "W/m/K", lo=0.0, lo_open=True)
+    r.keys(d, KNOWN_FIELDS["materials"], path)
+    if "k_W_mK" in d and ("k_r_W_mK" in d or "k_z_W_mK" in d):
+        r.add(f"{path}.k_W_mK", "is given together with k_r_W_mK / k_z_W_mK",
+              "give either k_W_mK (isotropic) or both k_r_W_mK and k_z_W_mK")
+        kr = kz = None
+    elif "k_W_mK" in d:
+        kr = kz = r.number(d, "k_W_mK", path, "W/m/K", lo=0.0, lo_open=True, hi=1e6)
     else:
-        kr = r.number(d, "k_r_W_mK", path, "W/m/K", lo=0.0, lo_open=True)
-        kz = r.number(d, "k_z_W_mK", path, "W/m/K", lo=0.0, lo_open=True)
-    rho = r.number(d, "rho_kg_m3", path, "kg/m3", lo=0.0, lo_open=True)
-    c = r.number(d, "c_J_kgK", path, "J/kg/K", lo=0.0, lo_open=True)
-    E = r.number(d, "E_Pa", path, "Pa", lo=0.0, lo_open=True)
+        kr = r.number(d, "k_r_W_mK", path, "W/m/K", lo=0.0, lo_open=True, hi=1e6)
+        kz = r.number(d, "k_z_W_mK", path, "W/m/K", lo=0.0, lo_open=True, hi=1e6)
+    rho = r.number(d, "rho_kg_m3", path, "kg/m3", lo=0.0, lo_open=True, hi=30000.0)
+    c = r.number(d, "c_J_kgK", path, "J/kg/K", lo=0.0, lo_open=True, hi=20000.0)
+    E = r.number(d, "E_Pa", path, "Pa", lo=0.0, lo_open=True, hi=2e12)
     nu = r.number(d, "nu", path, "-", lo=-1.0, lo_open=True, hi=0.4999)
-    alpha = r.number(d, "alpha_1_K", path, "1/K", lo=0.0)
+    alpha = r.number(d, "alpha_1_K", path, "1/K", lo=0.0, hi=1e-3)
     if len(r.problems) > n0:
         return None
     return Material(name, kr, kz, rho, c, E, nu, alpha, str(d.get("source", "")))
@@ -451,7 +552,7 @@ def read_toml(path: Path) -> dict:
     file and the fix (every TOML input of the project reads through here)."""
     file = str(path)
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a BOM is accepted
     except tomllib.TOMLDecodeError as exc:
         raise SpecError([Problem(file, "syntax", str(exc), "fix the TOML syntax at that line")]) \
             from None
@@ -469,6 +570,10 @@ def load_spec(name_or_path: str | Path) -> Spec:
 def _build(r: _Reader, data: dict[str, Any]) -> Spec:
     """Read the tables one after the other (the problems are listed in that order), then,
     if none was found, check the geometry; raises SpecError with every problem."""
+    r.keys(data, KNOWN_FIELDS[""], "")
+    for t in ("spindle", "operating", "power_balance", "mesh"):
+        if isinstance(data.get(t), dict):
+            r.keys(data[t], KNOWN_FIELDS[t], t)
     head = r.table(data, "spindle", "") or {}
     name = r.string(head, "name", "spindle") or "?"
     speed, T_amb, T_cool, T_init = _read_operating(r, data)
@@ -483,6 +588,8 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:
     pb = r.table(data, "power_balance", "", required=False) or {}
     preset = r.string(pb, "preset", "power_balance", required=False)
 
+    if not r.problems:
+        _check_size(r, parts, h0)
     if not r.problems:
         _check_geometry(r, parts, links, surfaces, sensors)
     if r.problems:
@@ -518,6 +625,9 @@ def _read_materials(r: _Reader, data: dict[str, Any]) -> dict[str, Material]:
         m = _read_material(r, mname, md, f"materials.{mname}")
         if m is not None:
             materials[mname] = m
+        else:
+            r.broken["material"].add(mname)
+            materials.pop(mname, None)
     return materials
 
 
@@ -526,6 +636,8 @@ def _read_parts(r: _Reader, data: dict[str, Any], materials: dict[str, Material]
     parts: list[Part] = []
     for i, pd in enumerate(r.array(data, "parts", "")):
         path = f"parts[{i}]"
+        n0 = len(r.problems)
+        r.keys(pd, KNOWN_FIELDS["parts"], path)
         pname = r.string(pd, "name", path)
         role = r.string(pd, "role", path, choices=ROLES)
         pmat = pd.get("material")
@@ -541,14 +653,33 @@ def _read_parts(r: _Reader, data: dict[str, Any], materials: dict[str, Material]
             sec = _read_section(r, sd, f"{path}.sections[{j}]", path, pmat, materials)
             if sec is not None:
                 sections.append(sec)
-        if pname is not None and role is not None and sections:
+        if len(sections) == len(secs):
+            _check_sections_join(r, sections, path)
+        ok = pname is not None and role is not None and bool(sections)
+        if ok:
             parts.append(Part(pname, role, tuple(sections)))
+        if pname is not None and (not ok or len(r.problems) > n0 or len(sections) < len(secs)):
+            r.broken["part"].add(pname)
     return parts
+
+
+def _check_sections_join(r: _Reader, sections: list[Section], path: str) -> None:
+    """A part is one body: its sections, in z order, must meet without a gap."""
+    order = sorted(range(len(sections)), key=lambda j: sections[j].z_start)
+    for a, b in zip(order, order[1:], strict=False):
+        gap = sections[b].z_start - sections[a].z_end
+        if gap > TOL_M:
+            r.add(f"{path}.sections[{b}].z_start",
+                  f"a {gap * 1e3:.3g} mm gap after sections[{a}] (z = {sections[a].z_end:g} to "
+                  f"{sections[b].z_start:g} m): a part is one body",
+                  f"give z_start = {sections[a].z_end:g} (or make the piece beyond the gap a "
+                  "part of its own, joined by a link)")
 
 
 def _read_section(r: _Reader, sd: dict, sp: str, path: str, pmat: Any,
                   materials: dict[str, Material]) -> Section | None:
     """One section ``sp`` of part ``path``; its material defaults to the part's ``pmat``."""
+    r.keys(sd, KNOWN_FIELDS["sections"], sp)
     z0 = r.number(sd, "z_start", sp, "m")
     z1 = r.number(sd, "z_end", sp, "m")
     ri = r.radius(sd, "r_inner", sp)
@@ -557,10 +688,13 @@ def _read_section(r: _Reader, sd: dict, sp: str, path: str, pmat: Any,
     if mat is None:
         r.add(f"{sp}.material", "no material for this section or its part",
               f"add material = \"...\" to {path} (one of: {', '.join(sorted(materials))})")
-    elif mat not in materials:
+    elif not isinstance(mat, str):
         r.add(f"{sp}.material" if "material" in sd else f"{path}.material",
-              f"unknown material '{mat}'",
-              f"use one of: {', '.join(sorted(materials))}, or define [materials.{mat}]")
+              f"must be a material name, not {_show(mat)}", "write material = \"steel\"")
+        mat = None
+    elif mat not in materials:
+        r.unknown("material", mat, f"{sp}.material" if "material" in sd else f"{path}.material",
+                  f"use one of: {', '.join(sorted(materials))}, or define [materials.{mat}]")
         mat = None
     if None in (z0, z1, ri, ro, mat):
         return None
@@ -583,6 +717,8 @@ def _read_links(r: _Reader, data: dict[str, Any], parts: list[Part]) -> list[Lin
     for i, ld in enumerate(r.array(data, "links", "", required=False)):
         path = f"links[{i}]"
         kind = r.string(ld, "type", path, choices=LINK_TYPES)
+        if kind is not None:
+            r.keys(ld, KNOWN_FIELDS[f"links.{kind}"], path)
         link = readers[kind](r, ld, path, parts) if kind is not None else None
         if link is not None:
             links.append(link)
@@ -595,7 +731,11 @@ def _read_bearing_link(r: _Reader, ld: dict, path: str, parts: list[Part]) -> Be
     sn = r.string(ld, "section", path)
     G = r.speed_table(ld, "G_W_K", path, "W/K")
     if pn is not None and pn not in part_names:
-        r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+        r.unknown("part", pn, f"{path}.part", f"use one of: {sorted(part_names)}")
+    elif G is not None and G.max > MAX_G_W_K:
+        r.add(f"{path}.G_W_K", f"{G.max:g} W/K is not a bearing's conductance (typ. 5-50 W/K "
+              f"per pair; above {MAX_G_W_K:g} W/K it would weld the rings)",
+              f"give G_W_K <= {MAX_G_W_K:g} W/K")
     elif pn is not None and sn is not None and not any(
             s.name == sn for s in next(p for p in parts if p.name == pn).sections):
         r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
@@ -615,10 +755,13 @@ def _read_air_gap_link(r: _Reader, ld: dict, path: str, parts: list[Part]) -> Ai
     h = r.speed_table(ld, "h_W_m2K", path, "W/m2/K")
     for key, v in (("inner", a), ("outer", b)):
         if v is not None and v not in part_names:
-            r.add(f"{path}.{key}", f"unknown part '{v}'", f"use one of: {sorted(part_names)}")
+            r.unknown("part", v, f"{path}.{key}", f"use one of: {sorted(part_names)}")
     if h is not None and h.min <= 0:
         r.add(f"{path}.h_W_m2K", "an air-gap coefficient must be > 0 W/m2/K",
               "give h_W_m2K > 0")
+    elif h is not None and h.max > MAX_FILM_W_M2K:
+        r.add(f"{path}.h_W_m2K", f"{h.max:g} W/m2/K is not an air gap's film ({PLAUSIBLE_FILM})",
+              f"give h_W_m2K <= {MAX_FILM_W_M2K:g}")
     elif a in part_names and b in part_names and h is not None:
         return AirGapLink(a, b, h)
     return None
@@ -627,12 +770,13 @@ def _read_air_gap_link(r: _Reader, ld: dict, path: str, parts: list[Part]) -> Ai
 def _read_contact_link(r: _Reader, ld: dict, path: str, parts: list[Part]) -> ContactLink | None:
     part_names = {p.name for p in parts}
     pl = ld.get("parts")
-    h = r.number(ld, "h_W_m2K", path, "W/m2/K", lo=0.0, lo_open=True)
+    # a contact conducts 1e3-1e5 W/m2/K (pressed steel joints); 1e8 is a perfect bond
+    h = r.number(ld, "h_W_m2K", path, "W/m2/K", lo=0.0, lo_open=True, hi=1e8)
     if not (isinstance(pl, list) and len(pl) == 2 and all(isinstance(x, str) for x in pl)):
         r.add(f"{path}.parts", "must name two parts", "write parts = [\"shaft\", \"rotor\"]")
     elif any(x not in part_names for x in pl):
         bad = next(x for x in pl if x not in part_names)
-        r.add(f"{path}.parts", f"unknown part '{bad}'", f"use one of: {sorted(part_names)}")
+        r.unknown("part", bad, f"{path}.parts", f"use one of: {sorted(part_names)}")
     elif h is not None:
         return ContactLink((pl[0], pl[1]), h)
     return None
@@ -644,6 +788,8 @@ def _read_surfaces(r: _Reader, data: dict[str, Any], parts: list[Part]) -> list[
     surfaces: list[Surface] = []
     for i, sd in enumerate(r.array(data, "surfaces", "", required=False)):
         path = f"surfaces[{i}]"
+        n0 = len(r.problems)
+        r.keys(sd, KNOWN_FIELDS["surfaces"], path)
         sname = r.string(sd, "name", path)
         pl = sd.get("parts", sd.get("part"))
         pl = [pl] if isinstance(pl, str) else pl
@@ -652,16 +798,22 @@ def _read_surfaces(r: _Reader, data: dict[str, Any], parts: list[Part]) -> list[
             pl = []
         for x in pl:
             if x not in part_names:
-                r.add(f"{path}.parts", f"unknown part '{x}'", f"use one of: {sorted(part_names)}")
+                r.unknown("part", x, f"{path}.parts", f"use one of: {sorted(part_names)}")
         side = r.string(sd, "side", path, required=False, choices=SIDES, default="any")
         zmin = r.number(sd, "z_min", path, "m", required=False, default=-np.inf)
         zmax = r.number(sd, "z_max", path, "m", required=False, default=np.inf)
         h = r.speed_table(sd, "h_W_m2K", path, "W/m2/K", required=False)
+        if h is not None and h.max > MAX_FILM_W_M2K:
+            r.add(f"{path}.h_W_m2K", f"{h.max:g} W/m2/K is not a film coefficient "
+                  f"({PLAUSIBLE_FILM})", f"give h_W_m2K <= {MAX_FILM_W_M2K:g}")
         tref = r.string(sd, "T_ref", path, required=h is not None, choices=T_REFS)
         if sname is not None and any(s.name == sname for s in surfaces):
             r.add(f"{path}.name", f"surface '{sname}' is defined twice", "give each its own name")
-        elif sname is not None and all(x in part_names for x in pl) and pl:
+        elif sname is not None and all(x in part_names for x in pl) and pl \
+                and len(r.problems) == n0:
             surfaces.append(Surface(sname, tuple(pl), side, zmin, zmax, h, tref))
+        elif sname is not None:
+            r.broken["surface"].add(sname)
     return surfaces
 
 
@@ -680,6 +832,7 @@ def _read_heat_source(r: _Reader, hd: dict, path: str, parts: list[Part],
                       surfaces: list[Surface], earlier: list[HeatSource]) -> HeatSource | None:
     part_names = {p.name for p in parts}
     surface_names = {s.name for s in surfaces}
+    r.keys(hd, KNOWN_FIELDS["heat_sources"], path)
     hname = r.string(hd, "name", path)
     pw = r.power(hd, path)
     pn, sn, surf = hd.get("part"), hd.get("section"), hd.get("surface")
@@ -688,7 +841,7 @@ def _read_heat_source(r: _Reader, hd: dict, path: str, parts: list[Part],
               "give exactly one of part = \"...\" or surface = \"...\"")
         return None
     if pn is not None and pn not in part_names:
-        r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+        r.unknown("part", str(pn), f"{path}.part", f"use one of: {sorted(part_names)}")
         return None
     if sn is not None and not any(s.name == sn for s in
                                   next(p for p in parts if p.name == pn).sections):
@@ -696,8 +849,8 @@ def _read_heat_source(r: _Reader, hd: dict, path: str, parts: list[Part],
               f"name one of its sections '{sn}' or drop the section field")
         return None
     if surf is not None and surf not in surface_names:
-        r.add(f"{path}.surface", f"unknown surface '{surf}'",
-              f"define it under [[surfaces]] (known: {sorted(surface_names)})")
+        r.unknown("surface", str(surf), f"{path}.surface",
+                  f"define it under [[surfaces]] (known: {sorted(surface_names)})")
         return None
     if hname is not None and any(h.name == hname for h in earlier):
         r.add(f"{path}.name", f"heat source '{hname}' is defined twice",
@@ -731,6 +884,7 @@ def _read_sensors(r: _Reader, data: dict[str, Any],
 
 
 def _read_sensor(r: _Reader, sd: dict, path: str) -> Sensor | None:
+    r.keys(sd, KNOWN_FIELDS["sensors"], path)
     sname = r.string(sd, "name", path)
     kind = r.string(sd, "kind", path, required=False, default="temperature",
                     choices=("temperature", "axial_displacement"))
@@ -747,12 +901,14 @@ def _read_sensor(r: _Reader, sd: dict, path: str) -> Sensor | None:
 
 def _read_sensor_array(r: _Reader, ad: dict, path: str, parts: list[Part]) -> SensorArray | None:
     part_names = {p.name for p in parts}
+    r.keys(ad, KNOWN_FIELDS["sensor_arrays"], path)
     aname = r.string(ad, "name", path)
     pn = r.string(ad, "part", path)
     cnt = ad.get("count", 11)
     rad = ad.get("radius", "mid")
-    if not isinstance(cnt, int) or isinstance(cnt, bool) or cnt < 2:
-        r.add(f"{path}.count", f"must be an integer >= 2, not {cnt!r}", "write count = 11")
+    if not isinstance(cnt, int) or isinstance(cnt, bool) or not 2 <= cnt <= 1000:
+        r.add(f"{path}.count", f"must be an integer from 2 to 1000, not {_show(cnt)}",
+              "write count = 11")
         return None
     if not (rad in ("mid", "inner", "outer") or (isinstance(rad, int | float)
                                                   and not isinstance(rad, bool))):
@@ -760,7 +916,10 @@ def _read_sensor_array(r: _Reader, ad: dict, path: str, parts: list[Part]) -> Se
               "\"outer\" or a radius in m")
         return None
     if pn is not None and pn not in part_names:
-        r.add(f"{path}.part", f"unknown part '{pn}'", f"use one of: {sorted(part_names)}")
+        r.unknown("part", pn, f"{path}.part", f"use one of: {sorted(part_names)}")
+        return None
+    if isinstance(rad, int | float) and _finite(rad) is None:
+        r.add(f"{path}.radius", f"{_show(rad)} is not a radius", "write a finite radius in m")
         return None
     if aname is not None and pn is not None:
         return SensorArray(aname, pn, cnt, rad)
@@ -782,6 +941,30 @@ def array_sensors(arr: SensorArray, part: Part) -> list[Sensor]:
         out.append(Sensor(f"{arr.name}_{i:02d}", "temperature", float(z), float(rad),
                           array=arr.name))
     return out
+
+
+def _check_size(r: _Reader, parts: list[Part], h0_m: float) -> None:
+    """A spec in millimetres, and a mesh too fine to build, before any work is done."""
+    secs = [s for p in parts for s in p.sections]
+    size = max(max(abs(s.z_start), abs(s.z_end), *s.r_outer) for s in secs)
+    if size > MAX_SIZE_M:
+        unit = "millimetres" if size < MAX_SIZE_M * 1000 else "no plausible unit"
+        r.add("parts", f"the geometry reaches {size:g} m from the origin, more than a motor "
+              f"spindle's {MAX_SIZE_M:g} m: the dimensions look like {unit}",
+              "give every length in metres (z, r and mesh.h0_m: divide millimetres by 1000)")
+        return
+    if h0_m > size:
+        r.add("mesh.h0_m", f"{h0_m:g} m is larger than the whole spindle ({size:g} m)",
+              "give an element size of millimetres to centimetres (spl2782 uses 0.01 m)")
+        return
+    area = sum(0.5 * (s.z_end - s.z_start) * ((s.r_outer[0] - s.r_inner[0])
+                                              + (s.r_outer[1] - s.r_inner[1])) for s in secs)
+    n0 = (area / h0_m) / h0_m if area > 0 else 0.0  # h0_m >= 1e-300: no overflow to inf
+    if n0 > MAX_LEVEL0_ELEMENTS:
+        h_min = math.sqrt(area / MAX_LEVEL0_ELEMENTS)
+        r.add("mesh.h0_m", f"{h0_m:g} m meshes the {area * 1e4:.3g} cm2 section into about "
+              f"{n0:.3g} elements at level 0 (limit {MAX_LEVEL0_ELEMENTS:g}; each level "
+              "multiplies by 4)", f"give h0_m >= {h_min:.2g} m (spl2782 uses 0.01 m)")
 
 
 def _check_geometry(r: _Reader, parts: list[Part], links: list[Link],

@@ -13,3 +13,11 @@ ZERO_C_K = 273.15
 RPM_TO_RAD_S = 2.0 * math.pi / 60.0
 """Angular speed [rad/s] of one revolution per minute."""
 
+
+SPEED_MAX_RPM = 100_000.0
+"""The highest speed any input may give [rpm]: the fastest machine-tool motor spindles turn at
+60 000-80 000 rpm; above this a value is taken to be in other units or a typo."""
+
+CYCLE_MAX_S = 1000.0 * 3600.0
+"""The longest cycle or run any input may describe [s] (1000 h, six weeks: bench runs last
+hours to days); above this the time column is in other units or the file is corrupt."""

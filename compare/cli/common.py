@@ -8,6 +8,7 @@ helpers that need more import it when they run.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -18,6 +19,40 @@ if TYPE_CHECKING:
     from spindle.spec import Spec
 
 
+def number(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+           integer: bool = False, unit: str = "") -> Callable[[str], float]:
+    """An argparse ``type``: a finite number (an integer with ``integer``) within [lo, hi]
+    (``lo_open``: above lo); anything else is refused by argparse with exit status 2 and a
+    message naming the option, before any work is done."""
+    def parse(text: str) -> float:
+        try:
+            v = int(text) if integer else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"'{text}' is not {'an integer' if integer else 'a number'}") from None
+        if not math.isfinite(v):
+            raise argparse.ArgumentTypeError(f"'{text}' is not a finite number")
+        u = f" {unit}" if unit else ""
+        if lo is not None and (v <= lo if lo_open else v < lo):
+            raise argparse.ArgumentTypeError(f"{text}{u} is too small: give a value "
+                                             f"{'>' if lo_open else '>='} {lo:g}{u}")
+        if hi is not None and v > hi:
+            raise argparse.ArgumentTypeError(f"{text}{u} is too large: give a value <= {hi:g}{u}")
+        return v
+
+    parse.__name__ = "integer" if integer else "number"
+    return parse
+
+
+#: option types shared by the commands (limits: the reason in the help of each option)
+TIME_STEP_S = number(0.0, 86400.0, lo_open=True, unit="s")
+SPEED_RPM = number(0.0, 100_000.0, unit="rpm")  # spindle.units.SPEED_MAX_RPM
+MESH_LEVEL = number(0, 6, integer=True)  # level 6 of spl2782: 5.6 million elements
+POSITIVE = number(0.0, lo_open=True)
+WORKERS = number(1, 256, integer=True)
+NODE_COUNT = number(2, 1000, integer=True)
+
+
 def add_spec(parser: argparse.ArgumentParser) -> None:
     """The positional SPEC: a shipped spec name or a path to a .toml file."""
     parser.add_argument("spec", metavar="SPEC")
@@ -26,6 +61,15 @@ def add_spec(parser: argparse.ArgumentParser) -> None:
 def add_out(parser: argparse.ArgumentParser, default: str) -> None:
     """``--out``: the output folder, ``default`` as the help shows it (e.g. results/<spec>)."""
     parser.add_argument("--out", help=f"output folder (default {default})")
+
+
+def out_folder(out: str | None, default: str, inputs: list) -> Path:
+    """The output folder: ``out``, else ``default`` (a path under results/ in which ``{spec}``
+    and ``{run}`` were filled with :func:`spindle.outputs.safe_name`), checked before any work
+    (:func:`spindle.outputs.check_output_dir`)."""
+    from spindle.outputs import check_output_dir
+
+    return check_output_dir(Path(out) if out else Path(default), inputs)
 
 
 def add_no_pictures(parser: argparse.ArgumentParser, what: str = "PNGs") -> None:

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import TYPE_CHECKING
 
-from compare.cli.common import add_out, add_spec, load_case_input
+from compare.cli.common import MESH_LEVEL, add_out, add_spec, load_case_input, out_folder
 from spindle.units import ZERO_C_K
 
 if TYPE_CHECKING:
@@ -38,14 +37,14 @@ def _cmd_crosscheck(args: argparse.Namespace) -> int:
     """``spindle-verify crosscheck``: print the comparison table, write JSON and CSV."""
     # imported here so that building the parser stays fast (compare/cli/common.py)
     from compare.crosscheck import crosscheck
-    from spindle.outputs import output_dir
+    from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/crosscheck", [spec.path])
     inputs: list[str] = []
     case = (None if args.case is None
             else load_case_input(spec, args.case, spec.default_load_case(), inputs))
-    out = Path(args.out or f"results/{spec.name}/crosscheck")
     with output_dir(out, inputs=[spec.path, *inputs]) as tmp:
         result = crosscheck(spec, args.level, case,
                             keep_dir=(tmp / "ccx") if args.keep_deck else None)
@@ -65,7 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "calculix-ccx) on the same P2 mesh: sensor temperatures and axial growth "
                     "(P1, TCP) from both codes and their differences.")
     add_spec(cp)
-    cp.add_argument("--level", type=int, default=1, help="mesh level (default 1)")
+    cp.add_argument("--level", type=MESH_LEVEL, default=1, help="mesh level (default 1)")
     cp.add_argument("--case", metavar="CYCLE",
                     help="steady load case from a cycle's first step, e.g. 'nominal' (default: "
                          "the spec's operating point)")

@@ -5,14 +5,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from compare.cli.common import add_no_pictures, add_quiet
+from compare.cli.common import NODE_COUNT, add_no_pictures, add_quiet, number, out_folder
 from compare.cli.common import progress as _progress
 from spindle.errors import InputError
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
     from compare.fit.run import report_summary_text, run_fit, save_report
-    from spindle.outputs import output_dir
+    from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 
     if args.model == "fem" and args.lumped_only:
@@ -20,12 +20,13 @@ def _cmd_fit(args: argparse.Namespace) -> int:
                          "reference, --lumped-only switches the FEM off",
                          "drop one of the two options")
     spec = load_spec(args.spec)
+    default = f"results/{safe_name(spec.name)}/fit-{safe_name(Path(args.run).stem)}"
+    out = out_folder(args.out, default, [spec.path, args.run])
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
                   progress=_progress(args.quiet),
                   fem_level=None if args.lumped_only else args.fem_level, model=args.model,
                   base_extra=tuple(args.base_extra or ()))
-    out = Path(args.out or f"results/{spec.name}/fit-{Path(args.run).stem}")
     with output_dir(out, inputs=[spec.path, args.run]) as tmp:
         save_report(rep, tmp, pictures=not args.no_pictures)
     print(report_summary_text(rep))
@@ -40,15 +41,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     fp.add_argument("run", metavar="RUN.csv", help="bench export (format: docs/bench.md)")
     fp.add_argument("--spec", default="spl2782", help="the spindle (default spl2782)")
     fp.add_argument("--out", help="output folder (default results/<spec>/fit-<run>)")
-    fp.add_argument("--fit-fraction", type=float, default=0.6,
+    fp.add_argument("--fit-fraction", type=number(0.2, 0.9), default=0.6,
                     help="fraction of the run used for fitting; the rest validates (0.6)")
-    fp.add_argument("--alpha", type=float, default=0.01,
+    fp.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
                     help="level of the likelihood-ratio test for adding an effect (0.01)")
-    fp.add_argument("--min-gain", type=float, default=25.0,
+    fp.add_argument("--min-gain", type=number(0.0, 100.0), default=25.0,
                     help="an effect must remove at least this share [%%] of the validation "
                     "error above the floor (lumped-model error against the FEM and sensor "
                     "noise) (default 25)")
-    fp.add_argument("--fem-level", type=int, default=0,
+    fp.add_argument("--fem-level", type=number(0, 4, integer=True), default=0,
                     help="FEM reference level that anchors the model on the run's inputs "
                     "(default 0; docs/fit.md)")
     fp.add_argument("--lumped-only", action="store_true",
@@ -65,7 +66,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "approximately: heat_capacity (a factor on every heat capacity), "
                     "friction_exponent (bearing friction times (n / 3000 rpm)^e) (default: "
                     "neither; docs/fit.md)")
-    fp.add_argument("--nodes", type=int, default=11, help="lumped model nodes (default 11)")
+    fp.add_argument("--nodes", type=NODE_COUNT, default=11, help="lumped model nodes (default 11)")
     fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
     add_no_pictures(fp)
     add_quiet(fp)

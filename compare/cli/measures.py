@@ -4,9 +4,18 @@ measures, inverse problems, sweeps)."""
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from compare.cli.common import add_no_pictures, add_out, add_quiet, add_spec, load_case_input
+from compare.cli.common import (
+    MESH_LEVEL,
+    WORKERS,
+    add_no_pictures,
+    add_out,
+    add_quiet,
+    add_spec,
+    load_case_input,
+    number,
+    out_folder,
+)
 from spindle.errors import InputError
 
 
@@ -16,10 +25,11 @@ def _cmd_measures(args: argparse.Namespace) -> int:
     from compare.executor import stderr_progress
     from lumped.build import PRESETS
     from spindle.drive import load_case
-    from spindle.outputs import output_dir
+    from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}-measures", [spec.path])
     for n in args.lumped_nodes:
         if n not in PRESETS and not (n.isdigit() and int(n) >= 2):
             raise InputError("command line", "--nodes", f"'{n}' is not a lumped model",
@@ -45,7 +55,6 @@ def _cmd_measures(args: argparse.Namespace) -> int:
                        sweeps=not args.no_sweeps, points=args.points or 7,
                        scheduler=args.scheduler, workers=args.workers,
                        progress=stderr_progress(not args.quiet))
-    out = Path(args.out or f"results/{spec.name}-measures")
     with output_dir(out, inputs=inputs) as tmp:
         files = rep.save(tmp, pictures=not args.no_pictures)
     b = rep.baseline
@@ -91,17 +100,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     me.add_argument("--case", metavar="CYCLE",
                     help="steady load case from a cycle's first step (default: 'nominal' for a "
                          "spec with a power balance, else the spec's own inputs)")
-    me.add_argument("--level", type=int, default=1, help="FEM mesh level (default 1)")
+    me.add_argument("--level", type=MESH_LEVEL, default=1, help="FEM mesh level (default 1)")
     me.add_argument("--nodes", dest="lumped_nodes", nargs="+", default=["paper5", "paper11"],
                     metavar="N", help="lumped models for the indicators and the measures: "
                                       "integers >= 2 or paper5 / paper11 (default paper5 paper11)")
-    me.add_argument("--points", type=int,
+    me.add_argument("--points", type=number(2, 10000, integer=True),
                     help="points per sensitivity sweep (default: the file's, else 7)")
     me.add_argument("--no-sweeps", action="store_true", help="skip the Fig. 16 sweeps")
     me.add_argument("--scheduler", metavar="ADDRESS",
                     help="run the cases on a Dask cluster (tcp://host:8786, or 'local'); needs "
                          "pip install \"spindle-verify[dask]\" (default: a local process pool)")
-    me.add_argument("--workers", type=int,
+    me.add_argument("--workers", type=WORKERS,
                     help="processes (default min(2, CPUs)); 1 runs the cases serially")
     add_out(me, "results/<spec>-measures")
     add_no_pictures(me)

@@ -4,18 +4,18 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-from compare.cli.common import add_no_pictures, add_out, add_spec
+from compare.cli.common import MESH_LEVEL, add_no_pictures, add_out, add_spec, out_folder
 
 
 def _cmd_mesh(args: argparse.Namespace) -> int:
     from meshes import build_mesh
     from meshes.io import mesh_png, save_mesh_vtu
-    from spindle.outputs import output_dir
+    from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", [spec.path])
     rows = []
     print(f"{'level':>5} {'elements':>9} {'nodes':>8} {'dofs_P1':>8} {'dofs_P2':>8} {'h_max_mm':>9}")
     for level in range(args.level + 1):
@@ -24,7 +24,6 @@ def _cmd_mesh(args: argparse.Namespace) -> int:
         rows.append({**c2, "dofs_P1": c1["dofs_P1"], "h_max_m": sm.h_max_m})
         print(f"{level:5d} {c2['elements']:9d} {c2['nodes']:8d} {c1['dofs_P1']:8d} "
               f"{c2['dofs_P2']:8d} {sm.h_max_m * 1e3:9.3f}")
-    out = Path(args.out or f"results/{spec.name}/mesh")
     with output_dir(out, inputs=[spec.path]) as tmp:
         save_mesh_vtu(sm, tmp / f"mesh_level{args.level}.vtu")
         (tmp / "mesh.json").write_text(json.dumps(
@@ -41,7 +40,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the command's sub-parser."""
     mp = subparsers.add_parser("mesh", help="mesh a spec at refinement levels 0..N; VTU and PNG")
     add_spec(mp)
-    mp.add_argument("--level", type=int, default=2, help="finest level (default 2)")
+    mp.add_argument("--level", type=MESH_LEVEL, default=2, help="finest level (default 2)")
     add_out(mp, "results/<spec>/mesh")
     add_no_pictures(mp, "PNG")
     mp.set_defaults(func=_cmd_mesh)

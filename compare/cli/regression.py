@@ -7,7 +7,7 @@ import argparse
 import json
 from pathlib import Path
 
-from compare.cli.common import add_quiet, add_spec
+from compare.cli.common import MESH_LEVEL, NODE_COUNT, POSITIVE, TIME_STEP_S, add_quiet, add_spec
 from compare.cli.common import progress as _progress
 from spindle.errors import InputError
 
@@ -56,15 +56,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "tolerances) as JSON for regression checks")
     add_spec(bp)
     bp.add_argument("--out", required=True, help="the JSON file to write")
-    bp.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2],
+    bp.add_argument("--levels", type=MESH_LEVEL, nargs="+", default=[0, 1, 2],
                     help="FEM levels, three or more (default 0 1 2)")
-    bp.add_argument("--nodes", type=int, nargs="+", default=[5, 11],
+    bp.add_argument("--nodes", type=NODE_COUNT, nargs="+", default=[5, 11],
                     help="lumped node counts (default 5 11)")
-    bp.add_argument("--dt", type=float, default=300.0, help="transient time step [s] (300)")
+    bp.add_argument("--dt", type=TIME_STEP_S, default=300.0, help="transient time step [s] (300)")
     bp.add_argument("--steady-only", action="store_true", help="skip the transient figures")
-    bp.add_argument("--tol-temp", type=float, default=0.01,
+    bp.add_argument("--tol-temp", type=POSITIVE, default=0.01,
                     help="how far a temperature may move [K] (default 0.01)")
-    bp.add_argument("--tol-growth", type=float, default=0.01,
+    bp.add_argument("--tol-growth", type=POSITIVE, default=0.01,
                     help="how far a growth may move [um] (default 0.01)")
     add_quiet(bp)
     bp.set_defaults(func=_cmd_baseline)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
+from compare.cli.common import MESH_LEVEL, NODE_COUNT, POSITIVE, TIME_STEP_S, number, out_folder
 from compare.verify.accuracy import (
     NODES,
     TOL_GROWTH_UM,
@@ -21,10 +21,11 @@ from spindle.errors import InputError
 def run(args: argparse.Namespace) -> int:
     """``spindle-verify sensors``: the node count, and with ``--rank K`` the sensor ranking.
     Returns the exit status (0; bad input raises :class:`spindle.errors.InputError`)."""
-    from spindle.outputs import output_dir
+    from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", [spec.path])
     quiet = args.quiet
 
     def say(msg: str) -> None:
@@ -44,7 +45,6 @@ def run(args: argparse.Namespace) -> int:
             f"(dt {args.rank_dt:g} s)")
         ranking = rank_sensors(spec, rank_case, args.rank, args.candidates, None, args.method,
                                args.rank_level, args.rank_dt, args.tol_temp, args.tol_growth)
-    out = Path(args.out or f"results/{spec.name}/sensors")
     with output_dir(out, inputs=[spec.path]) as tmp:
         files = choice.save(tmp, pictures=not args.no_pictures)
         if ranking is not None:
@@ -72,22 +72,22 @@ def register(subparsers) -> argparse.ArgumentParser:
         "sensors", help="the lumped node count that meets the tolerances on every case, and "
                         "a ranking of sensor positions that reconstruct shaft temperature and P1")
     p.add_argument("spec", metavar="SPEC")
-    p.add_argument("--tol-temp", type=float, default=TOL_TEMP_K,
+    p.add_argument("--tol-temp", type=POSITIVE, default=TOL_TEMP_K,
                    help=f"tolerance on the worst sensor temperature error [K] (default "
                         f"{TOL_TEMP_K:g})")
-    p.add_argument("--tol-growth", type=float, default=TOL_GROWTH_UM,
+    p.add_argument("--tol-growth", type=POSITIVE, default=TOL_GROWTH_UM,
                    help=f"tolerance on the P1 error [um] (default {TOL_GROWTH_UM:g})")
-    p.add_argument("--nodes", type=int, nargs="+", default=list(NODES),
+    p.add_argument("--nodes", type=NODE_COUNT, nargs="+", default=list(NODES),
                    help="lumped node counts (default " + " ".join(map(str, NODES)) + ")")
     p.add_argument("--cases", nargs="+", metavar="CYCLE",
                    help="shipped cycle names or cycle files; a steady cycle (nominal) is a "
                         "steady state, the others transients (default: the study's two cases, "
                         "e.g. nominal and spl-16h)")
-    p.add_argument("--level", type=int, default=2,
+    p.add_argument("--level", type=MESH_LEVEL, default=2,
                    help="FEM level of the reference for the node count (default 2)")
-    p.add_argument("--dt", type=float, default=60.0,
+    p.add_argument("--dt", type=TIME_STEP_S, default=60.0,
                    help="time step of the transient cases [s] (default 60)")
-    p.add_argument("--rank", type=int, metavar="K",
+    p.add_argument("--rank", type=number(1, 1000, integer=True), metavar="K",
                    help="also rank the first K sensor positions")
     p.add_argument("--method", choices=METHODS, default="greedy",
                    help="ranking: greedy forward selection (default) or pivoted QR")
@@ -96,9 +96,9 @@ def register(subparsers) -> argparse.ArgumentParser:
                         "sensor of the spec)")
     p.add_argument("--rank-case", metavar="CYCLE",
                    help="ranking: transient cycle (default: the study's transient case)")
-    p.add_argument("--rank-level", type=int, default=1,
+    p.add_argument("--rank-level", type=MESH_LEVEL, default=1,
                    help="ranking: FEM level (default 1)")
-    p.add_argument("--rank-dt", type=float, default=300.0,
+    p.add_argument("--rank-dt", type=TIME_STEP_S, default=300.0,
                    help="ranking: time step [s] (default 300)")
     p.add_argument("--out", help="output folder (default results/<spec>/sensors)")
     p.add_argument("--no-pictures", action="store_true", help="skip the PNGs")

@@ -7,7 +7,20 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from compare.cli.common import add_no_pictures, add_out, add_quiet, add_spec, load_case_input
+from compare.cli.common import (
+    MESH_LEVEL,
+    POSITIVE,
+    SPEED_RPM,
+    TIME_STEP_S,
+    add_no_pictures,
+    add_out,
+    add_quiet,
+    add_spec,
+    load_case_input,
+    number,
+    out_folder,
+)
+from spindle.errors import InputError
 from spindle.units import ZERO_C_K
 
 
@@ -23,10 +36,15 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     from compare.progress import Progress
     from reference import ReferenceModel
     from spindle.loads import TimeSeries
-    from spindle.outputs import output_dir
+    from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 
+    if args.case and args.cycle:
+        raise InputError("command line", "--case", "--case (a steady load point) and --cycle (a "
+                         "transient) exclude each other", "give one of them")
     spec = load_spec(args.spec)
+    inputs = [spec.path, *(x for x in (args.case, args.cycle) if x and Path(x).is_file())]
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}", inputs)
     t0 = time.perf_counter()
     if args.model == "lumped":
         from lumped import build
@@ -62,7 +80,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     else:
         result = ref.steady(case)
     t_solve = time.perf_counter() - t0 - t_asm
-    out = Path(args.out or f"results/{spec.name}")
+    result.check_plausible(spec.path)
     with output_dir(out, inputs=inputs) as tmp:
         files = result.save(tmp, pictures=not args.no_pictures)
     print(f"{header}; {'build' if args.model == 'lumped' else 'assembly'} {t_asm:.2f} s, "
@@ -107,7 +125,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     so.add_argument("--nodes", default="11",
                     help="lumped model: masses along shaft and housing, an integer >= 2 or "
                          "paper5 / paper11 (default 11)")
-    so.add_argument("--level", type=int, default=2, help="mesh level (default 2)")
+    so.add_argument("--level", type=MESH_LEVEL, default=2, help="mesh level (default 2)")
     so.add_argument("--order", type=int, choices=(1, 2), default=2,
                     help="element order (default 2)")
     mode = so.add_mutually_exclusive_group()
@@ -119,11 +137,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     so.add_argument("--case", metavar="CYCLE",
                     help="steady load case from a cycle's first step, e.g. 'nominal' "
                          "(38 kW / 4300 rpm); heat sources from the power balance")
-    so.add_argument("--speed", type=float, help="spindle speed for a steady solve [rpm]")
-    so.add_argument("--dt", type=float, default=60.0, help="time step [s] (default 60)")
-    so.add_argument("--theta", type=float, default=1.0,
+    so.add_argument("--speed", type=SPEED_RPM, help="spindle speed for a steady solve [rpm]")
+    so.add_argument("--dt", type=TIME_STEP_S, default=60.0, help="time step [s] (default 60)")
+    so.add_argument("--theta", type=number(0.5, 1.0), default=1.0,
                     help="1 = backward Euler (default), 0.5 = Crank-Nicolson")
-    so.add_argument("--save-every", type=float, default=1800.0,
+    so.add_argument("--save-every", type=POSITIVE, default=1800.0,
                     help="keep a field for ParaView every this many seconds (default 1800)")
     so.add_argument("--centrifugal", action="store_true",
                     help="add the centrifugal load of the rotating parts (off by default)")

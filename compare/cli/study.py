@@ -3,9 +3,19 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from compare.cli.common import add_no_pictures, add_out, add_quiet, add_spec
+from compare.cli.common import (
+    MESH_LEVEL,
+    NODE_COUNT,
+    POSITIVE,
+    TIME_STEP_S,
+    WORKERS,
+    add_no_pictures,
+    add_out,
+    add_quiet,
+    add_spec,
+    out_folder,
+)
 from compare.cli.common import progress as _progress
 from spindle.errors import InputError
 
@@ -13,10 +23,11 @@ from spindle.errors import InputError
 def _cmd_study(args: argparse.Namespace) -> int:
     from compare.verify.accuracy import worst_temperature_K
     from compare.verify.study import run_study
-    from spindle.outputs import output_dir
+    from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/study", [spec.path])
     if args.workers < 1:
         raise InputError("command line", "--workers", f"{args.workers} is below 1",
                          "give --workers 1 (serial) or more")
@@ -25,7 +36,6 @@ def _cmd_study(args: argparse.Namespace) -> int:
     result = run_study(spec, levels, nodes, transient=not args.steady_only, dt_s=args.dt,
                        threshold=args.threshold / 100.0, progress=say, workers=args.workers,
                        scheduler=args.scheduler)
-    out = Path(args.out or f"results/{spec.name}/study")
     with output_dir(out, inputs=[spec.path]) as tmp:
         result.save(tmp, pictures=not args.no_pictures)
     conv = result.convergence
@@ -68,20 +78,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     st = subparsers.add_parser("study", help="verification study: FEM grid convergence (GCI), accuracy "
                         "of eq. 14, the lumped models and the FEM levels, HTML report")
     add_spec(st)
-    st.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3],
+    st.add_argument("--levels", type=MESH_LEVEL, nargs="+", default=[0, 1, 2, 3],
                     help="nested FEM levels, three or more (default 0 1 2 3)")
-    st.add_argument("--nodes", type=int, nargs="+", default=[2, 3, 5, 7, 11, 15, 21, 31, 41],
+    st.add_argument("--nodes", type=NODE_COUNT, nargs="+", default=[2, 3, 5, 7, 11, 15, 21, 31, 41],
                     help="lumped node counts (default 2 3 5 7 11 15 21 31 41)")
-    st.add_argument("--threshold", type=float, default=1.0,
+    st.add_argument("--threshold", type=POSITIVE, default=1.0,
                     help="GCI [%%] a level must meet for every quantity to be the ground truth "
                          "(default 1)")
-    st.add_argument("--dt", type=float, default=60.0, help="transient time step [s] (default 60)")
+    st.add_argument("--dt", type=TIME_STEP_S, default=60.0, help="transient time step [s] (default 60)")
     st.add_argument("--steady-only", action="store_true", help="skip the transient comparison")
     st.add_argument("--scheduler", metavar="ADDRESS",
                     help="run the independent runs on a Dask cluster (tcp://host:8786, or "
                          "'local' with --workers processes); needs "
                          "pip install \"spindle-verify[dask]\" (default: no cluster)")
-    st.add_argument("--workers", type=int, default=1,
+    st.add_argument("--workers", type=WORKERS, default=1,
                     help="processes for the independent runs (the lumped models, the FEM "
                          "transients): 1 runs them serially in this process, so the runtimes "
                          "in the tables are not disturbed by other runs (default 1); 2 runs "

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from compare.cli.common import MESH_LEVEL, number
 from spindle.errors import InputError
 
 
@@ -37,8 +38,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="cycle: a shipped name or cycle file, or random / random-loaded (non-"
                          "monotonic steps up to 6000 rpm drawn from the seed) (default spl-16h)")
     sy.add_argument("--effect", default="clean", help="effect to inject (default clean)")
-    sy.add_argument("--seed", type=int, default=0)
-    sy.add_argument("--level", type=int, default=1, help="FEM level (default 1)")
+    sy.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0)
+    sy.add_argument("--level", type=MESH_LEVEL, default=1, help="FEM level (default 1)")
     sy.add_argument("--mismatch", action="store_true",
                     help="make the data with a spindle that differs from the spec (films, "
                          "contacts, axial length, friction, loss split, FEM level; drawn from "
