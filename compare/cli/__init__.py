@@ -78,7 +78,10 @@ def _terminate(signum: int, frame: object) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # argparse refused an option (exit 2, message printed) or --help
+        return int(exc.code or 0)
     import signal
     import threading
 
