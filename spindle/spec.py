@@ -383,10 +383,9 @@ class _Reader:
 
     def radius(self, data: dict, key: str, path: str) -> tuple[float, float] | None:
         v = data.get(key)
-        if isinstance(v, list) and len(v) == 2 and None not in (_finite(v[0]), _finite(v[1])):
-            pair = (_finite(v[0]), _finite(v[1]))
-        elif _finite(v) is not None:
-            pair = (_finite(v), _finite(v))
+        ends = [_finite(x) for x in v] if isinstance(v, list) and len(v) == 2 else [_finite(v)] * 2
+        if None not in ends:
+            pair = (ends[0], ends[1])
         elif v is None:
             self.add(f"{path}.{key}", "required field is missing",
                      f"add {key} = <radius in m> (or [start, end] for a cone)")

@@ -64,9 +64,9 @@ def add_out(parser: argparse.ArgumentParser, default: str) -> None:
 
 
 def out_folder(out: str | None, default: str, inputs: list) -> Path:
-    """The output folder: ``out``, else ``default`` (a path under results/ in which ``{spec}``
-    and ``{run}`` were filled with :func:`spindle.outputs.safe_name`), checked before any work
-    (:func:`spindle.outputs.check_output_dir`)."""
+    """The output folder: ``out``, else ``default`` (a path under results/ whose spec and run
+    names the caller made safe with :func:`spindle.outputs.safe_name`), checked before any
+    work (:func:`spindle.outputs.check_output_dir`)."""
     from spindle.outputs import check_output_dir
 
     return check_output_dir(Path(out) if out else Path(default), inputs)

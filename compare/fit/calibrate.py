@@ -230,16 +230,15 @@ class Calibrator:
                 out.append((v - _to_z(p, centre)) / sd)
         return np.asarray(out)
 
-    def set_event_prior(self, name: str, value: float, ci95: Sequence[float]) -> None:
+    def set_event_prior(self, name: str, value: float, ci95: Sequence[float]) -> float:
         """A prior on effect parameter ``name`` from an event test: centred on ``value``
         (clipped into the bounds), with the sd of its 95 % interval ``ci95`` on the fitted
-        scale."""
+        scale. Returns the centre (a start for the fit)."""
         p = next(q for e in EFFECTS.values() for q in e.params if q.name == name)
-        lo, hi = (min(max(v, p.lo), p.hi) for v in ci95)
-        centre = min(max(value, p.lo), p.hi)
-        sd = (_to_z(p, hi) - _to_z(p, lo)) / 3.92 if not p.log else \
-            (_to_z(p, max(hi, 1e-12)) - _to_z(p, max(lo, 1e-12))) / 3.92
-        self.event_prior[name] = (centre, max(sd, 1e-3))
+        floor = 1e-12 if p.log else -math.inf  # the log scale needs v > 0
+        lo, hi, centre = (min(max(v, p.lo, floor), p.hi) for v in (*ci95, value))
+        self.event_prior[name] = (centre, max((_to_z(p, hi) - _to_z(p, lo)) / 3.92, 1e-3))
+        return centre
 
     def residuals(self, out: dict[str, np.ndarray], window: str) -> dict[str, np.ndarray]:
         res = {}
@@ -446,9 +445,7 @@ def _accept_events(cal: Calibrator, current: Fit, events: Mapping[str, EventTest
         par = test.parameter or {}
         start = dict(current.theta)
         if par:
-            cal.set_event_prior(par["name"], par["value"], par["ci95"])
-            p = next(q for q in EFFECTS[name].params if q.name == par["name"])
-            start[p.name] = min(max(par["value"], p.lo), p.hi)
+            start[par["name"]] = cal.set_event_prior(par["name"], par["value"], par["ci95"])
         v0 = current.validation_score()
         full = cal.fit(current.effects + (name,), start=start,
                        lag_channel=channel or current.lag_channel)
