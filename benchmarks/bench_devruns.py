@@ -33,6 +33,8 @@ class DevRun:
     spec: str
     truth: str | None
     base_extra: tuple[str, ...] = ()
+    blocks: int = 1
+    cv_blocks: int = 5
 
     @property
     def label(self) -> str:
@@ -45,7 +47,8 @@ def fit_one(case: DevRun) -> dict:
     from spindle.spec import load_spec
 
     t = time.perf_counter()
-    rep = run_fit(case.path, load_spec(case.spec), base_extra=case.base_extra)
+    rep = run_fit(case.path, load_spec(case.spec), base_extra=case.base_extra,
+                  blocks=case.blocks, cv_blocks=case.cv_blocks)
     doc = rep.to_dict()
     named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
                           and e["parameters"].get("channel") else "") for e in doc["effects"]]
@@ -57,6 +60,8 @@ def fit_one(case: DevRun) -> dict:
     return {"run": case.label, "truth": case.truth, "named": named,
             "unexplained": unexplained, "right": right,
             "validation_rmse": {c: v["rmse"] for c, v in val.items()},
+            "cross_validated_rmse": {c: v["rmse"] for c, v in (
+                doc["cross_validation"].get("final", {}).get("pooled", {}).items())},
             "within_tolerance": {c: v["rmse"] <= (1.5 if c == "P1" else 1.0)
                                  for c, v in val.items()},
             "implausible": {k: round(v, 2) for k, v in (doc.get("parameters_prior_z") or {})
@@ -76,6 +81,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--workers", type=int, default=2, help="parallel fits (default 2)")
     ap.add_argument("--base-extra", nargs="+", default=[], metavar="PARAM",
                     help="as fit --base-extra (heat_capacity, friction_exponent)")
+    ap.add_argument("--blocks", type=int, default=1, help="as fit --blocks (default 1)")
+    ap.add_argument("--cv-blocks", type=int, default=5, help="as fit --cv-blocks (default 5)")
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
 
@@ -83,13 +90,13 @@ def main(argv: list[str] | None = None) -> None:
 
     truth = json.loads((args.runs / "truth.json").read_text(encoding="utf-8"))
     labels = args.only or sorted(truth)
-    cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"], tuple(args.base_extra))
-             for k in labels]
+    cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"], tuple(args.base_extra),
+                    args.blocks, args.cv_blocks) for k in labels]
     t = time.perf_counter()
     outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
     rows = []
     print(f"{'run':8} {'truth':24} {'named':30} ok  validation RMS after (T1 T2 Tst K, P1 µm)"
-          "   s")
+          "   s  cross-validated RMS after")
     for o in outcomes:
         if o.error:
             print(f"{o.label:8} failed: {o.error}")
@@ -100,7 +107,10 @@ def main(argv: list[str] | None = None) -> None:
         named = ", ".join(r["named"]) or ("unexplained" if r["unexplained"] else "nothing")
         print(f"{r['run']:8} {str(r['truth']):24} {named:30} {'yes' if r['right'] else 'NO ':3} "
               + " ".join(f"{v.get(c, float('nan')):5.2f}" for c in ("T1", "T2", "T_stator", "P1"))
-              + f" {r['seconds']:5.0f}" + (f"  implausible {r['implausible']}"
+              + f" {r['seconds']:5.0f}  "
+              + " ".join(f"{r['cross_validated_rmse'].get(c, float('nan')):5.2f}"
+                         for c in ("T1", "T2", "T_stator", "P1"))
+              + (f"  implausible {r['implausible']}"
                                             if r["implausible"] else ""))
     n_right = sum(r["right"] for r in rows)
     print(f"right verdicts: {n_right} of {len(cases)}; wall time {time.perf_counter() - t:.0f} s "

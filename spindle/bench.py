@@ -37,7 +37,7 @@ from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
 from spindle.power import power_balance
 from spindle.spec import Spec
-from spindle.units import CYCLE_MAX_S, SPEED_MAX_RPM, ZERO_C_K
+from spindle.units import CYCLE_MAX_S, POWER_MAX_KW, SPEED_MAX_RPM, TORQUE_MAX_NM, ZERO_C_K
 
 # a bench export may hold long cells in columns the tool does not read (notes, JSON): the
 # csv module's default 128 kB field limit would refuse valid files
@@ -65,7 +65,7 @@ TEMPERATURE_COLUMNS: tuple[str, ...] = ("T_env_C", "T_coolant_C", "T1_C", "T2_C"
 T_MIN_C = -60.0
 T_KELVIN_MEDIAN_C = 150.0
 T_KELVIN_MAX_C = 250.0
-POWER_LIMIT_KW = 1000.0
+POWER_LIMIT_KW = POWER_MAX_KW
 #: What a fit needs: rows with at least one measured channel, and their time span [s].
 MIN_ROWS = 50
 MIN_SPAN_S = 1800.0
@@ -550,7 +550,7 @@ def _is_number(s: str) -> bool:
 
 def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error: _ErrorFor) -> None:
     """Temperatures in °C (not kelvin, >= -60 °C), speed 0..100 000 rpm, power within
-    ±1000 kW; the first offending line is named."""
+    ±1000 kW, load torque within ±10 000 N m; the first offending line is named."""
 
     def first(mask: np.ndarray) -> int:
         return int(line_no[np.flatnonzero(mask)[0]])
@@ -582,6 +582,13 @@ def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error:
         raise error(f"power_kW (line {first(big)})", f"{p[big][0]:g} kW is outside "
                     f"±{POWER_LIMIT_KW:g} kW", "export the electrical power in kW (a value in W is "
                     "1000 times too large)")
+    m = columns.get("load_torque_Nm")
+    if m is not None:
+        big = np.abs(np.nan_to_num(m)) > TORQUE_MAX_NM
+        if big.any():
+            raise error(f"load_torque_Nm (line {first(big)})", f"{m[big][0]:g} N m is beyond "
+                        f"±{TORQUE_MAX_NM:g} N m, more than any motor spindle delivers",
+                        "export the process load torque in N m")
 
 
 # ============================================================================ spec

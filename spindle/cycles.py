@@ -40,7 +40,14 @@ if TYPE_CHECKING:  # only for the annotation: spec.py is not imported at run tim
     from spindle.spec import Spec
 
 #: 0 degC in K.
-from spindle.units import CYCLE_MAX_S, SPEED_MAX_RPM, ZERO_C_K
+from spindle.units import (
+    CYCLE_MAX_S,
+    MAX_SERIES_POINTS,
+    POWER_MAX_KW,
+    SPEED_MAX_RPM,
+    TORQUE_MAX_NM,
+    ZERO_C_K,
+)
 
 #: Temperatures accepted in cycle files [degC] (as spindle.loads.read_cycle_csv).
 T_MIN_C, T_MAX_C = -60.0, 200.0
@@ -192,6 +199,14 @@ def _check_number(param: str, value: float, lo: float | None = None, hi: float |
     return v
 
 
+def _check_points(param: str, points: float, smallest: float) -> None:
+    """A generated series of ``points`` samples is refused beyond MAX_SERIES_POINTS, naming
+    ``param`` and its ``smallest`` allowed value [s]."""
+    if points > MAX_SERIES_POINTS:
+        raise ParameterError(param, f"gives {points:.3g} samples, more than "
+                             f"{MAX_SERIES_POINTS:.0e}", f"give {param} >= {smallest:.3g} s")
+
+
 def _check_temperature(param: str, value: float) -> float:
     v = _check_number(param, value)
     if not T_MIN_C <= v <= T_MAX_C:
@@ -227,6 +242,7 @@ def drifting_ambient(duration_s: float, *, T_start_C: float = 19.5, T_peak_C: fl
     Te = Tp if T_end_C is None else _check_temperature("T_end_C", T_end_C)
     tp = _check_number("t_peak_h", t_peak_h, lo=0.0, strict_lo=True, unit="h") * 3600.0
     dt = _check_number("sample_s", sample_s, lo=0.0, strict_lo=True, unit="s")
+    _check_points("sample_s", D / dt, D / MAX_SERIES_POINTS)
     t = np.unique(np.concatenate([np.arange(0.0, D, dt), [min(tp, D), D]]))
     rise = T0 + (Tp - T0) * _half_cosine(t / tp)
     if tp < D:
@@ -259,6 +275,7 @@ def chiller_cycling(duration_s: float, *, setpoint_C: float = 20.0, band_K: floa
     Ts = _check_temperature("setpoint_C", setpoint_C)
     b = _check_number("band_K", band_K, lo=0.0, unit="K")
     P = _check_number("period_s", period_s, lo=0.0, strict_lo=True, unit="s")
+    _check_points("period_s", 2.0 * D / P, 2.0 * D / MAX_SERIES_POINTS)
     r = float(rise_fraction)
     if not (math.isfinite(r) and 0.0 < r < 1.0):
         raise ParameterError("rise_fraction", f"must be strictly between 0 and 1, not {r:g}",
@@ -592,15 +609,32 @@ def _meta_temperature(f: _File, meta: dict[str, tuple[str, int]], key: str,
 # --------------------------------------------------------------------------- shipped cycles
 
 
+#: the shortest step of a cycle [s]: shorter ones are a unit mistake (and vanish in the sum of
+#: the durations: a 1e-320 s step after an hour does not advance the time)
+STEP_MIN_S = 1e-3
+
+
 def check_cycle_limits(cycle: Cycle, file: str) -> Cycle:
     """``cycle`` if its speeds and duration are those of a spindle's test cycle
     (``spindle.units.SPEED_MAX_RPM``, ``CYCLE_MAX_S``); otherwise an InputError naming the
     step: the work of simulating it would be absurd, and so would the result."""
     for k, s in enumerate(cycle.steps):
+        if s.duration_s < STEP_MIN_S:
+            raise InputError(file, f"steps[{k}].duration_s", f"{s.duration_s:g} s is shorter "
+                             f"than {STEP_MIN_S:g} s", "give step durations in seconds "
+                             "(duration_s) or hours (duration_h)")
         if s.speed_rpm > SPEED_MAX_RPM:
             raise InputError(file, f"steps[{k}].speed_rpm", f"{s.speed_rpm:g} rpm is above "
                              f"{SPEED_MAX_RPM:g} rpm, faster than any motor spindle",
                              "give the speed in rpm (1/min)")
+        if abs(s.load_torque_Nm) > TORQUE_MAX_NM:
+            raise InputError(file, f"steps[{k}].load_torque_Nm", f"{s.load_torque_Nm:g} N m is "
+                             f"beyond ±{TORQUE_MAX_NM:g} N m, more than any motor spindle "
+                             "delivers", "give the process load torque in N m")
+        if s.power_kW is not None and abs(s.power_kW) > POWER_MAX_KW:
+            raise InputError(file, f"steps[{k}].power_kW", f"{s.power_kW:g} kW is beyond "
+                             f"±{POWER_MAX_KW:g} kW", "give the electrical power in kW (a value "
+                             "in W is 1000 times too large)")
     if cycle.duration_s > CYCLE_MAX_S:
         raise InputError(file, "duration_s", f"the steps last {cycle.duration_s / 3600:.4g} h, "
                          f"more than {CYCLE_MAX_S / 3600:g} h", "give step durations in seconds "

@@ -7,6 +7,7 @@ A steady solve evaluates them at one instant; a transient solve follows them.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -16,7 +17,7 @@ import numpy as np
 
 from spindle.commented_csv import CommentedCsv, split_commented_csv
 from spindle.errors import InputError
-from spindle.units import CYCLE_MAX_S, SPEED_MAX_RPM, ZERO_C_K
+from spindle.units import CYCLE_MAX_S, MAX_SERIES_POINTS, SPEED_MAX_RPM, ZERO_C_K
 
 Interpolation = Literal["linear", "previous"]
 
@@ -125,7 +126,17 @@ class LoadCase:
 
 def time_grid(case: LoadCase, dt_s: float) -> np.ndarray:
     """Output times of a transient run [s]: every dt_s, plus every sample time of the
-    inputs, so that steps land on the inputs' corners (both models use the same grid)."""
+    inputs, so that steps land on the inputs' corners (both models use the same grid). More
+    than MAX_SERIES_POINTS steps is refused (InputError naming --dt) before anything is
+    allocated."""
+    if not (math.isfinite(dt_s) and dt_s > 0):
+        raise InputError("command line", "--dt", f"{dt_s:g} s is not a positive time step",
+                         "give a time step > 0 s, e.g. 60")
+    steps = case.duration_s / dt_s + len(case.breakpoints())
+    if steps > MAX_SERIES_POINTS:
+        raise InputError("command line", "--dt", f"{dt_s:g} s over {case.duration_s / 3600:.4g} h "
+                         f"is {steps:.3g} time steps, more than {MAX_SERIES_POINTS:.0e}",
+                         f"give --dt >= {case.duration_s / MAX_SERIES_POINTS:.3g} s")
     grid = np.unique(np.concatenate([np.arange(0.0, case.duration_s, dt_s),
                                      case.breakpoints(), [case.duration_s]]))
     return grid[np.concatenate([[True], np.diff(grid) > 1e-9 * dt_s])]
@@ -191,6 +202,13 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
 
 def _check_cycle_header(name: str, header: list[str], source_names: list[str]) -> None:
     """time_s is required; every column is a known one or ``<source>_W``."""
+    for k, h in enumerate(header):
+        if not h.strip():
+            raise InputError(name, f"header (column {k + 1})", "has an empty column name",
+                             "name every column, and end the rows without a trailing comma")
+        if h in header[:k]:
+            raise InputError(name, f"header (column {k + 1})", f"'{h}' appears twice",
+                             "keep one column of each name")
     if "time_s" not in header:
         raise InputError(name, "time_s", "required column is missing",
                          "add a 'time_s' column with the time since the start [s]")

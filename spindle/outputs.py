@@ -46,9 +46,15 @@ def safe_name(name: str) -> str:
     return text[:100] or "unnamed"
 
 
+#: file in every output folder: it marks the folder as one spindle-verify wrote, so that a
+#: later run may replace it as a whole (a folder without it and not empty is refused)
+MARKER = ".spindle-verify"
+
+
 def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Path:
     """Refuse, before any work is done, an output folder that cannot be one: a file, an input,
-    a folder holding one of the inputs, or a place that cannot be created or written."""
+    a folder holding one of the inputs, a place that cannot be created or written, or a
+    folder with files that an earlier run did not write (no :data:`MARKER`)."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise InputError(str(path), "--out", "is a file, not a folder",
@@ -70,27 +76,46 @@ def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Pat
     if not os.access(base, os.W_OK | os.X_OK):
         raise InputError(str(path), "--out", f"cannot be written ({base} is not writable)",
                          "give a folder in a place you can write to")
+    if path.is_dir() and not (path / MARKER).exists() and any(path.iterdir()):
+        raise InputError(str(path), "--out", "holds files spindle-verify did not write (an "
+                         "output folder is replaced as a whole, and these would be lost)",
+                         "give a new or empty folder, or one an earlier spindle-verify run "
+                         "wrote")
+    if path.is_dir():
+        nested = next((q.parent for q in path.glob(f"*/**/{MARKER}")), None)
+        if nested is not None:
+            raise InputError(str(path), "--out", f"holds the output of another run "
+                             f"({nested.relative_to(path)}), which replacing it would delete",
+                             "give a folder of its own, e.g. a subfolder or a sibling")
     return path
 
 
 def _clean_leftovers(parent: Path, name: str) -> None:
     """Remove the temporary folders of earlier runs into ``name`` that were killed before they
-    could clean up (their process is gone)."""
-    for old in parent.glob(f".{name}.tmp-*"):
-        m = re.match(rf"\.{re.escape(name)}\.tmp-(\d+)-", old.name)
+    could clean up (their process is gone); an old output a killed run had moved aside but
+    not yet replaced is put back."""
+    for old in [*parent.glob(f".{name}.tmp-*"), *parent.glob(f".{name}.old-*")]:
+        m = re.match(rf"\.{re.escape(name)}\.(tmp|old)-(\d+)-", old.name)
         if not m or not old.is_dir():
             continue
         try:
-            os.kill(int(m.group(1)), 0)
+            os.kill(int(m.group(2)), 0)
         except ProcessLookupError:
-            shutil.rmtree(old, ignore_errors=True)
+            target = parent / name
+            if m.group(1) == "old" and not target.exists():
+                os.rename(old, target)
+            else:
+                shutil.rmtree(old, ignore_errors=True)
         except (PermissionError, OverflowError):
             pass
 
 
 @contextmanager
 def output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[Path]:
-    """Yield a temporary folder to write into; on success move its files into ``path``."""
+    """Yield a temporary folder to write into; on success it replaces ``path`` as a whole
+    (an earlier run's folder is moved aside, the new one renamed into place, the old one
+    removed), so the folder never mixes two runs' files and a failed run leaves the old one
+    as it was."""
     path = check_output_dir(path, inputs)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -101,19 +126,35 @@ def output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[
     tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.tmp-{os.getpid()}-", dir=path.parent))
     try:
         yield tmp
-        files = [f for f in tmp.rglob("*") if f.is_file()]
         protected = {Path(p).resolve() for p in inputs}
-        for f in files:
-            dest = (path / f.relative_to(tmp)).resolve()
-            if dest in protected:
-                raise InputError(str(dest), "--out", "an output would overwrite this input",
+        for f in tmp.rglob("*"):
+            if (path / f.relative_to(tmp)).resolve() in protected:
+                raise InputError(str(path / f.relative_to(tmp)), "--out",
+                                 "an output would overwrite this input",
                                  "choose another output folder")
-        for f in files:
-            dest = path / f.relative_to(tmp)
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(f, dest)
+        (tmp / MARKER).write_text("written by spindle-verify; the next run into this folder "
+                                  "replaces it as a whole\n", encoding="utf-8")
+        os.chmod(tmp, 0o777 & ~_UMASK)  # mkdtemp makes 0700; outputs are ordinary folders
+        _replace_folder(tmp, path)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _replace_folder(new: Path, path: Path) -> None:
+    """Rename ``new`` to ``path``; an existing ``path`` is first moved aside (restored if the
+    rename fails) and removed after."""
+    if not path.exists():
+        os.rename(new, path)
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{path.name}.old-{os.getpid()}-", dir=path.parent))
+    os.rmdir(old)
+    os.rename(path, old)
+    try:
+        os.rename(new, path)
+    except OSError:
+        os.rename(old, path)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
 
 
 def write_csv(path: Path, header: list[str], rows) -> None:

@@ -43,19 +43,26 @@ def test_no_priors_judges_the_channels_only():
 
 
 def test_extrapolation_warnings():
-    """A cycle that ramps up warns (its last steps are beyond the fit window); one that
-    visits the same levels before and after the split does not."""
+    """A cycle that ramps up warns when the validation window is its end (one split); one
+    that visits the same levels before and after does not; the blocked windows of a ramp
+    (compare.fit.calibrate.Measured, blocks=5) hold no speed beyond the fit window's."""
+    from compare.fit.calibrate import Measured
+
     grid = np.arange(0.0, 10 * 3600.0 + 1.0, 60.0)
     t = grid[:-1]
+    after_6h = grid <= 6 * 3600.0
     ramp = np.floor(t / 3600.0) * 600.0  # 0, 600, ..., 5400 rpm; 3600 starts at the split
-    w = extrapolation_warnings(grid, ramp, np.zeros_like(t), 6 * 3600.0)
+    w = extrapolation_warnings(grid, ramp, np.zeros_like(t), after_6h)
     assert any("speed 5400 rpm, above the fit window's 3600" in m for m in w)
     assert any("never occur in the fit window" in m for m in w)
     back_and_forth = np.where((t // 3600.0) % 2 == 0, 1500.0, 4500.0)
-    assert extrapolation_warnings(grid, back_and_forth, np.zeros_like(t), 6 * 3600.0) == []
+    assert extrapolation_warnings(grid, back_and_forth, np.zeros_like(t), after_6h) == []
     torque = np.where(t > 6 * 3600.0, 40.0, 10.0)
     assert any("load torque 40" in m for m in extrapolation_warnings(
-        grid, back_and_forth, torque, 6 * 3600.0))
+        grid, back_and_forth, torque, after_6h))
+    blocked = Measured(grid, {"T1": np.zeros_like(grid)}, 0.6, blocks=5).fit_points()
+    w = extrapolation_warnings(grid, ramp, np.zeros_like(t), blocked)
+    assert not any("above the fit window" in m for m in w)
 
 
 PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"

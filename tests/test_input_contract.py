@@ -34,6 +34,8 @@ def _mm(text: str) -> str:
 
 
 STEPS = "speed_rpm,duration_s,load_torque_Nm\n"
+CYCLE = (Path(__file__).resolve().parents[1] / "spindle" / "data" / "cycles"
+         / "spl-16h.toml").read_text(encoding="utf-8")
 # (case, files to write, command line, field the one message must name)
 CORPUS = [
     ("bearing conductance 1e300", {"s.toml": _sub(SPL, "G_W_K = 30.0", "G_W_K = 1e300")},
@@ -85,6 +87,22 @@ CORPUS = [
      ["solve", "spl2782", "--cycle", "c.csv"], "header (line 1)"),
     ("binary after the header", {"c.csv": STEPS.encode() + bytes(range(256)) * 4},
      ["solve", "spl2782", "--cycle", "c.csv"], "file"),
+    ("ambient drift sampled every microsecond",
+     {"c.toml": CYCLE.replace("sample_s = 900.0", "sample_s = 1e-6")},
+     ["solve", "spl2782", "--cycle", "c.toml"], "sample_s"),
+    ("chiller period of a microsecond",
+     {"c.toml": CYCLE.replace("period_s = 1200.0", "period_s = 1e-6")},
+     ["solve", "spl2782", "--cycle", "c.toml"], "period_s"),
+    ("load torque 1e308 N m", {"c.csv": STEPS + "1000,3600,1e308\n"},
+     ["solve", "spl2782", "--cycle", "c.csv"], "steps[0].load_torque_Nm"),
+    ("power in W, not kW", {"c.csv": "speed_rpm,duration_s,power_kW\n1000,3600,38000\n"},
+     ["solve", "spl2782", "--cycle", "c.csv"], "steps[0].power_kW"),
+    ("cycle column named twice", {"c.csv": "time_s,speed_rpm,speed_rpm\n0,0,0\n60,10,10\n"},
+     ["solve", "spl2782", "--cycle", "c.csv"], "header (column 3)"),
+    ("trailing comma in a time series", {"c.csv": "time_s,speed_rpm,\n0,0,\n60,10,\n"},
+     ["solve", "spl2782", "--cycle", "c.csv"], "header (column 3)"),
+    ("--dt of 0.1 ms over 16 h", {}, ["solve", "spl2782", "--cycle", "spl-16h", "--dt",
+                                     "1e-4"], "--dt"),
     ("--case with --cycle", {}, ["solve", "spl2782", "--case", "nominal", "--cycle",
                                  "spl-16h"], "--case"),
     ("--out is an input", {"s.toml": FIN}, ["solve", "s.toml", "--out", "s.toml"], "--out"),

@@ -9,6 +9,17 @@ from compare.cli.common import NODE_COUNT, add_no_pictures, add_quiet, number, o
 from compare.cli.common import progress as _progress
 from spindle.errors import InputError
 
+_CV_RANGE = number(0, 20, integer=True)
+
+
+def cv_blocks(text: str) -> int:
+    """``--cv-blocks``: 0 (none) or 2..20."""
+    value = _CV_RANGE(text)
+    if value == 1:
+        raise argparse.ArgumentTypeError("1 block leaves nothing to fit on: give 0 (none) or "
+                                         "2..20")
+    return value
+
 
 def _cmd_fit(args: argparse.Namespace) -> int:
     from compare.fit.run import report_summary_text, run_fit, save_report
@@ -26,7 +37,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
                   progress=_progress(args.quiet),
                   fem_level=None if args.lumped_only else args.fem_level, model=args.model,
-                  base_extra=tuple(args.base_extra or ()))
+                  base_extra=tuple(args.base_extra or ()), blocks=args.blocks,
+                  cv_blocks=args.cv_blocks)
     with output_dir(out, inputs=[spec.path, args.run]) as tmp:
         save_report(rep, tmp, pictures=not args.no_pictures)
     print(report_summary_text(rep))
@@ -43,6 +55,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     fp.add_argument("--out", help="output folder (default results/<spec>/fit-<run>)")
     fp.add_argument("--fit-fraction", type=number(0.2, 0.9), default=0.6,
                     help="fraction of the run used for fitting; the rest validates (0.6)")
+    fp.add_argument("--blocks", type=number(1, 20, integer=True), default=1,
+                    help="windows for selecting effects: cut the run into this many blocks, "
+                    "of which about 1 - fit-fraction, spread over the run, validate (default "
+                    "1: the fit window is the run's start; docs/fit.md says why)")
+    fp.add_argument("--cv-blocks", type=cv_blocks, default=5,
+                    help="blocked cross-validation of the base and the final model: each of "
+                    "this many blocks held out in turn, the model refitted without it and "
+                    "simulated over it (default 5; 0: none)")
     fp.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
                     help="level of the likelihood-ratio test for adding an effect (0.01)")
     fp.add_argument("--min-gain", type=number(0.0, 100.0), default=25.0,

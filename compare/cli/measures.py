@@ -29,7 +29,7 @@ def _cmd_measures(args: argparse.Namespace) -> int:
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}-measures", [spec.path])
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/measures", [spec.path])
     for n in args.lumped_nodes:
         if n not in PRESETS and not (n.isdigit() and int(n) >= 2):
             raise InputError("command line", "--nodes", f"'{n}' is not a lumped model",
@@ -112,7 +112,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          "pip install \"spindle-verify[dask]\" (default: a local process pool)")
     me.add_argument("--workers", type=WORKERS,
                     help="processes (default min(2, CPUs)); 1 runs the cases serially")
-    add_out(me, "results/<spec>-measures")
+    add_out(me, "results/<spec>/measures")
     add_no_pictures(me)
     add_quiet(me)
     me.set_defaults(func=_cmd_measures)

@@ -44,7 +44,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
                          "transient) exclude each other", "give one of them")
     spec = load_spec(args.spec)
     inputs = [spec.path, *(x for x in (args.case, args.cycle) if x and Path(x).is_file())]
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}", inputs)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/solve", inputs)
     t0 = time.perf_counter()
     if args.model == "lumped":
         from lumped import build
@@ -147,7 +147,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="add the centrifugal load of the rotating parts (off by default)")
     so.add_argument("--thermal-only", action="store_true",
                     help="skip the thermoelastic growth (P1, TCP)")
-    add_out(so, "results/<spec>")
+    add_out(so, "results/<spec>/solve")
     add_no_pictures(so)
     add_quiet(so)
     so.set_defaults(func=_cmd_solve)

@@ -91,14 +91,15 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
 
 
 def extrapolation_warnings(grid_s: np.ndarray, speed_rpm: np.ndarray,
-                           load_torque_Nm: np.ndarray, split_s: float,
+                           load_torque_Nm: np.ndarray, in_fit: np.ndarray,
                            rel: float = 0.05) -> list[str]:
-    """Operating points of the validation window (after ``split_s`` [s]) outside what the
+    """Operating points of the validation window (grid points where ``in_fit`` is False,
+    compare.fit.calibrate.Measured.fit_points) outside what the
     fit window saw: speeds [rpm] or load torques [N m] beyond the fit window's largest by more
     than ``rel``, or speed levels the fit window never held (none within ``rel``). Per
     interval arrays, ``grid_s`` its edges."""
-    t = np.asarray(grid_s)[:-1]
-    fit, val = t <= split_s, t > split_s
+    fit = np.asarray(in_fit, dtype=bool)[:len(grid_s) - 1]
+    val = ~fit
     out = []
     for name, x, unit in (("speed", np.asarray(speed_rpm), "rpm"),
                           ("load torque", np.asarray(load_torque_Nm), "N m")):

@@ -46,22 +46,65 @@ TOLERANCE = {"T1": 1.0, "T2": 1.0, "T_stator": 1.0, "P1": 1.5e-6}  # K, K, K, m 
 
 @dataclass
 class Measured:
-    """Measured channels on the model grid (NaN where not measured), and the windows."""
+    """Measured channels on the model grid (NaN where not measured), and the windows.
+
+    ``blocks`` = 1: the fit window is the first ``fit_fraction`` of the run, the rest
+    validates. ``blocks`` > 1: the run is cut into that many equal blocks and about
+    ``1 - fit_fraction`` of them, spread over the run, validate (issue 13 §4: a cycle that
+    ramps up would otherwise be validated only on speeds the fit never saw). ``held_out``:
+    one block validates and every other fits (a fold of blocked cross-validation)."""
 
     grid_s: np.ndarray
     values: dict[str, np.ndarray]
     fit_fraction: float = 0.6
+    blocks: int = 1
+    held_out: int | None = None
+    _fit_points: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        g = np.asarray(self.grid_s, dtype=float)
+        if self.blocks <= 1:
+            self._fit_points = g <= self.split_s
+            return
+        block = self.block_of(g)
+        self._fit_points = ~np.isin(block, self.validation_blocks())
 
     @property
     def split_s(self) -> float:
+        """End of the fit window of a one-split scheme [s]."""
         return float(self.grid_s[0] + self.fit_fraction * (self.grid_s[-1] - self.grid_s[0]))
+
+    def block_of(self, t_s: np.ndarray) -> np.ndarray:
+        """Index of the block each time [s] lies in."""
+        edges = np.linspace(self.grid_s[0], self.grid_s[-1], self.blocks + 1)
+        return np.clip(np.searchsorted(edges, t_s, side="right") - 1, 0, self.blocks - 1)
+
+    def validation_blocks(self) -> list[int]:
+        """The validating blocks: ``held_out``, or round(blocks (1 - fit_fraction)) of them
+        at even spacing (5 blocks at 0.6: the 2nd and the 4th)."""
+        if self.held_out is not None:
+            return [self.held_out]
+        n_val = int(round(self.blocks * (1.0 - self.fit_fraction)))
+        return sorted({int((i + 0.5) * self.blocks / n_val) for i in range(n_val)})
+
+    def fit_points(self) -> np.ndarray:
+        """True at the grid points of the fit window."""
+        return self._fit_points
+
+    def spans(self) -> list[tuple[float, float, str]]:
+        """The windows as contiguous (start [s], end [s], "fit" | "validation") spans."""
+        g, f = np.asarray(self.grid_s, dtype=float), self._fit_points
+        cut = np.flatnonzero(f[1:] != f[:-1]) + 1
+        starts, ends = np.r_[0, cut], np.r_[cut, len(g)]
+        return [(float(g[a] if a == 0 else g[a - 1]), float(g[b - 1]),
+                 "fit" if f[a] else "validation") for a, b in zip(starts, ends, strict=True)]
 
     def mask(self, channel: str, window: str) -> np.ndarray:
         ok = ~np.isnan(self.values[channel])
         if window == "fit":
-            return ok & (self.grid_s <= self.split_s)
+            return ok & self._fit_points
         if window == "validation":
-            return ok & (self.grid_s > self.split_s)
+            return ok & ~self._fit_points
         return ok
 
 
@@ -564,3 +607,44 @@ def parameters_table(fit: Fit) -> list[dict]:
                      "ci95": list(fit.ci95[k]), "identifiable": fit.identifiable[k],
                      "meaning": p.doc})
     return rows
+
+
+def cross_validate(cal: Calibrator, fit: Fit, blocks: int = 5, max_nfev: int = 20) -> dict:
+    """Blocked cross-validation of ``fit``'s model (issue 13 §4): for each of ``blocks``
+    equal blocks of the run, refit the same free parameters on every
+    other block, starting from ``fit``'s values with the same priors, and simulate the held-out
+    block open loop. Returns per fold the block [s] and each channel's held-out error, and
+    per channel the error pooled over the folds (``rmse``, ``max``, ``within_tolerance``;
+    ``unit`` K or um): what the model predicts where it was not calibrated, the run's whole
+    operating range included."""
+    from dataclasses import replace
+
+    meas = cal.measured
+    blocks = max(int(blocks), 2)
+    edges = np.linspace(meas.grid_s[0], meas.grid_s[-1], blocks + 1)
+    folds, pooled = [], {c: [] for c in cal.channels}
+    for i in range(blocks):
+        held = replace(meas, blocks=blocks, held_out=i)
+        fold_cal = replace(cal, measured=held, progress=None, evaluations=0)
+        refit = fold_cal.fit(fit.effects, free=fit.free, start=fit.theta,
+                             lag_channel=fit.lag_channel, max_nfev=max_nfev)
+        cal.evaluations += fold_cal.evaluations
+        errs = {}
+        for c in cal.channels:
+            m = held.mask(c, "validation")
+            d = meas.values[c][m] - refit.model[c][m]
+            pooled[c].append(d)
+            if len(d):
+                errs[c] = _error_row(c, d)
+        folds.append({"block_s": [float(edges[i]), float(edges[i + 1])], "validation": errs})
+    total = {c: _error_row(c, np.concatenate(d)) for c, d in pooled.items()
+             if sum(len(x) for x in d)}
+    return {"blocks": blocks, "folds": folds, "pooled": total}
+
+
+def _error_row(channel: str, d: np.ndarray) -> dict:
+    """rmse, max (channel unit at the edges: K or um), within_tolerance of differences [SI]."""
+    scale, unit = (1e6, "um") if channel == "P1" else (1.0, "K")
+    return {"rmse": float(np.sqrt(np.mean(d * d)) * scale),
+            "max": float(np.max(np.abs(d)) * scale), "unit": unit,
+            "within_tolerance": float(np.mean(np.abs(d) <= TOLERANCE[channel])), "n": int(len(d))}

@@ -34,6 +34,7 @@ from compare.fit.calibrate import (
     Fit,
     Measured,
     Selection,
+    cross_validate,
     forward_selection,
     parameters_table,
     resample,
@@ -58,8 +59,9 @@ from spindle.bench import (
     settled_speed,
 )
 from spindle.drive import drive_for
-from spindle.errors import InputError
+from spindle.errors import InputError, SolverError
 from spindle.outputs import jsonable
+from spindle.results import check_plausible
 from spindle.spec import Spec
 from spindle.units import ZERO_C_K
 
@@ -117,6 +119,9 @@ class FitReport:
     warnings: list[str] = field(default_factory=list)
     #: compare.fit.events tests of the raw samples, by candidate label
     events: dict[str, dict] = field(default_factory=dict)
+    #: compare.fit.calibrate.cross_validate of the base and the final model ("base",
+    #: "final"); empty when switched off
+    cross_validation: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         sel = self.selection
@@ -140,8 +145,11 @@ class FitReport:
         return jsonable({
             "format": REPORT_FORMAT, "run": str(self.run.path), "spec": self.spec.name,
             "channels": self.channels, "run_summary": self.run.summary(),
-            "windows": {"fit": [float(self.measured.grid_s[0]), self.measured.split_s],
-                        "validation": [self.measured.split_s, float(self.measured.grid_s[-1])]},
+            "windows": {"blocks": self.measured.blocks,
+                        "fit": [[a, b] for a, b, w in self.measured.spans() if w == "fit"],
+                        "validation": [[a, b] for a, b, w in self.measured.spans()
+                                       if w == "validation"]},
+            "cross_validation": self.cross_validation,
             "tolerances": {"temperature_K": 1.0, "growth_um": 1.5},
             "alpha": self.alpha,
             "calibration_model": self.calibration_model,
@@ -206,12 +214,17 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
             nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
             min_gain: float = 0.25, progress: Callable[[str], None] | None = None,
             fem_level: int | None = 0, model: str = "lumped",
-            base_extra: tuple[str, ...] = ()) -> FitReport:
+            base_extra: tuple[str, ...] = (), blocks: int = 1,
+            cv_blocks: int = 5) -> FitReport:
     """The whole loop (module docstring). ``model``: "lumped" calibrates the base parameters
     on the lumped grey box anchored to the FEM at the spec's values; "fem" calibrates them on
     the FEM reference itself (level ``fem_level``), then anchors the lumped grey box there
     and selects effects on it. ``base_extra``: names of EXTRA_BASE_PARAMS calibrated with
-    the base (lumped calibration only)."""
+    the base (lumped calibration only). ``blocks``: the run is cut into that many blocks, of
+    which about 1 - ``fit_fraction`` validate, spread over the run (1: the fit window is the
+    first ``fit_fraction``). ``cv_blocks``: blocked cross-validation of the base and the
+    final model over that many blocks, each left out in turn (compare.fit.calibrate.
+    cross_validate; 0: none)."""
     from compare.fit.discrepancy import fem_discrepancy
     from compare.fit.residuals import diagnose
 
@@ -238,15 +251,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
                          "add [power_balance] preset to the spec")
     inputs = greybox_inputs(run, grid_s)
-    values = {}
-    for c in channels:
-        t, y = run.channel(c)
-        values[c] = resample(t, y, inputs.grid_s)
-    measured = Measured(inputs.grid_s, values, fit_fraction)
-    for c in channels:
-        if measured.mask(c, "fit").sum() < 10 or measured.mask(c, "validation").sum() < 5:
-            raise InputError(str(path), c, "has too few samples in the fit or validation window",
-                             "export a run that measures this channel throughout, or drop it")
+    measured = _measured(run, channels, inputs.grid_s, fit_fraction, blocks)
     cal = Calibrator(GreyBox(spec, drive, inputs, nodes, base_extra=tuple(base_extra)),
                      measured, channels, progress=say)
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
@@ -267,6 +272,13 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     events = event_tests(run, cal.gb, base.theta, channels)
     sel = forward_selection(cal, candidates, alpha, base=base, min_gain=min_gain, events=events)
     final = sel.final
+    for fit in (sel.base, final):  # nothing impossible is written (issue 14)
+        check_plausible(np.concatenate([fit.model[c] for c in channels if c != "P1"] or
+                                       [np.ones(1)]), 0.0, str(path))
+        if "P1" in channels and not np.all(np.isfinite(fit.model["P1"])):
+            raise SolverError(f"{path}: P1: the calibrated model's growth is not finite; fix: "
+                              "check the run's inputs (speed, power, torque) for values far "
+                              "outside the spec's operating range")
     ins = {"speed": np.concatenate([[inputs.speed_rpm[0]], inputs.speed_rpm]),
            "power": np.concatenate([[inputs.power_kW[0]], inputs.power_kW]),
            "T_env": np.concatenate([[inputs.T_env_K[0]], inputs.T_env_K])}
@@ -315,11 +327,16 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     adequacy["with_effects"] = adequacy_final
     adequacy["verdict"] = verdict_text(adequacy, adequacy_final, list(final.effects))
     warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
-                                   measured.split_s)
+                                   measured.fit_points())
+    cv = {}
+    if cv_blocks:
+        say(f"cross-validating over {cv_blocks} blocks")
+        cv = {"base": cross_validate(cal, sel.base, cv_blocks),
+              "final": cross_validate(cal, final, cv_blocks)}
     return FitReport(run, spec, channels, measured, inputs, sel, diag_b, diag_a, unexplained,
                      text, signatures, time.perf_counter() - t0, alpha, anchor, cal.floor,
                      cal.prior_z(final) or None, model, fem_cal_info, adequacy, warns,
-                     {k: t.to_dict() for k, t in events.items()})
+                     {k: t.to_dict() for k, t in events.items()}, cv)
 
 
 #: least_squares function evaluations of the FEM fit with priors (each iteration adds a
@@ -404,6 +421,46 @@ def save_report(rep: FitReport, out: Path, pictures: bool = True) -> list[Path]:
     return files
 
 
+def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fraction: float,
+              blocks: int) -> Measured:
+    """The measured channels on the model grid, with the windows; refuses a channel with too
+    few samples in either window."""
+    if not 1 <= blocks <= 20:
+        raise InputError("command line", "--blocks", f"{blocks} is outside 1..20",
+                         "cut the run into 1 (one split) to 20 blocks, e.g. 5")
+    values = {}
+    for c in channels:
+        t, y = run.channel(c)
+        values[c] = resample(t, y, grid_s)
+    measured = Measured(grid_s, values, fit_fraction, blocks)
+    for c in channels:
+        if measured.mask(c, "fit").sum() < 10 or measured.mask(c, "validation").sum() < 5:
+            raise InputError(str(run.path), c, "has too few samples in the fit or validation "
+                             "window", "export a run that measures this channel throughout, "
+                             "or drop it")
+    return measured
+
+
+def _spans_text(measured: Measured) -> str:
+    return ", ".join(f"{a / 3600:.2f}-{b / 3600:.2f} h" for a, b, w in measured.spans()
+                     if w == "validation")
+
+
+def _cv_html(doc: dict) -> str:
+    cv = doc.get("cross_validation") or {}
+    if not cv:
+        return ""
+    rows = []
+    for key, label in (("base", "base model"), ("final", "final model")):
+        for c, e in cv[key]["pooled"].items():
+            rows.append([label, c, e["rmse"], e["max"], e["unit"], 100 * e["within_tolerance"]])
+    return (f"<h2>Blocked cross-validation ({cv['final']['blocks']} blocks, each held out "
+            "once)</h2><p>Each block refitted without it and simulated open loop: the error "
+            "where the model was not calibrated, over the run's whole operating range.</p>"
+            + html_table(["model", "channel", "rms", "max", "unit", "% within tolerance"], rows,
+                         ["s", "s", ".3f", ".3f", "s", ".0f"]))
+
+
 def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
     from compare.fit.residuals import plot_acf, plot_cumulated_periodogram
     from spindle.outputs import atomic_write
@@ -426,7 +483,9 @@ def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
                             label=f"model ±{tol:g} {unit}")
             ax.plot(g, model, color="tab:blue", ls="--", lw=1, label="model")
             ax.plot(g, meas, color="black", lw=0.8, label="measured")
-            ax.axvline(rep.measured.split_s / 3600, color="tab:red", lw=0.8, ls=":")
+            for a, b, w in rep.measured.spans():
+                if w == "validation":
+                    ax.axvspan(a / 3600, b / 3600, color="tab:orange", alpha=0.08, lw=0)
             ax.set_ylabel(f"{c} [{unit}]")
             ax.set_title(f"{c} {label}" + (f" (+ {', '.join(fit.effects)})" if fit.effects
                                             else " (base model)"), fontsize=9)
@@ -434,7 +493,7 @@ def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
             if i == 0:
                 ax.legend(fontsize=7)
     for ax in axes[-1]:
-        ax.set_xlabel("time [h] (dotted: end of the fit window)")
+        ax.set_xlabel("time [h] (shaded: validation window)")
     atomic_write(out / "fit_channels.png", lambda tmp: fig.savefig(tmp, dpi=110))
     plt.close(fig)
     made.append(("fit_channels.png", "measured against the model, before and after, with the "
@@ -536,8 +595,9 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
     unexpl = doc["unexplained"]
     return html_page("spindle-verify fit", [
         f"<h1>Fit of {html.escape(str(rep.run.path))} to {html.escape(rep.spec.name)}</h1>",
-        f"<p>Channels {rep.channels}; fit window up to {rep.measured.split_s / 3600:.2f} h, "
-        f"validation after; likelihood-ratio level {rep.alpha:g}; {rep.runtime_s:.1f} s.</p>",
+        f"<p>Channels {rep.channels}; validation window {_spans_text(rep.measured)}, the "
+        f"rest fits; likelihood-ratio level {rep.alpha:g}; {rep.runtime_s:.1f} s.</p>",
+        _cv_html(doc),
         anchor_html,
         _adequacy_html(doc),
         "<h2>Effects accepted (in order)</h2><ul>" + eff + "</ul>",
@@ -596,6 +656,12 @@ def report_summary_text(rep: FitReport) -> str:
         v = doc[key].get("validation", {})
         lines.append(f"  validation error {label}: " + ", ".join(
             f"{c} {e['rmse']:.3f} {e['unit']} rms / {e['max']:.3f} max" for c, e in v.items()))
+    for key, label in (("base", "before"), ("final", "after")):
+        pooled = (doc.get("cross_validation") or {}).get(key, {}).get("pooled")
+        if pooled:
+            lines.append(f"  cross-validated error {label} ({doc['cross_validation'][key]['blocks']}"
+                         " blocks, each held out): " + ", ".join(
+                             f"{c} {e['rmse']:.3f} {e['unit']} rms" for c, e in pooled.items()))
     odd = {k: v for k, v in (doc.get("parameters_prior_z") or {}).items() if abs(v) > 2.576}
     if odd:
         lines.append("  base parameters still implausible (prior sds from the spec's values): "
