@@ -75,6 +75,8 @@ class ThermoelasticModel:
             role = spec.part(reg.part).role if reg.kind != "air_gap" else "air"
             inner_ring = role in ("front_bearing", "rear_bearing") and reg.section == "inner_ring"
             rotating = role in ROTATING_ROLES or inner_ring
+            if reg.kind == "air_gap":  # a gap carries no load: no stiffness (its own DOFs
+                lam = mu = 0.0          # are removed in _reduction)
             rows.append((lam, mu, mu * (FLOATING_SHEAR if float_ else 1.0), m.alpha_1_K,
                          m.rho_kg_m3 if rotating else 0.0))
         arr = np.array(rows)[sm.element_region]
@@ -107,6 +109,7 @@ class ThermoelasticModel:
         rep = first[label]
         fixed = np.zeros(n, dtype=bool)
         fixed[self.ir[np.abs(b.doflocs[1, self.ir]) < 1e-12]] = True
+        fixed[self._air_only_dofs()] = True  # inside an air gap: no stiffness, no meaning
         if fixed_axial:
             for name in fixed_axial:
                 fixed[np.intersect1d(b.get_dofs(facets=sm.surfaces[name]).flatten(), self.iz)] = True
@@ -117,6 +120,15 @@ class ThermoelasticModel:
         col[keep] = np.arange(len(keep))
         rows = np.nonzero(col[rep] >= 0)[0]
         return sp.csr_matrix((np.ones(len(rows)), (rows, col[rep[rows]])), shape=(n, len(keep)))
+
+    def _air_only_dofs(self) -> np.ndarray:
+        """DOFs that only air-gap elements hold (the layer's interior and mid-edge nodes)."""
+        sm, b = self.smesh, self.basis
+        air = np.array([reg.kind == "air_gap" for reg in sm.regions])[sm.element_region]
+        if not air.any():
+            return np.zeros(0, dtype=np.int64)
+        in_air = np.unique(b.element_dofs[:, air])
+        return np.setdiff1d(in_air, np.unique(b.element_dofs[:, ~air]))
 
     def _axial_support_dof(self) -> int:
         b = self.basis

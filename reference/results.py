@@ -47,7 +47,8 @@ class SteadyResult(SteadyTable):
         return dict(zip(names, (self.model.probe_matrix(pts) @ self.T).tolist(), strict=True))
 
     def summary(self) -> dict:
-        return self.steady_summary({"mesh": _mesh_info(self.model)})
+        return {**self.steady_summary({"mesh": _mesh_info(self.model)}),
+                "inputs_used": self.model.op.inputs_used(self.case, self.time_s, self.speed_rpm)}
 
     def plot(self, ax=None):
         from reference.plots import plot_section
@@ -112,7 +113,20 @@ class TransientResult(TransientTable):
                 "mesh": _mesh_info(self.model), "theta": self.theta,
                 "duration_s": float(self.times_s[-1]), "steps": len(self.times_s) - 1,
                 "energy": self.energy,
-                **self.peaks()}
+                **self.peaks(), "inputs_used_by_speed": self.inputs_by_speed()}
+
+    def inputs_by_speed(self) -> dict[str, dict]:
+        """ThermalModel.op.inputs_used at the first output time of each speed the run held
+        (films and links depend on the speed; sources and reference temperatures are those
+        of that instant)."""
+        out: dict[str, dict] = {}
+        for t in self.times_s:
+            n = float(self.case.speed_rpm(float(t)))
+            key = f"{n:g} rpm"
+            if key not in out:
+                out[key] = {"first_at_s": float(t),
+                            **self.model.op.inputs_used(self.case, float(t), n)}
+        return out
 
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         """Summary JSON, sensor time series CSV, VTU per saved time with a PVD, PNGs."""

@@ -27,6 +27,7 @@ from reference.probes import probe_matrix
 from spindle.errors import SolverError
 from spindle.loads import LoadCase, time_grid
 from spindle.spec import BearingLink, ContactLink
+from spindle.units import ZERO_C_K
 
 TWO_PI = 2.0 * math.pi
 
@@ -98,6 +99,29 @@ class Operator:
         # 1^T R_s T = int_s T r ds and 1^T b_s = int_s r ds (partition of unity)
         return {s.name: TWO_PI * s.h_W_m2K(speed_rpm) * (float(b @ T) - T_ref[s.T_ref] * b.sum())
                 for s, _, b in self.films}
+
+    def inputs_used(self, case: LoadCase, t: float, speed_rpm: float) -> dict:
+        """What the solve used at time ``t`` [s] and ``speed_rpm``, for an independent check
+        (issue 15): each heat source [W], each film's coefficient [W/m2/K], area [m2] and
+        reference temperature [degC], each link's conductance (bearing G [W/K], air-gap and
+        contact coefficients [W/m2/K])."""
+        T_ref = {"ambient": float(case.T_ambient_K(t)), "coolant": float(case.T_coolant_K(t))}
+        links = {}
+        for lk, _ in self.links:
+            if isinstance(lk, BearingLink):
+                links[f"bearing:{lk.part}"] = {"G_W_K": float(lk.G_W_K(speed_rpm))}
+            else:
+                links[f"air_gap:{lk.inner}-{lk.outer}"] = {"h_W_m2K": float(lk.h_W_m2K(speed_rpm))}
+        for lk, _ in self.contacts:
+            links[f"contact:{'-'.join(lk.parts)}"] = {"h_W_m2K": float(lk.h_W_m2K)}
+        return {
+            "heat_sources_W": {src.name: float(case.sources.get(src.name, src.power_W)(t))
+                               for src, _ in self.sources},
+            "films": {s.name: {"h_W_m2K": float(s.h_W_m2K(speed_rpm)),
+                               "area_m2": TWO_PI * float(b.sum()), "T_ref": s.T_ref,
+                               "T_ref_C": T_ref[s.T_ref] - ZERO_C_K}
+                      for s, _, b in self.films},
+            "links": links}
 
     def stored_J(self, T: np.ndarray, T0: np.ndarray) -> float:
         """Heat stored since T0 [J]: 2 pi 1^T M (T - T0)."""

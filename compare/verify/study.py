@@ -26,6 +26,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from compare.report import html_figure, html_page, html_table, markdown_to_html_table
 from compare.verify.accuracy import (
     NODES,
@@ -59,12 +61,16 @@ class StudyResult:
     #: runs that failed: {"label", "error", "type"} each; their models are missing from the
     #: tables (a failed FEM transient on the reference level leaves ``transient`` None)
     failures: list[dict[str, str]] = field(default_factory=list)
+    #: how the reference transient was converged in time (_converged_reference); None
+    #: without a transient
+    time_integration: dict | None = None
 
     def summary(self) -> dict:
         return {"spec": self.spec.name, "runtime_s": self.runtime_s,
                 "ground_truth_level": self.ground_truth_level,
                 "reference_level": self.reference_level,
                 "convergence": self.convergence.summary(),
+                "time_integration": self.time_integration,
                 "steady": self.steady.summary(),
                 "transient": self.transient.summary() if self.transient else None,
                 "failures": self.failures}
@@ -148,11 +154,27 @@ class StudyResult:
                 f"<h2>3. Transient accuracy ({html.escape(self.transient.case_name)})</h2>",
                 f"<p>Reference: {html.escape(self.transient.reference_label)}. Errors are "
                 "over the sensors and over time.</p>",
+                self._time_html(),
                 markdown_to_html_table(self.transient.markdown()),
                 img("accuracy_transient_error.png", "error against unknowns"),
                 img("accuracy_transient_shaft_profile.png", "shaft sensors at the peak"),
             ]
         return html_page(f"spindle-verify study: {self.spec.name}", parts)
+
+    def _time_html(self) -> str:
+        ti = self.time_integration
+        if not ti:
+            return ""
+        halved = (f"halved {ti['halvings']} times from the requested {ti['dt_requested_s']:g} s"
+                  if ti["halvings"] else "as requested")
+        verdict = ("below" if ti["converged"] else "STILL ABOVE (after the last halving; "
+                   "the transient verdicts carry that much time error)")
+        return (f"<p><b>Time.</b> {html.escape(ti['method'])}; dt {ti['dt_s']:g} s "
+                f"({halved}). Bound on the temporal error: {ti['time_error_K']:.3g} K and "
+                f"{ti['time_error_um']:.3g} µm, {100 * ti['relative']:.2g} % of the peak rise "
+                f"({ti['peak_rise_K']:.3g} K): {verdict} the {100 * ti['threshold']:g} % "
+                "threshold of the spatial GCI. The lumped models integrate exactly for inputs "
+                "held over each step and are read at the same instants.</p>")
 
     def _failures_html(self) -> str:
         if not self.failures:
@@ -265,14 +287,20 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     for lv, res, rt, n in zip(conv.levels, conv.results, conv.runtime_s, conv.dofs, strict=True):
         fem.append(Entry(f"FEM level {lv}", "fem", n, rt, res.sensors, res.growth_m, level=lv))
 
-    # the independent runs, longest first (the FEM transients) so that a pool stays busy
     T0 = float(t_case.T_ambient_K(0.0))
+    failures: list[dict[str, str]] = []
+    reference, time_integration = None, None
+    if transient:  # first the time step, on the reference level (issue 15 §1)
+        reference, time_integration, failed = _converged_reference(
+            spec, t_case, ref_level, dt_s, T0, threshold, progress)
+        failures += failed
+        dt_s = time_integration["dt_s"] if time_integration else dt_s
+    # the independent runs, longest first (the FEM transients) so that a pool stays busy
     coarse_levels = [lv for lv in conv.levels if lv < ref_level]
     groups: dict[str, list[StudyRun]] = {"steady": [StudyRun(spec, s_case, "lumped", n)
                                                     for n in nodes]}
-    if transient:
-        groups = {"reference": [StudyRun(spec, t_case, "fem", ref_level, dt_s, T0)],
-                  "coarse": [StudyRun(spec, t_case, "fem", lv, dt_s, T0)
+    if reference is not None:
+        groups = {"coarse": [StudyRun(spec, t_case, "fem", lv, dt_s, T0)
                              for lv in reversed(coarse_levels)],
                   "lumped": [StudyRun(spec, t_case, "lumped", n, dt_s, T0) for n in nodes],
                   **groups}
@@ -283,7 +311,6 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
         progress(f"{len(runs)} independent runs ({where})")
     outcomes = iter(run_cases(run_study_case, runs, scheduler=scheduler, workers=workers,
                               progress=progress))
-    failures: list[dict[str, str]] = []
     got: dict[str, list[Entry]] = {}
     for name, group in groups.items():  # outcomes come in the order of ``runs``
         got[name] = []
@@ -299,14 +326,67 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     steady = AccuracyResult(spec, s_case.name, False, ref_entry, label,
                             ([eq14] if eq14 else []) + got["steady"] + fem)
     trans = None
-    if got.get("reference"):
+    if reference is not None:
         from spindle.loads import time_grid
 
         coarse = sorted(got["coarse"], key=lambda e: e.level)  # the table goes coarse first
-        trans = AccuracyResult(spec, t_case.name, True, got["reference"][0],
-                               f"FEM level {ref_level}, backward Euler dt {dt_s:g} s",
+        ti = time_integration
+        trans = AccuracyResult(spec, t_case.name, True, reference,
+                               f"FEM level {ref_level}, backward Euler at {dt_s:g} s and "
+                               f"{dt_s / 2:g} s, Richardson-extrapolated (temporal error "
+                               f"<= {ti['time_error_K']:.3g} K, {ti['time_error_um']:.3g} µm: "
+                               f"{100 * ti['relative']:.2g} % of the peak)",
                                got["lumped"] + coarse, times_s=time_grid(t_case, dt_s))
     ref_res = conv.results[conv.levels.index(ref_level)]
     return StudyResult(spec, conv, steady, trans, gt, ref_level, time.perf_counter() - t0,
-                       s_case, ref_res, failures)
+                       s_case, ref_res, failures, time_integration)
+
+
+#: at most this many halvings of the requested time step (60 s -> 3.75 s)
+MAX_TIME_HALVINGS = 4
+
+
+def _converged_reference(spec: Spec, case: LoadCase, level: int, dt_s: float, T0: float,
+                         threshold: float, progress: Callable[[str], None] | None
+                         ) -> tuple[Entry | None, dict | None, list[dict[str, str]]]:
+    """The reference transient converged in time: Richardson-extrapolated backward Euler
+    (compare.verify.accuracy.richardson_transient) at ``dt_s`` [s], halved until its
+    temporal error bound is at most ``threshold`` of the peak (the sensors' largest rise
+    above ``T0`` [K], P1's largest magnitude), at most MAX_TIME_HALVINGS times. Returns the
+    entry, the ``time_integration`` record for study.json and the failures."""
+    from compare.executor import run_cases
+
+    dt, requested = float(dt_s), float(dt_s)
+    for halvings in range(MAX_TIME_HALVINGS + 1):
+        if progress:
+            progress(f"reference transient at dt {dt:g} s and {dt / 2:g} s")
+        (o,) = run_cases(run_study_case, [StudyRun(spec, case, "fem", level, dt, T0)])
+        if not o.ok:
+            return None, None, [{"label": o.label, "error": o.error or "",
+                                 "type": o.error_type or ""}]
+        ref: Entry = o.value
+        record = _time_error_record(ref, T0, requested, dt, halvings, threshold)
+        if record["converged"]:
+            break
+        dt /= 2.0
+    if progress:
+        progress(f"time step {dt:g} s: temporal error {100 * record['relative']:.2g} % of the "
+                 f"peak (threshold {100 * threshold:g} %)")
+    return ref, record, []
+
+
+def _time_error_record(ref: Entry, T0: float, requested: float, dt: float, halvings: int,
+                       threshold: float) -> dict:
+    temps = [k for k in ref.sensors if k in ref.time_error]
+    rise = max(float(np.max(np.abs(np.asarray(ref.sensors[k]) - T0))) for k in temps)
+    err_K = max(ref.time_error[k] for k in temps)
+    rel = err_K / max(rise, 1e-12)
+    p1 = ref.growth.get("P1")
+    err_m = ref.time_error.get("P1", 0.0) if p1 is not None else 0.0
+    if p1 is not None:
+        rel = max(rel, err_m / max(float(np.max(np.abs(p1))), 1e-12))
+    return {"method": "backward Euler at dt and dt/2, Richardson-extrapolated (second order)",
+            "dt_requested_s": requested, "dt_s": dt, "halvings": halvings,
+            "time_error_K": err_K, "time_error_um": err_m * 1e6, "peak_rise_K": rise,
+            "relative": rel, "threshold": threshold, "converged": rel <= threshold}
 

@@ -6,7 +6,7 @@ Builds the lumped model (eq. 7-13) and the FEM reference from the same spec, sol
 the nominal point, prints the worst sensor temperature error and the P1 error against the
 paper's tolerances (1 K, ±1.5 µm) and writes the per-sensor errors to OUT_DIR/errors.csv.
 ``spindle-verify study`` does this for every node count and FEM level, with grid convergence
-(the README's 4.8 K and 2.6 µm are against its extrapolated reference; level 1 is within
+(the README's 4.8 K and 2.7 µm are against its extrapolated reference; level 1 is within
 0.07 K and 0.04 µm of it at these sensors, docs/harness.md); this is the one-case version.
 """
 
