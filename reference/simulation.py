@@ -60,6 +60,19 @@ class ReferenceModel:
         omega2 = (self._step_speeds(case, times_s) * RPM_TO_RAD_S) ** 2
         return omega2 * self.elastic.gain(reading)[1]
 
+    def exact_readouts(self, case: LoadCase, dt_s: float, T0: float | None = None
+                       ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
+        """(times [s], sensors [K], growth readings [m]) on time_grid(case, dt_s), exact in
+        time (ThermalModel.exact_readouts; small meshes only)."""
+        gains = {k: self.elastic.gain(k) for k in self.readings} if self.elastic else {}
+        t, names, S, F = self.thermal.exact_readouts(case, dt_s, T0,
+                                                     {k: g for k, (g, _) in gains.items()})
+        T_ref = self.elastic.T_ref if self.elastic else 0.0
+        omega2 = (self._step_speeds(case, t) * RPM_TO_RAD_S) ** 2
+        growth = {k: F[k] - T_ref * g.sum() + (omega2 * c if self.centrifugal else 0.0)
+                  for k, (g, c) in gains.items()}
+        return t, {n: S[:, j] for j, n in enumerate(names)}, growth
+
     def transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
                   T0: np.ndarray | float | None = None, save_every: int = 0,
                   progress: Callable[[float], None] | None = None) -> TransientResult:

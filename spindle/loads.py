@@ -113,12 +113,31 @@ class LoadCase:
     T_coolant_K: TimeSeries
     sources: Mapping[str, TimeSeries] = field(default_factory=dict)
     duration_s: float = 0.0
+    #: further times [s] every transient of this case lands on (with_jump_ladder)
+    extra_times_s: tuple[float, ...] = ()
 
     def breakpoints(self) -> np.ndarray:
-        """All sample times of all inputs [s], sorted and unique."""
+        """All sample times of all inputs [s] and the extra times, sorted and unique."""
         series = [self.speed_rpm, self.T_ambient_K, self.T_coolant_K, *self.sources.values()]
-        pts = np.concatenate([s.breakpoints() for s in series] + [np.zeros(1)])
+        pts = np.concatenate([s.breakpoints() for s in series]
+                             + [np.zeros(1), np.asarray(self.extra_times_s, dtype=float)])
         return np.unique(pts[(pts >= 0) & (pts <= self.duration_s)])
+
+    def jumps(self) -> np.ndarray:
+        """Times [s] where the speed or a heat source may step: their samples."""
+        series = [self.speed_rpm, *self.sources.values()]
+        pts = np.concatenate([s.breakpoints() for s in series] + [np.zeros(1)])
+        return np.unique(pts[(pts >= 0) & (pts < self.duration_s)])
+
+    def with_jump_ladder(self, first_s: float = 1.0, last_s: float = 64.0) -> LoadCase:
+        """This case with output times first_s, 2 first_s, 4 first_s, ... up to last_s [s]
+        after every jump (issue 15 §1): the response to a step in heat is steepest just after
+        it, and a comparison sampled only every dt misses its peak error, so that the
+        verdicts would depend on dt. The ladder is the same for every dt."""
+        steps = first_s * 2.0 ** np.arange(int(np.floor(np.log2(last_s / first_s))) + 1)
+        pts = (self.jumps()[:, None] + steps[None, :]).ravel()
+        return replace(self, extra_times_s=tuple(sorted(set(self.extra_times_s)
+                                                        | set(pts.tolist()))))
 
     def with_sources(self, sources: Mapping[str, TimeSeries]) -> LoadCase:
         return replace(self, sources={**self.sources, **sources})

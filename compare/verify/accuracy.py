@@ -45,6 +45,8 @@ class Entry:
     #: FEM transients: per sensor [K] and growth reading [m], max over time of |T(dt/2) -
     #: T(dt)|, a bound on the temporal error of the Richardson-extrapolated read-outs
     time_error: dict[str, float] = field(default_factory=dict)
+    #: FEM transients: "exact" (modal, ThermalModel.exact_readouts) or "richardson"
+    time_method: str = ""
 
 
 def _stats(d: np.ndarray) -> tuple[float, float]:
@@ -343,9 +345,17 @@ def fem_entry(spec: Spec, level: int, case: LoadCase, dt_s: float | None, T0: fl
         sensors, growth = _read_outs(model, case, dt_s, T0)
         return Entry(f"FEM level {level}", "fem", int(model.thermal.basis.N),
                      time.perf_counter() - t, sensors, growth, level=level)
-    sensors, growth, err = richardson_transient(model, case, dt_s, T0)
+    from reference.thermal import EXACT_MAX_DOFS
+
+    if model.thermal.basis.N <= EXACT_MAX_DOFS:  # exact in time: no temporal error
+        _, sensors, growth = model.exact_readouts(case, dt_s, T0)
+        err, method = {k: 0.0 for k in [*sensors, *growth]}, "exact"
+    else:
+        sensors, growth, err = richardson_transient(model, case, dt_s, T0)
+        method = "richardson"
     return Entry(f"FEM level {level}", "fem", int(model.thermal.basis.N),
-                 time.perf_counter() - t, sensors, growth, level=level, time_error=err)
+                 time.perf_counter() - t, sensors, growth, level=level, time_error=err,
+                 time_method=method)
 
 
 def richardson_transient(model, case: LoadCase, dt_s: float, T0: float | None
