@@ -167,14 +167,14 @@ class StudyResult:
             return ""
         halved = (f"halved {ti['halvings']} times from the requested {ti['dt_requested_s']:g} s"
                   if ti["halvings"] else "as requested")
-        verdict = ("below" if ti["converged"] else "STILL ABOVE (after the last halving; "
-                   "the transient verdicts carry that much time error)")
+        limit = f"the {100 * ti['threshold']:g} % threshold of the spatial GCI"
+        verdict = (f"below {limit}" if ti["converged"] else f"STILL ABOVE {limit} after the "
+                   "last halving: the transient verdicts carry that much time error")
         return (f"<p><b>Time.</b> {html.escape(ti['method'])}; dt {ti['dt_s']:g} s "
                 f"({halved}). Bound on the temporal error: {ti['time_error_K']:.3g} K and "
                 f"{ti['time_error_um']:.3g} µm, {100 * ti['relative']:.2g} % of the peak rise "
-                f"({ti['peak_rise_K']:.3g} K): {verdict} the {100 * ti['threshold']:g} % "
-                "threshold of the spatial GCI. The lumped models integrate exactly for inputs "
-                "held over each step and are read at the same instants.</p>")
+                f"({ti['peak_rise_K']:.3g} K): {verdict}. The lumped models integrate exactly "
+                "for inputs held over each step and are read at the same instants.</p>")
 
     def _failures_html(self) -> str:
         if not self.failures:
