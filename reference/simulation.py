@@ -64,28 +64,34 @@ class ReferenceModel:
                        ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
         """(times [s], sensors [K], growth readings [m]) on time_grid(case, dt_s), exact in
         time (ThermalModel.exact_readouts; small meshes only)."""
-        gains = {k: self.elastic.gain(k) for k in self.readings} if self.elastic else {}
+        gains = self._gains()
         t, names, S, F = self.thermal.exact_readouts(case, dt_s, T0,
                                                      {k: g for k, (g, _) in gains.items()})
+        return (t, {n: S[:, j] for j, n in enumerate(names)},
+                self._growth(gains, F, self._step_speeds(case, t)))
+
+    def _gains(self) -> dict[str, tuple[np.ndarray, float]]:
+        """Each growth reading's thermal gain g [m/K per DOF] and centrifugal c [m s^2]."""
+        return {k: self.elastic.gain(k) for k in self.readings} if self.elastic else {}
+
+    def _growth(self, gains: dict, functionals: dict[str, np.ndarray],
+                speed_rpm: np.ndarray) -> dict[str, np.ndarray]:
+        """Growth readings [m] from the recorded g . T series and the speed held over each
+        step [rpm] (the centrifugal part only if this model adds it)."""
         T_ref = self.elastic.T_ref if self.elastic else 0.0
-        omega2 = (self._step_speeds(case, t) * RPM_TO_RAD_S) ** 2
-        growth = {k: F[k] - T_ref * g.sum() + (omega2 * c if self.centrifugal else 0.0)
-                  for k, (g, c) in gains.items()}
-        return t, {n: S[:, j] for j, n in enumerate(names)}, growth
+        omega2 = (np.asarray(speed_rpm) * RPM_TO_RAD_S) ** 2
+        return {k: functionals[k] - T_ref * g.sum() + (omega2 * c if self.centrifugal else 0.0)
+                for k, (g, c) in gains.items()}
 
     def transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
                   T0: np.ndarray | float | None = None, save_every: int = 0,
                   progress: Callable[[float], None] | None = None) -> TransientResult:
-        gains = {k: self.elastic.gain(k) for k in self.readings} if self.elastic else {}
+        gains = self._gains()
         res = self.thermal.solve_transient(case, dt_s, theta, T0, save_every, progress,
                                            functionals={k: g for k, (g, _) in gains.items()})
-        T_ref = self.elastic.T_ref if self.elastic else 0.0
         t = res.times_s
         speed = self._step_speeds(case, t)
-        omega2 = (speed * RPM_TO_RAD_S) ** 2
-        for k, (g, c) in gains.items():
-            res.growth_m[k] = res.functionals[k] - T_ref * g.sum() \
-                + (omega2 * c if self.centrifugal else 0.0)
+        res.growth_m.update(self._growth(gains, res.functionals, speed))
         if self.elastic is not None:  # displacement fields at the saved times, for ParaView
             res.elastic = self.elastic
             at = np.searchsorted(t, res.field_times_s)  # saved times are grid times

@@ -320,7 +320,6 @@ class ThermalModel:
                           dt * dt / 2 - lam * dt ** 3 / 6)
             z = e * z + g1 * a + g2 * b
             Y[k] = OV @ z
-            x = None  # the state lives in the modal coordinates from here
         n_s = len(names)
         return grid, names, Y[:, :n_s], {k: Y[:, n_s + j] for j, k in enumerate(fnames)}
 

@@ -74,10 +74,14 @@ class Measured:
         """End of the fit window of a one-split scheme [s]."""
         return float(self.grid_s[0] + self.fit_fraction * (self.grid_s[-1] - self.grid_s[0]))
 
+    def block_edges(self) -> np.ndarray:
+        """The blocks' bounds [s]: ``blocks`` equal parts of the grid's span."""
+        return np.linspace(self.grid_s[0], self.grid_s[-1], self.blocks + 1)
+
     def block_of(self, t_s: np.ndarray) -> np.ndarray:
         """Index of the block each time [s] lies in."""
-        edges = np.linspace(self.grid_s[0], self.grid_s[-1], self.blocks + 1)
-        return np.clip(np.searchsorted(edges, t_s, side="right") - 1, 0, self.blocks - 1)
+        return np.clip(np.searchsorted(self.block_edges(), t_s, side="right") - 1, 0,
+                       self.blocks - 1)
 
     def validation_blocks(self) -> list[int]:
         """The validating blocks: ``held_out``, or round(blocks (1 - fit_fraction)) of them
@@ -304,16 +308,14 @@ class Calibrator:
             for c in self.channels:
                 m = self.measured.mask(c, window)
                 d = self.measured.values[c][m] - out[c][m]
-                scale = 1e6 if c == "P1" else 1.0
-                unit = "um" if c == "P1" else "K"
                 if len(d) == 0:
                     errs[window][c] = {"n": 0}
                     continue
+                row = _error_row(c, d)
+                unit = row["unit"]
                 errs[window][c] = {
-                    "n": int(len(d)), f"rmse_{unit}": float(np.sqrt(np.mean(d * d)) * scale),
-                    f"max_{unit}": float(np.max(np.abs(d)) * scale),
-                    f"bias_{unit}": float(np.mean(d) * scale),
-                    "within_tolerance": float(np.mean(np.abs(d) <= TOLERANCE[c])),
+                    "n": row["n"], f"rmse_{unit}": row["rmse"], f"max_{unit}": row["max"],
+                    f"bias_{unit}": row["bias"], "within_tolerance": row["within_tolerance"],
                     "rmse_w": float(np.sqrt(np.mean(d * d)) / TOLERANCE[c])}
         return errs
 
@@ -621,10 +623,10 @@ def cross_validate(cal: Calibrator, fit: Fit, blocks: int = 5, max_nfev: int = 2
 
     meas = cal.measured
     blocks = max(int(blocks), 2)
-    edges = np.linspace(meas.grid_s[0], meas.grid_s[-1], blocks + 1)
     folds, pooled = [], {c: [] for c in cal.channels}
     for i in range(blocks):
         held = replace(meas, blocks=blocks, held_out=i)
+        edges = held.block_edges()
         fold_cal = replace(cal, measured=held, progress=None, evaluations=0)
         refit = fold_cal.fit(fit.effects, free=fit.free, start=fit.theta,
                              lag_channel=fit.lag_channel, max_nfev=max_nfev)
@@ -643,8 +645,10 @@ def cross_validate(cal: Calibrator, fit: Fit, blocks: int = 5, max_nfev: int = 2
 
 
 def _error_row(channel: str, d: np.ndarray) -> dict:
-    """rmse, max (channel unit at the edges: K or um), within_tolerance of differences [SI]."""
+    """rmse, max, bias (channel unit at the edges: K or um) and within_tolerance of
+    differences ``d`` [SI]; the errors of Calibrator.errors and of cross_validate."""
     scale, unit = (1e6, "um") if channel == "P1" else (1.0, "K")
     return {"rmse": float(np.sqrt(np.mean(d * d)) * scale),
-            "max": float(np.max(np.abs(d)) * scale), "unit": unit,
+            "max": float(np.max(np.abs(d)) * scale), "bias": float(np.mean(d) * scale),
+            "unit": unit,
             "within_tolerance": float(np.mean(np.abs(d) <= TOLERANCE[channel])), "n": int(len(d))}

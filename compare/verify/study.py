@@ -326,8 +326,7 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
             if o.ok:
                 got[name].append(o.value)
             else:
-                failures.append({"label": o.label, "error": o.error or "",
-                                 "type": o.error_type or ""})
+                failures.append(_failure(o))
 
     eq14 = eq14_entry(spec, s_case)
     steady = AccuracyResult(spec, s_case.name, False, ref_entry, label,
@@ -350,6 +349,12 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     ref_res = conv.results[conv.levels.index(ref_level)]
     return StudyResult(spec, conv, steady, trans, gt, ref_level, time.perf_counter() - t0,
                        s_case, ref_res, failures, time_integration)
+
+
+def _failure(outcome) -> dict[str, str]:
+    """The failures entry of a run that failed (compare.executor's outcome)."""
+    return {"label": outcome.label, "error": outcome.error or "",
+            "type": outcome.error_type or ""}
 
 
 #: at most this many halvings of the requested time step for a Richardson-extrapolated
@@ -375,8 +380,7 @@ def _converged_reference(spec: Spec, case: LoadCase, level: int, dt_s: float, T0
             progress(f"reference transient at dt {dt:g} s and {dt / 2:g} s")
         (o,) = run_cases(run_study_case, [StudyRun(spec, case, "fem", level, dt, T0)])
         if not o.ok:
-            return None, None, [{"label": o.label, "error": o.error or "",
-                                 "type": o.error_type or ""}]
+            return None, None, [_failure(o)]
         ref: Entry = o.value
         record = _time_error_record(ref, T0, requested, dt, halvings, threshold)
         if record["converged"] or halvings == MAX_TIME_HALVINGS:
