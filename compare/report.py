@@ -17,7 +17,18 @@ from typing import Any
 CSS = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}"
        "table{border-collapse:collapse;font-size:12px;margin:1em 0}"
        "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
-       "th{background:#f2f2f2}img{max-width:100%}figcaption{font-size:12px;color:#555}")
+       "th{background:#f2f2f2}img{max-width:100%}figcaption{font-size:12px;color:#555}"
+       "td.pass{background:#d9f2d9;color:#145214;font-weight:bold;text-align:center}"
+       "td.fail{background:#f8d7d7;color:#7a1010;font-weight:bold;text-align:center}"
+       "p.summary{font-size:15px;background:#f6f6f6;padding:0.6em 0.8em;border-left:4px solid "
+       "#888}td:last-child{min-width:12em}")
+
+
+def verdict_cell(ok: bool | None) -> str:
+    """A table cell saying PASS or FAIL in words and colour (n/a without a verdict)."""
+    if ok is None:
+        return "<td>n/a</td>"
+    return '<td class="pass">PASS</td>' if ok else '<td class="fail">FAIL</td>'
 
 MISSING = "—"
 

@@ -59,6 +59,7 @@ from spindle.spec import (
     Part,
     Section,
     Spec,
+    as_spec,
 )
 
 #: the paper's models: 5 masses along shaft and housing (Fig. 5), and 11 (the 11 virtual
@@ -208,7 +209,7 @@ def _radial_R(spec: Spec, sec: Section, r_face: float, dz: float) -> float:
     return abs(np.log(max(r_face, 1e-12) / rc)) / (2 * np.pi * k * dz)
 
 
-def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = True,
+def build_network(spec: Spec | str, nodes: int | str = 11, radial_conduction: bool = True,
                   coolant_advection_W_K: float | None = None, bearing_tc_1_K: float = 0.0
                   ) -> LumpedNetwork:
     """The function-block network of ``spec`` with ``nodes`` masses along shaft and housing
@@ -220,7 +221,8 @@ def build_network(spec: Spec, nodes: int | str = 11, radial_conduction: bool = T
     the heat it carries (its mean temperature is the supply plus Q / (2 m_dot c_p)), instead of
     staying at the supply temperature; ``bearing_tc_1_K`` makes each bearing's friction heat
     rise with the inner-outer ring temperature difference, Q (1 + tc (T_inner - T_outer)), as
-    thermal expansion raises the preload."""
+    thermal expansion raises the preload. ``spec``: a Spec, a shipped name or a path."""
+    spec = as_spec(spec)
     nodes = _node_number(nodes)
     b = _Builder(spec, Network(f"{spec.name}-{nodes}"), rad=1.0 if radial_conduction else 0.0,
                  coolant_advection_W_K=coolant_advection_W_K, bearing_tc_1_K=bearing_tc_1_K)
@@ -510,7 +512,7 @@ class _Builder:
         faces = exposed_faces(self.spec)
         surface_map: dict[str, list[tuple[Mass, float, float]]] = {}
         for s in self.spec.surfaces:
-            surface_map[s.name] = [p for f in surface_faces(s, faces) for p in self.face_pieces(f)]
+            surface_map[s.name] = [p for f in surface_faces(s, faces, self.spec) for p in self.face_pieces(f)]
             if s.h_W_m2K is None:
                 continue
             grouped: dict[str, list[tuple[float, float]]] = {}

@@ -75,10 +75,14 @@ class Fin:
         ``h_W_m2K`` defaults to the effective alpha: the film conductance of all the part's
         convective surfaces at ``speed_rpm`` (spec speed if None), spread over its lateral
         area. ``Q1_W`` / ``Q2_W`` default to the heat sources on the part's rear and front end
-        faces; a part without such sources needs them given.
+        faces; a part without such sources needs them given. ``spec``: a Spec, a shipped name
+        or a path.
         """
         from spindle.errors import Problem, SpecError
         from spindle.faces import exposed_faces, surface_faces
+        from spindle.spec import as_spec
+
+        spec = as_spec(spec)
 
         p = spec.part(part)
         z0 = min(s.z_start for s in p.sections)
@@ -91,7 +95,7 @@ class Fin:
         faces = exposed_faces(spec)
         n = spec.speed_rpm if speed_rpm is None else speed_rpm
         if h_W_m2K is None:
-            hA = sum(s.h_W_m2K(n) * sum(f.area_m2 for f in surface_faces(s, faces)
+            hA = sum(s.h_W_m2K(n) * sum(f.area_m2 for f in surface_faces(s, faces, spec)
                                         if f.part == part)
                      for s in spec.surfaces if s.h_W_m2K is not None)
             h_W_m2K = hA / lateral

@@ -18,7 +18,7 @@ from lumped.results import LumpedSteadyResult, LumpedTransientResult
 from spindle.errors import SolverError
 from spindle.geometry import TOL_M
 from spindle.loads import LoadCase, time_grid
-from spindle.spec import Spec
+from spindle.spec import Spec, as_spec
 
 
 class LumpedModel:
@@ -29,8 +29,9 @@ class LumpedModel:
     printed); ``lags`` puts a Kelvin-Voigt element on growth readings by name.
     """
 
-    def __init__(self, spec: Spec, nodes: int | str = 11, radial_conduction: bool = True,
+    def __init__(self, spec: Spec | str, nodes: int | str = 11, radial_conduction: bool = True,
                  lags: dict[str, KelvinVoigt] | None = None, network: LumpedNetwork | None = None):
+        spec = as_spec(spec)
         self.spec = spec
         # a prebuilt (possibly extended) network of the spec may be given instead
         self.net = network if network is not None else build_network(spec, nodes,

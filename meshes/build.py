@@ -16,8 +16,9 @@ from scipy.spatial import cKDTree
 from skfem import MeshTri
 
 from spindle.errors import Problem, SpecError
+from spindle.faces import closed_radii
 from spindle.geometry import TOL_M, Trapezoid
-from spindle.spec import AirGapLink, BearingLink, ContactLink, Material, Spec
+from spindle.spec import AirGapLink, BearingLink, ContactLink, Material, Spec, as_spec
 
 #: Facets whose normal is within 45 degrees of +r are "outer", of -r "inner", of +z "front".
 _SIDE_OF = {(True, True): "outer", (True, False): "inner",
@@ -228,8 +229,10 @@ def _split_contacts(spec: Spec, regions: list[Region], p: np.ndarray, t: np.ndar
 _LEVEL0: dict[int, tuple[Spec, list[Region], MeshTri, np.ndarray]] = {}
 
 
-def build_mesh(spec: Spec, level: int = 0) -> SpindleMesh:
-    """Mesh of ``spec`` at refinement ``level`` (each level halves every edge of level 0)."""
+def build_mesh(spec: Spec | str, level: int = 0) -> SpindleMesh:
+    """Mesh of ``spec`` (a Spec, a shipped name or a path) at refinement ``level`` (each
+    level halves every edge of level 0)."""
+    spec = as_spec(spec)
     if level < 0 or level > 8:
         raise SpecError([Problem(spec.path, "level", f"{level} is out of range",
                                  "give a level between 0 and 8")])
@@ -294,6 +297,15 @@ def _classify_facets(sm: SpindleMesh) -> None:
                & (mid[0] >= s.z_min - TOL_M) & (mid[0] <= s.z_max + TOL_M))
         if s.side != "any":
             sel &= side == s.side
+        else:  # what the open air reaches (spindle.faces.open_to_air): no bore, no pocket
+            sel &= side != "inner"
+            closed: dict[tuple[str, float], list] = {}
+            for k in np.nonzero(sel & np.isin(side, ("front", "rear")))[0]:
+                key = (str(side[k]), round(float(mid[0, k]), 9))
+                if key not in closed:
+                    closed[key] = closed_radii(spec, *key)
+                r = float(mid[1, k])
+                sel[k] = not any(a + TOL_M < r < b - TOL_M for a, b in closed[key])
         facets = bf[sel]
         if len(facets) == 0:
             problems.append(Problem(spec.path, f"surfaces.{s.name}", "selects no exposed "

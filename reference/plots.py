@@ -87,8 +87,15 @@ def deformed_png(grid, path: Path, title: str = "", growth_m: dict | None = None
     fig, ax = plt.subplots(figsize=(12, 4.2), layout="constrained")
     ax.triplot(mtri.Triangulation(pts[:, 0] * 1e3, pts[:, 1] * 1e3, tri), color="0.85", lw=0.2)
     moved = pts + scale * d
+    from matplotlib.colors import TwoSlopeNorm
+
+    uz = np.asarray(grid.point_data["u_z_um"])
+    # a diverging map centred on zero: white is "does not move", red and blue the two ways
+    span = max(float(np.abs(uz).max()), 1e-12)
+    norm = TwoSlopeNorm(0.0, vmin=min(float(uz.min()), -1e-3 * span),
+                        vmax=max(float(uz.max()), 1e-3 * span))
     tc = ax.tripcolor(mtri.Triangulation(moved[:, 0] * 1e3, moved[:, 1] * 1e3, tri),
-                      grid.point_data["u_z_um"], shading="gouraud", cmap="coolwarm")
+                      uz, shading="gouraud", cmap="coolwarm", norm=norm)
     fig.colorbar(tc, ax=ax, label="axial displacement u_z [µm]", shrink=0.9)
     text = ", ".join(f"{k} = {v * 1e6:.2f} µm" for k, v in (growth_m or {}).items())
     ax.set_title(f"{title}\ndeformed x{scale:.0f} (grey: undeformed); {text}", fontsize=10)

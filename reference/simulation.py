@@ -16,7 +16,7 @@ from reference.elastic import ThermoelasticModel
 from reference.results import SteadyResult, TransientResult
 from reference.thermal import ThermalModel
 from spindle.loads import LoadCase
-from spindle.spec import Spec
+from spindle.spec import Spec, as_spec
 from spindle.units import RPM_TO_RAD_S
 
 
@@ -27,8 +27,9 @@ class ReferenceModel:
     default; it shortens the shaft axially at speed).
     """
 
-    def __init__(self, spec: Spec, level: int = 2, order: int = 2, centrifugal: bool = False,
-                 elastic: bool = True):
+    def __init__(self, spec: Spec | str, level: int = 2, order: int = 2,
+                 centrifugal: bool = False, elastic: bool = True):
+        spec = as_spec(spec)
         self.spec, self.centrifugal = spec, centrifugal
         self.thermal = ThermalModel(build_mesh(spec, level), order)
         self.elastic = ThermoelasticModel(self.thermal) if elastic else None

@@ -120,6 +120,9 @@ class Operator:
         for lk, _ in self.contacts:
             links[f"contact:{'-'.join(lk.parts)}"] = {"h_W_m2K": float(lk.h_W_m2K)}
         return {
+            # "steady": the spec's [operating] point and [[heat_sources]]; otherwise the cycle
+            # or case whose power balance gave the sources
+            "load_case": case.name,
             "heat_sources_W": {src.name: float(case.sources.get(src.name, src.power_W)(t))
                                for src, _ in self.sources},
             "films": {s.name: {"h_W_m2K": float(s.h_W_m2K(speed_rpm)),

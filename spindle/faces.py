@@ -113,13 +113,48 @@ def exposed_faces(spec: Spec) -> list[Face]:
     return faces
 
 
-def surface_faces(surface: Surface, faces: list[Face]) -> list[Face]:
-    """The exposed face pieces a named surface selects: its parts, its side, its z range."""
+def closed_radii(spec: Spec, side: str, z: float) -> list[tuple[float, float]]:
+    """The radii [m] at which a disc face at ``z`` facing ``side`` ("front": +z, "rear": -z)
+    looks into a closed cavity rather than the open air: where its normal ray meets another
+    section (a pocket between two parts), or where the air just beyond it lies inside a bore
+    (radially inside another section: the bore of a shaft, a housing's interior). Sorted,
+    possibly overlapping intervals. meshes.build applies the same test to boundary facets."""
+    sign = 1.0 if side == "front" else -1.0
+    z_next = z + sign * 10.0 * TOL_M
+    out = []
+    for _, t in spec.sections():
+        beyond = (t.z_end > z + TOL_M) if sign > 0 else (t.z_start < z - TOL_M)
+        if beyond:  # the ray meets it somewhere along its z span
+            out.append((min(float(t.r_in(t.z_start)), float(t.r_in(t.z_end))),
+                        max(float(t.r_out(t.z_start)), float(t.r_out(t.z_end)))))
+        if t.z_start - TOL_M <= z_next <= t.z_end + TOL_M:
+            r_in = float(t.r_in(z_next))
+            if r_in > TOL_M:  # everything inside its bore
+                out.append((0.0, r_in))
+    return sorted(out)
+
+
+def open_to_air(spec: Spec, face: Face) -> list[Face]:
+    """The pieces of ``face`` that the open air reaches (what ``side = "any"`` selects): an
+    outer line whole; an inner line (a bore) never; a disc where :func:`closed_radii` leaves
+    it. The spec's cavity faces (a bore, a pocket between two parts, the inside of the
+    housing) are adiabatic, as its comments say."""
+    if face.is_line:
+        return [face] if face.side == "outer" else []
+    return [Face(face.part, face.section, face.side, p, q, face.z)
+            for p, q in _subtract(face.lo, face.hi, closed_radii(spec, face.side, face.z))]
+
+
+def surface_faces(surface: Surface, faces: list[Face], spec: Spec) -> list[Face]:
+    """The exposed face pieces (``faces``: :func:`exposed_faces` of ``spec``) a named surface
+    selects: its parts, its side, its z range; ``side = "any"`` selects what the open air
+    reaches (:func:`open_to_air`)."""
     out = []
     for f in faces:
         if f.part not in surface.parts or (surface.side != "any" and f.side != surface.side):
             continue
         c = f.clip(surface.z_min, surface.z_max)
-        if c is not None:
-            out.append(c)
+        if c is None:
+            continue
+        out.extend(open_to_air(spec, c) if surface.side == "any" else [c])
     return out

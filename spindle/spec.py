@@ -566,6 +566,16 @@ def load_spec(name_or_path: str | Path) -> Spec:
     return _build(_Reader(str(path)), read_toml(path))
 
 
+def as_spec(spec: Spec | str | Path) -> Spec:
+    """``spec`` itself, or the spec a shipped name or a file path names (:func:`load_spec`):
+    what every public constructor that takes a spec accepts, as the command line does."""
+    if isinstance(spec, Spec):
+        return spec
+    if isinstance(spec, str | Path):
+        return load_spec(spec)
+    raise TypeError(f"a spec is a Spec, a shipped name or a path, not {type(spec).__name__}")
+
+
 def _build(r: _Reader, data: dict[str, Any]) -> Spec:
     """Read the tables one after the other (the problems are listed in that order), then,
     if none was found, check the geometry; raises SpecError with every problem."""

@@ -273,7 +273,7 @@ def test_synth_coolant_feedback_is_converged(setup):
     ref = ReferenceModel(spec, 0)
     T0 = float(case.T_ambient_K(0.0))
     R = 0.008
-    res, Tm = _fixed_point(ref, case, "coolant_dynamics", {"R_adv_K_W": R}, 600.0, T0)
+    res, Tm, _ = _fixed_point(ref, case, "coolant_dynamics", {"R_adv_K_W": R}, 600.0, T0)
     th = ref.thermal
     g = np.sum([TWO_PI * s.h_W_m2K(0.0) * b for s, _, b in th.op.films
                 if s.T_ref == "coolant"], axis=0)

@@ -97,3 +97,46 @@ def test_names_on_the_skfem_mesh():
     sm = build_mesh(load_spec("spl2782"), 1)
     assert set(sm.mesh.subdomains) == set(sm.part_names)
     np.testing.assert_array_equal(sm.mesh.boundaries["housing_outer"], sm.surfaces["housing_outer"])
+
+
+def _facet_area_m2(sm, facets) -> float:
+    """2 pi int r ds over boundary facets (exact for straight facets)."""
+    m = sm.mesh
+    a, b = m.p[:, m.facets[0, facets]], m.p[:, m.facets[1, facets]]
+    return float(np.sum(2 * math.pi * 0.5 * (a[1] + b[1]) * np.hypot(*(b - a))))
+
+
+@pytest.mark.parametrize("name", ["spl2782", "fin-shaft"])
+def test_mesh_films_are_the_cad_surfaces(name):
+    """The mesh's facets of every named surface have the area of the faces spindle.faces
+    selects on the CAD lines (the lumped models use those), at two levels."""
+    from spindle.faces import exposed_faces, surface_faces
+
+    spec = load_spec(name)
+    faces = exposed_faces(spec)
+    for level in (0, 1):
+        sm = build_mesh(spec, level)
+        for s in spec.surfaces:
+            cad = sum(f.area_m2 for f in surface_faces(s, faces, spec))
+            assert _facet_area_m2(sm, sm.surfaces[s.name]) == pytest.approx(cad, rel=1e-9), s.name
+
+
+def test_open_air_surfaces_leave_the_cavities_out():
+    """Issue 15 §3: ``side = "any"`` is what the open air reaches. Hand counts from the spec's
+    dimensions: the nose (r 0.065, z 0.490-0.5295) outside and its front ring (r 0.040-0.065),
+    the HSK flange (r 0.040, 30 mm) and its front ring (r 0.025-0.040), the dummy tool
+    (r 0.025, 170 mm) and its end; the rear end (r 0.035, 20 mm) and its ring (r 0.0125-0.035).
+    Not the HSK bore (r 0.030), the faces at z = 0.490, the tool's rear face in the bore, nor
+    the drawbar bore (r 0.0125): cavities, adiabatic as the spec's comments say."""
+    from spindle.faces import exposed_faces, surface_faces
+
+    spec = load_spec("spl2782")
+    faces = exposed_faces(spec)
+    pi = math.pi
+    front = (2 * pi * 0.065 * (0.5295 - 0.490) + pi * (0.065**2 - 0.040**2)
+             + 2 * pi * 0.040 * 0.030 + pi * (0.040**2 - 0.025**2)
+             + 2 * pi * 0.025 * 0.170 + pi * 0.025**2)
+    rear = 2 * pi * 0.035 * 0.020 + pi * (0.035**2 - 0.0125**2)
+    area = {s.name: sum(f.area_m2 for f in surface_faces(s, faces, spec)) for s in spec.surfaces}
+    assert area["shaft_front_free"] == pytest.approx(front, rel=1e-9)
+    assert area["shaft_rear_free"] == pytest.approx(rear, rel=1e-9)

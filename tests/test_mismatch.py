@@ -23,7 +23,7 @@ def _film_conductance(spec, group: str, speed_rpm: float = 3000.0) -> float:
     """sum h A [W/K] over the surfaces of one film group, at a speed."""
     faces = exposed_faces(spec)
     groups = film_groups(spec)
-    return sum(s.h_W_m2K(speed_rpm) * sum(f.area_m2 for f in surface_faces(s, faces))
+    return sum(s.h_W_m2K(speed_rpm) * sum(f.area_m2 for f in surface_faces(s, faces, spec))
                for s in spec.surfaces if s.h_W_m2K is not None and groups[s.name] == group)
 
 

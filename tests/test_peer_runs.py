@@ -7,14 +7,14 @@ table). The fast path (events, selection, report) is covered in the default run 
 tests/test_events.py (the event tests on these runs' raw samples) and
 tests/test_greybox.py::test_synth_then_fit_end_to_end.
 
-The runs the tool still gets wrong are marked xfail(strict): the slow effects whose
-signature the base model's misfit imitates on this spindle (docs/fit.md, "Runs from a
-spindle the spec only approximates"). Strict, so that a fix shows up as a failure to
-update here.
+The runs the tool still gets wrong are marked xfail(strict) (docs/fit.md, "Runs from a
+spindle the spec only approximates"), and so are the named runs whose validation error stays
+above a tolerance. Strict, so that a fix shows up as a failure to update here.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 from pathlib import Path
 
@@ -23,11 +23,23 @@ import pytest
 PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"
 #: the runs named wrongly at the last measurement, with what fit names (docs/fit.md)
 KNOWN_WRONG = {
-    "dev-02": "bearing_preload: nothing named (the preload's slow heat feedback is within "
-              "the base model's misfit)",
-    "dev-05": "windage_loss: mount_conduction named instead",
-    "dev-08": "coolant_dynamics: nothing named (the jacket film factor absorbs it)",
+    "dev-08": "coolant_dynamics: nothing named (the jacket film factor absorbs it; the base "
+              "model is inadequate for the loaded runs)",
 }
+#: runs whose validation open-loop RMS after the fit exceeds a tolerance although the effect
+#: is named, with the channel (docs/fit.md: the base model's misfit, not the effect's)
+KNOWN_OVER_TOLERANCE = {
+    "dev-01": "T1 at 1.5 K: the base model's misfit on this spindle",
+}
+TOLERANCE = {"T1": 1.0, "T2": 1.0, "T_stator": 1.0, "P1": 1.5}  # the paper's: K, K, K, µm
+
+
+@functools.cache
+def _fit(label: str) -> dict:
+    from compare.fit.run import run_fit
+    from spindle.spec import load_spec
+
+    return run_fit(PEER_RUNS / f"{label}.csv", load_spec("spl2782"), cv_blocks=0).to_dict()
 
 
 def _runs() -> list:
@@ -44,11 +56,30 @@ def _runs() -> list:
                     reason="the peer's bench runs are beside the project")
 @pytest.mark.parametrize(("label", "truth"), _runs())
 def test_fit_names_the_peer_runs_effect(label, truth):
-    from compare.fit.run import run_fit
-    from spindle.spec import load_spec
-
-    doc = run_fit(PEER_RUNS / f"{label}.csv", load_spec("spl2782")).to_dict()
+    doc = _fit(label)
     named = [e["name"] for e in doc["effects"]]
     assert named == ([truth] if truth else []), named
     for e in doc["effects"]:  # each named effect carries its evidence
         assert e["p_value"] < doc["alpha"] and e["needed_by"]
+
+
+def _named_runs() -> list:
+    if not (PEER_RUNS / "truth.json").exists():
+        return []
+    truth = json.loads((PEER_RUNS / "truth.json").read_text(encoding="utf-8"))
+    return [pytest.param(label, id=label, marks=[pytest.mark.xfail(
+        strict=True, reason=KNOWN_OVER_TOLERANCE[label])] if label in KNOWN_OVER_TOLERANCE
+        else []) for label, t in sorted(truth.items())
+        if t["truth"] and label not in KNOWN_WRONG]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not (PEER_RUNS / "truth.json").exists(),
+                    reason="the peer's bench runs are beside the project")
+@pytest.mark.parametrize("label", _named_runs())
+def test_validation_error_after_is_within_the_tolerances(label):
+    """Issue 13 §6: where the effect is named, the validation open-loop RMS after the fit is
+    within 1 K and 1.5 µm on every channel."""
+    val = _fit(label)["error_after"]["validation"]
+    over = {c: e["rmse"] for c, e in val.items() if e["rmse"] > TOLERANCE[c]}
+    assert not over, over

@@ -158,3 +158,24 @@ def test_film_from_a_correlation(tmp_path):
     assert any(p.field == "surfaces[0].h_W_m2K.correlation" for p in problems(tmp_path, bad))
     bad = GOOD.replace("h_W_m2K = 10.0", 'h_W_m2K = { correlation = "air_gap", d_m = 0.08 }')
     assert any("not a parameter" in p.message for p in problems(tmp_path, bad))
+
+
+def test_python_api_takes_a_spec_name_or_path():
+    """Issue 16: wherever the Python API takes a spec, a shipped name or a path works, as on
+    the command line; anything else is a TypeError naming what is accepted."""
+    import lumped
+    from lumped import Fin
+    from meshes import build_mesh
+    from reference import ReferenceModel
+    from spindle.spec import load_spec, resolve_spec_path
+
+    by_name = lumped.build("fin-shaft", 5)
+    by_path = lumped.build(resolve_spec_path("fin-shaft"), 5)
+    by_spec = lumped.build(load_spec("fin-shaft"), 5)
+    assert by_name.n_states == by_path.n_states == by_spec.n_states
+    assert build_mesh("fin-shaft", 0).mesh.nelements == build_mesh(load_spec("fin-shaft"), 0
+                                                                    ).mesh.nelements
+    assert ReferenceModel("fin-shaft", 0).spec.name == "fin-shaft"
+    assert Fin.from_spec("fin-shaft") == Fin.from_spec(load_spec("fin-shaft"))
+    with pytest.raises(TypeError, match="shipped name or a path"):
+        lumped.build(3)

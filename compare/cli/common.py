@@ -101,3 +101,15 @@ def load_case_input(spec: Spec, source: str, base: LoadCase, inputs: list[str]) 
     if Path(source).is_file():
         inputs.append(source)
     return case
+
+
+def pass_fail(ok: bool) -> str:
+    """PASS or FAIL for the console: in green or red on a colour terminal, plain words
+    otherwise (a log, a pipe, NO_COLOR set)."""
+    import os
+    import sys
+
+    word = "PASS" if ok else "FAIL"
+    if sys.stdout.isatty() and not os.environ.get("NO_COLOR"):
+        return f"\033[{'32' if ok else '31'};1m{word}\033[0m"
+    return word

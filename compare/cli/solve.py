@@ -101,9 +101,13 @@ def _cmd_solve(args: argparse.Namespace) -> int:
               f" kWh, stored {e['energy_stored_J'] / 3.6e6:.4f} kWh, relative imbalance "
               f"{e['relative_imbalance']:.1e}")
     else:
+        heat = sum(float(v(0.0)) for v in case.sources.values())
+        origin = (f"the power balance of '{case.name}'" if args.case
+                  else "the spec's [[heat_sources]]")
         _print_sensor_table(result.sensor_table(),
                             f"steady state at {result.speed_rpm:g} rpm, ambient "
-                            f"{case.T_ambient_K(0) - ZERO_C_K:.2f} degC:")
+                            f"{case.T_ambient_K(0) - ZERO_C_K:.2f} degC, heat {heat:.1f} W "
+                            f"from {origin}:")
         for n, v in result.growth_m.items():
             print(f"  {n + '_um':<16} {v * 1e6:9.3f}  axial growth relative to the housing "
                   "fixation below the front bearing")

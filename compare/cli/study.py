@@ -15,6 +15,7 @@ from compare.cli.common import (
     add_quiet,
     add_spec,
     out_folder,
+    pass_fail,
 )
 from compare.cli.common import progress as _progress
 from spindle.errors import InputError
@@ -62,13 +63,14 @@ def _cmd_study(args: argparse.Namespace) -> int:
             mark = f" ({t['preset'][i]})" if t["preset"][i] else ""
             print(f"  {name + mark:<22} {t['unknowns'][i]:8d} "
                   f"{worst:14.3f} {p1:10.3f} "
-                  f"{t['runtime_s'][i]:10.3f}  {'ok' if t['meets_tolerances'][i] else '--'}")
+                  f"{t['runtime_s'][i]:10.3f}  {pass_fail(t['meets_tolerances'][i])}")
         slopes = acc.slopes()
         if slopes:
             print("  fitted slopes of error against unknowns: "
                   + ", ".join(f"{k} {v:.2f}" for k, v in slopes.items()))
     for f in result.failures:
         print(f"  FAILED {f['label']}: {f['error']}")
+    print(result.headline())
     print(f"wrote {out}/report.html (and tables, plots, JSON)")
     return 1 if result.failures else 0
 

@@ -33,12 +33,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the command's sub-parser."""
     sy = subparsers.add_parser("synth", help="a synthetic bench run from the FEM reference with one "
                         "effect injected; the truth goes to RUN.truth.json")
-    sy.add_argument("--spec", default="spl2782")
+    from compare.fit.greybox import EFFECTS
+    from compare.fit.synth import OUTSIDE
+
+    sy.add_argument("--spec", default="spl2782",
+                    help="the spindle the data come from: a shipped name or a spec file "
+                         "(default spl2782)")
     sy.add_argument("--cycle", default="spl-16h",
                     help="cycle: a shipped name or cycle file, or random / random-loaded (non-"
                          "monotonic steps up to 6000 rpm drawn from the seed) (default spl-16h)")
-    sy.add_argument("--effect", default="clean", help="effect to inject (default clean)")
-    sy.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0)
+    sy.add_argument("--effect", default="clean", metavar="EFFECT",
+                    help="effect to inject: clean (none, the default), one of the fit's "
+                         f"library ({', '.join(EFFECTS)}) or one outside it "
+                         f"({', '.join(OUTSIDE)}, which fit should report unexplained)")
+    sy.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0,
+                    help="random seed: the effect's magnitude, the noise and sampling, and "
+                         "with --mismatch or a random cycle their draws (default 0)")
     sy.add_argument("--level", type=MESH_LEVEL, default=1, help="FEM level (default 1)")
     sy.add_argument("--mismatch", action="store_true",
                     help="make the data with a spindle that differs from the spec (films, "

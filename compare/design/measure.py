@@ -64,7 +64,7 @@ class Measure:
 def _host_area_m2(spec: Spec, names: tuple[str, ...]) -> float:
     faces = exposed_faces(spec)
     return float(sum(f.area_m2 for s in spec.surfaces if s.name in names
-                     for f in surface_faces(s, faces)))
+                     for f in surface_faces(s, faces, spec)))
 
 
 def apply_measure(spec: Spec, measure: Measure | None) -> Spec:

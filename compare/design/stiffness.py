@@ -78,7 +78,7 @@ def surface_films(spec: Spec, speed_rpm: float) -> list[SurfaceFilm]:
     simplified formulas' sum(alpha_i A_i) runs over (coolant jacket included)."""
     faces = exposed_faces(spec)
     return [SurfaceFilm(s.name, str(s.T_ref), s.h_W_m2K(speed_rpm),
-                        float(sum(f.area_m2 for f in surface_faces(s, faces))))
+                        float(sum(f.area_m2 for f in surface_faces(s, faces, spec))))
             for s in spec.surfaces if s.h_W_m2K is not None]
 
 

@@ -25,13 +25,16 @@ WHERE_IN_SPEC = {
                          "bearing sets: viscosity, pitch diameter, lubrication)",
     "rotor_share": "the rotor's share of the motor losses in the drive file "
                    "([motor] rotor_loss_share)",
-    "h_coolant": "the coolant-jacket films (surfaces with T_ref = \"coolant\") and the "
-                 "stator-to-jacket conduction path (stator material, its contact to the sleeve)",
+    "h_coolant": "the coolant-jacket films (surfaces with T_ref = \"coolant\": the flow, the "
+                 "channel's hydraulic diameter, the correlation)",
     "h_air": "the housing's films to the ambient air (surfaces with T_ref = \"ambient\" on the "
              "housing)",
     "h_rotating": "the rotating surfaces' film correlation (shaft and tool surfaces, "
                   "correlation d_m)",
     "contact": "the fitted-joint contact conductances ([[links]] kind = \"contact\", h_W_m2K)",
+    "stator_contact": "the stator's contact to the cooling sleeve ([[links]] kind = \"contact\" "
+                      "with the stator, h_W_m2K) and the winding's conduction to the core "
+                      "(the stator's k_W_mK)",
     "alpha_eff": "the expansion coefficients of the growth chain's materials (alpha_1_K) and "
                  "the P1 sensor's position",
     "heat_capacity": "the parts' volumes and materials (rho_kg_m3, c_J_kgK): the thermal mass "

@@ -458,7 +458,7 @@ def lr_test(before: Fit, after: Fit) -> tuple[float, float]:
 
 #: effects with an instantaneous signature, judged on the run's events where a test applies
 #: (compare.fit.events) rather than on the open-loop fit, whose slow misfit they cannot mimic
-EVENT_EFFECTS = ("centrifugal_shortening", "sensor_lag")
+EVENT_EFFECTS = ("centrifugal_shortening", "sensor_lag", "bearing_preload", "windage_loss")
 
 
 def event_supported(events: Mapping[str, EventTest], alpha: float
@@ -468,9 +468,10 @@ def event_supported(events: Mapping[str, EventTest], alpha: float
     applies, at alpha over their number (Bonferroni: one lag is looked for in several
     channels). (effect, lag channel, test) in that order."""
     out: list[tuple[str, str | None, EventTest]] = []
-    c = events.get("centrifugal_shortening")
-    if c is not None and c.significant(alpha):
-        out.append(("centrifugal_shortening", None, c))
+    for name in ("centrifugal_shortening", "bearing_preload", "windage_loss"):
+        c = events.get(name)
+        if c is not None and c.significant(alpha):
+            out.append((name, None, c))
     lags = [t for k, t in events.items() if k.startswith("sensor_lag(")
             and math.isfinite(t.p_value)]
     if lags:
@@ -491,6 +492,9 @@ def _accept_events(cal: Calibrator, current: Fit, events: Mapping[str, EventTest
         start = dict(current.theta)
         if par:
             start[par["name"]] = cal.set_event_prior(par["name"], par["value"], par["ci95"])
+        else:  # no estimate from the event: start inside the range (not on the neutral bound)
+            for p in EFFECTS[name].params:
+                start[p.name] = p.lo + 0.1 * (p.hi - p.lo) if p.lo >= 0 else 0.1 * p.hi
         v0 = current.validation_score()
         full = cal.fit(current.effects + (name,), start=start,
                        lag_channel=channel or current.lag_channel)
@@ -504,12 +508,62 @@ def _accept_events(cal: Calibrator, current: Fit, events: Mapping[str, EventTest
     return current
 
 
+def at_bound(fit: Fit, effect: str, rel: float = 1e-3) -> list[str]:
+    """The parameters of ``effect`` whose calibrated value lies on the bound of its range away
+    from the neutral value (within ``rel`` of the range)."""
+    out = []
+    for p in EFFECTS[effect].params:
+        v, tol = fit.theta[p.name], rel * (p.hi - p.lo)
+        if (p.hi != p.default and v >= p.hi - tol) or (p.lo != p.default and v <= p.lo + tol):
+            out.append(p.name)
+    return out
+
+
+class _Judge:
+    """Whether a refitted candidate qualifies in the open-loop loop of
+    :func:`forward_selection`: (ok, validation excess after, needed by, parameters on a
+    bound, (cross-validated score before, after) or None)."""
+
+    def __init__(self, cal: Calibrator, current: Fit, alpha: float, min_gain: float,
+                 cv_blocks: int, cv_gain: float):
+        self.cal, self.current, self.alpha = cal, current, alpha
+        self.min_gain, self.cv_blocks, self.cv_gain = min_gain, cv_blocks, cv_gain
+        self.x0, self.v0 = cal.validation_excess(current), current.validation_score()
+        self.odd0 = cal.implausible(current, alpha)
+        self._cv_now: float | None = None
+
+    def __call__(self, name: str, full: Fit, pv: float) -> tuple:
+        cal = self.cal
+        x1 = cal.validation_excess(full)
+        # needed: it predicts the validation window better, or without it the base
+        # parameters sit outside their prior range and with it they do not
+        why = ("validation" if x1 < (1.0 - self.min_gain) * self.x0 else
+               "plausibility" if self.odd0 and cal.comfortable(full) else None)
+        # an estimate on its range's bound is not an estimate: the effect is taking up a
+        # misfit larger than it can physically be (not_identifiable in the report)
+        bound = at_bound(full, name)
+        ok = pv < self.alpha and why is not None and not bound
+        cv = None
+        if ok and self.cv_blocks:
+            # the split's validation window is one stretch of the run; over blocks of the
+            # whole run a sink for the base model's misfit predicts little better
+            if self._cv_now is None:
+                self._cv_now = cv_score(cross_validate(cal, self.current, self.cv_blocks))
+            cv = (self._cv_now, cv_score(cross_validate(cal, full, self.cv_blocks)))
+            ok = cv[1] <= (1.0 - self.cv_gain) * cv[0]
+        return ok, x1, why, bound, cv
+
+
 def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                       alpha: float = 0.01, base: Fit | None = None,
                       min_gain: float = 0.25, refit_top: int = 3,
                       screen_nfev: int = 12,
-                      events: Mapping[str, EventTest] | None = None) -> Selection:
-    """Bacher-Madsen forward selection over the candidate effects. With ``events`` (the
+                      events: Mapping[str, EventTest] | None = None,
+                      cv_blocks: int = 5, cv_gain: float = 0.15) -> Selection:
+    """Bacher-Madsen forward selection over the candidate effects. A candidate of the
+    open-loop loop that passes the likelihood-ratio test, is needed and lies inside its range
+    must also lower the blocked cross-validated error (``cv_blocks`` blocks; 0: not asked) by
+    ``cv_gain`` (15 %). With ``events`` (the
     run's event tests, compare.fit.events.event_tests) the event-signature effects are
     judged on them where a test applies: added first when it is significant, never
     otherwise."""
@@ -561,8 +615,8 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
         def gain(f: Fit, cur: Fit = current) -> float:
             return log_posterior_gain(cur, f)
 
-        x0, v0 = cal.validation_excess(current), current.validation_score()
-        odd0 = cal.implausible(current, alpha)
+        judge = _Judge(cal, current, alpha, min_gain, cv_blocks, cv_gain)
+        x0, v0, odd0 = judge.x0, judge.v0, judge.odd0
         refits = []
         for name, screen, lag_ch in sorted(screens, key=lambda s: -gain(s[1]))[:refit_top]:
             say(f"refitting with {name}" + (f" ({lag_ch})" if lag_ch else ""))
@@ -571,16 +625,11 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
             if gain(full) < gain(screen):  # the joint fit may stop early; keep the better
                 full = screen
             lr, pv = lr_test(current, full)
-            x1 = cal.validation_excess(full)
-            # needed: it predicts the validation window better, or without it the base
-            # parameters sit outside their prior range and with it they do not
-            why = ("validation" if x1 < (1.0 - min_gain) * x0 else
-                   "plausibility" if odd0 and cal.comfortable(full) else None)
-            ok = pv < alpha and why is not None
-            refits.append((ok, gain(full), name, full, lag_ch, lr, pv, x1, why))
+            ok, x1, why, bound, cv = judge(name, full, pv)
+            refits.append((ok, gain(full), name, full, lag_ch, lr, pv, x1, why, bound, cv))
         qualifying = [r for r in refits if r[0]]
         chosen = max(qualifying or refits, key=lambda r: r[1])
-        for ok, _g, name, full, lag_ch, _lr, pv, x1, why in refits:
+        for ok, _g, name, full, lag_ch, _lr, pv, x1, why, bound, cv in refits:
             tried.append({"effect": name, "channel": lag_ch, "round": len(steps) + 1,
                           "p_value": pv, "validation_before": v0,
                           "validation_after": full.validation_score(), "excess_before": x0,
@@ -588,11 +637,13 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                           "implausible_after": cal.implausible(full, alpha),
                           "prior_z_before": cal.prior_z(current),
                           "prior_z_after": cal.prior_z(full),
-                          "needed_by": why, "qualifies": ok,
+                          "needed_by": why, "at_bound": bound,
+                          "cv_before": None if cv is None else cv[0],
+                          "cv_after": None if cv is None else cv[1], "qualifies": ok,
                           "accepted": ok and full is chosen[3]})
         if not qualifying:
             break
-        _ok, _g, name, full, lag_ch, lr, pv, _x1, why = chosen
+        _ok, _g, name, full, lag_ch, lr, pv, _x1, why, _b, _cv = chosen
         steps.append(Step(name, full, lr, pv, full.bic() - current.bic(), v0,
                           full.validation_score(), why))
         current = full
@@ -642,6 +693,14 @@ def cross_validate(cal: Calibrator, fit: Fit, blocks: int = 5, max_nfev: int = 2
     total = {c: _error_row(c, np.concatenate(d)) for c, d in pooled.items()
              if sum(len(x) for x in d)}
     return {"blocks": blocks, "folds": folds, "pooled": total}
+
+
+def cv_score(cv: dict) -> float:
+    """The pooled cross-validated open-loop RMS of :func:`cross_validate`, in tolerance units,
+    averaged over the channels."""
+    rows = cv["pooled"]  # rmse in K, or in µm for P1
+    return float(np.mean([r["rmse"] / (TOLERANCE[c] * (1e6 if c == "P1" else 1.0))
+                          for c, r in rows.items()]))
 
 
 def _error_row(channel: str, d: np.ndarray) -> dict:

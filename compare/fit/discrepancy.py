@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from compare.fit.greybox import BASE_PARAMS, GreyBox, Inputs, default_theta
+from compare.fit.greybox import GreyBox, Inputs, base_params, default_theta
 from spindle.loads import LoadCase, TimeSeries
 from spindle.spec import Spec
 
@@ -92,7 +92,8 @@ def reference_channels(gb: GreyBox, channels: tuple[str, ...] | list[str], level
     driven by the grey box's inputs and its heat sources at the spec's parameter values."""
     from reference import ReferenceModel
 
-    src = gb.sources(BASE_PARAMS["f0"].default, BASE_PARAMS["rotor_share"].default)
+    spec_values = base_params(gb.drive)
+    src = gb.sources(spec_values["f0"].default, spec_values["rotor_share"].default)
     return fem_readings(ReferenceModel(gb.spec, level), gb.spec, gb.inputs, src, channels)
 
 
@@ -101,7 +102,7 @@ def fem_discrepancy(gb: GreyBox, channels: tuple[str, ...] | list[str], level: i
     """FEM minus lumped (``gb`` without effects, at the spec's values) on ``gb``'s inputs."""
     t0 = time.perf_counter()
     fem = reference_channels(gb, channels, level)
-    theta = default_theta(BASE_PARAMS)
+    theta = default_theta(base_params(gb.drive))
     plain = GreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, _cache=gb._cache)
     lumped = plain.simulate(theta)
     offsets = {c: fem[c] - lumped[c] for c in channels}

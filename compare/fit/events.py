@@ -341,10 +341,14 @@ def model_onsets(gb, theta: dict[str, float], channels, sub: int = 6) -> ModelOn
     return ModelOnsets(t, {c: out[c] for c in ratios}, steps, ratios)
 
 
-def event_tests(run, gb, theta: dict[str, float], channels) -> dict[str, EventTest]:
-    """The centrifugal test on P1 and the lag test of every measured channel, on the raw
-    samples of the bench run ``run`` (spindle.bench.BenchRun); keys ``centrifugal_shortening``
-    and ``sensor_lag(<channel>)``."""
+def event_tests(run, gb, theta: dict[str, float], channels, alpha: float = 0.01
+                ) -> dict[str, EventTest]:
+    """The centrifugal test on P1, the lag test of every measured channel, and the power
+    tests (compare.fit.power_events; ``alpha`` decides whether the power drifts), on the raw
+    samples of the bench run ``run`` (spindle.bench.BenchRun); keys ``centrifugal_shortening``,
+    ``sensor_lag(<channel>)``, ``bearing_preload`` and ``windage_loss``."""
+    from compare.fit.power_events import power_tests
+
     t, n = run.time_s, run.columns["speed_rpm"]
     steps = {sc.name: speed_steps(t, n, quiet_s=sc.quiet_s) for sc in ONSET_SCALES}
     out: dict[str, EventTest] = {}
@@ -362,4 +366,5 @@ def event_tests(run, gb, theta: dict[str, float], channels) -> dict[str, EventTe
                               "ci95": [onsets.lag_for_ratio(c, hi, sc),
                                        onsets.lag_for_ratio(c, lo, sc)]}
         out[f"sensor_lag({c})"] = test
+    out.update(power_tests(run, alpha, gb, theta))
     return out

@@ -15,7 +15,8 @@ How each parameter enters, on one :class:`reference.ReferenceModel` built once:
   :func:`compare.fit.discrepancy.load_case_from_inputs`;
 - ``h_coolant``, ``h_air``, ``h_rotating``: factors on the film coefficients h of the spec's
   surfaces, grouped as the grey box groups them (:func:`compare.fit.greybox.film_groups`);
-- ``contact``: a factor on the interface coefficient h_c of every contact link of the spec
+- ``contact`` and ``stator_contact``: factors on the interface coefficient h_c of the spec's
+  contact links, the second on those of the stator, the first on every other
   (``op.contacts`` holds exactly the spec's ContactLinks; the grey box's contact edges are
   the lumped edges between parts joined by a ContactLink, the same joints). Note that the
   lumped grey box multiplies its whole contact edge, interface *and* the solid conduction to
@@ -36,7 +37,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from compare.fit.greybox import BASE_PARAMS, GreyBox, Inputs, Param, film_groups
+from compare.fit.greybox import BASE_PARAMS, GreyBox, Inputs, Param, base_params, film_groups
 from spindle.drive import Drive
 from spindle.spec import Spec
 
@@ -78,7 +79,7 @@ class FemGreyBox:
         return self
 
     def parameters(self) -> dict[str, Param]:
-        return dict(BASE_PARAMS)
+        return base_params(self.drive)
 
     @property
     def fem_runs(self) -> int:
@@ -106,18 +107,20 @@ class FemGreyBox:
     def _apply(self, th: dict[str, float]) -> object:
         """Swap the film and contact coefficients for ``th``'s factors (PaperStudy.apply)."""
         ref, films, contacts, links = self._reference()
-        factors = tuple(float(th[k]) for k in ("h_coolant", "h_air", "h_rotating", "contact"))
+        names = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact")
+        factors = tuple(float(th[k]) for k in names)
         if self._cache.get("fem_applied") != factors:
-            f = dict(zip(("h_coolant", "h_air", "h_rotating", "contact"), factors, strict=True))
+            f = dict(zip(names, factors, strict=True))
+            stator = {p.name for p in self.spec.parts if p.role == "stator"}
             op = ref.thermal.op
             # a factor of exactly 1 keeps the spec's own object: the default point is then the
             # FEM reference of compare.fit.discrepancy bit for bit
             op.films = [(s if g is None or f[g] == 1.0 else
                          replace(s, h_W_m2K=s.h_W_m2K.scaled(f[g])), R, b)
                         for s, R, b, g in films]
-            op.contacts = [(lk if f["contact"] == 1.0 else
-                            replace(lk, h_W_m2K=lk.h_W_m2K * f["contact"]), C)
-                           for lk, C in contacts]
+            op.contacts = [(lk if f[g] == 1.0 else replace(lk, h_W_m2K=lk.h_W_m2K * f[g]), C)
+                           for lk, C in contacts
+                           for g in ["stator_contact" if set(lk.parts) & stator else "contact"]]
             op.links = list(links)  # no air-gap parameter in the grey box
             ref.thermal._lu.clear()  # the factorisations hold the old coefficients
             self._cache["fem_applied"] = factors
@@ -157,7 +160,7 @@ class FemGreyBox:
         parameters ``theta`` (missing names take their defaults)."""
         if x0_K is not None:
             raise ValueError("FemGreyBox starts from the inputs' start temperature only")
-        th = {k: float(theta.get(k, p.default)) for k, p in BASE_PARAMS.items()}
+        th = {k: float(theta.get(k, p.default)) for k, p in base_params(self.drive).items()}
         out = {c: v.copy() for c, v in self._thermal_run(th).items()}
         if "P1" in out:
             # the thermoelastic growth is linear in a uniform scale of the expansion

@@ -13,6 +13,7 @@ name                    meaning                                                b
 ``h_air``               factor on the housing-to-air film conductances         0.2 .. 5
 ``h_rotating``          factor on the rotating surfaces' film conductances     0.2 .. 5
 ``contact``             factor on the interface conductances of contact links  0.2 .. 5
+``stator_contact``      the same for the stator's contacts (to the sleeve)     0.1 .. 20
 ``alpha_eff``           factor on the expansion coefficients of the growth     0.5 .. 2
 ``heat_capacity``       factor on every heat capacity of the network           0.1 .. 3
 ``friction_exponent``   bearing friction x (n / 3000 rpm)^e                    -1 .. 1
@@ -36,13 +37,14 @@ from lumped.realtime import modal_recursion
 from lumped.simulation import LumpedModel
 from spindle.bench import interval_heat_W
 from spindle.drive import Drive
-from spindle.drive_file import FRICTION_REF_RPM
+from spindle.drive_file import FRICTION_REF_RPM, MOTOR_SOURCES
 from spindle.spec import Spec
 
 ROTATING = ("shaft", "tool", "rotor")
 #: the parameters that change the conductance matrix K (the others change sources or read-outs)
-_K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "heat_capacity", "R_adv_K_W",
-             "G_mount_W_K", "k_preload_1_K")
+_K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact", "heat_capacity",
+             "R_adv_K_W",
+             "G_mount_W_K", "k_preload_1_K", "k_preload_rear_1_K")
 CHANNELS = ("T1", "T2", "T_stator", "P1")
 
 
@@ -68,7 +70,12 @@ class Param:
 # losses moves with slip by about half, 0.4; Dittus-Boelter / Gnielinski for the jacket
 # +-25 %, 0.25; natural and mixed convection correlations on the housing +-35 %, 0.35;
 # rotating-surface correlations +-50 %, 0.4; contact conductances scatter by a factor 2-4
-# between assemblies, 0.7; expansion coefficients of steels +-10 %, 0.1. Two more freedoms
+# between assemblies, 0.7; the stator's fit to the cooling sleeve apart from them, 1.0: the
+# winding-to-jacket path (interference fit over a laminated stack, impregnation, the winding's
+# own conduction to the core) is the least known conductance of a motor spindle, with
+# interface coefficients quoted from a few hundred to several thousand W/(m2 K) (a factor
+# 10 at 2.3 sigma; a peer's SPL2782-family runs call for the bound of 20, issue 13);
+# expansion coefficients of steels +-10 %, 0.1. Two more freedoms
 # for a spindle its spec describes only approximately (issue 13, ``fit --base-extra``; a
 # peer's SPL2782-family runs need both): the effective heat capacity, since how much of the
 # CAD masses takes part on a cycle's time scales depends on contacts and films the spec only
@@ -76,6 +83,7 @@ class Param:
 # friction, Palmgren's (nu n)^(2/3) law being an average over lubrication regimes (exponent
 # shift 0.5 at 1 sigma, per Harris's spread of measured friction-speed curves).
 BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
+    # defaults of f0 and rotor_share: placeholders; a model takes the drive's (base_params)
     Param("f0", "-", 0.30, 0.05, 3.0, "Palmgren bearing friction factor of all pairs",
           prior_sd=0.4),
     Param("rotor_share", "-", 0.06, 0.01, 0.5, "rotor share of the motor losses", prior_sd=0.4),
@@ -87,6 +95,8 @@ BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
           prior_sd=0.4),
     Param("contact", "x", 1.0, 0.2, 5.0, "factor on the contact-link interface conductances",
           prior_sd=0.7),
+    Param("stator_contact", "x", 1.0, 0.1, 20.0, "factor on the contact conductances of the "
+          "stator (its fit to the cooling sleeve: the winding-to-jacket path)", prior_sd=1.0),
     Param("alpha_eff", "x", 1.0, 0.5, 2.0, "factor on the expansion coefficients of the "
           "thermoelastic chain (effective expansion coefficient)", prior_sd=0.1),
 )}
@@ -101,6 +111,21 @@ EXTRA_BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
           f"(n / {FRICTION_REF_RPM:g} rpm)^e: its speed dependence beyond Palmgren's",
           log=False, prior_sd=0.5),
 )}
+
+
+def base_params(drive: Drive) -> dict[str, Param]:
+    """:data:`BASE_PARAMS` with the spec's own values of the drive's parameters as defaults
+    (prior centres): f0 of its bearing sets (when they share one; else the default stands)
+    and the rotor's share of the motor loss."""
+    from dataclasses import replace as dc_replace
+
+    out = dict(BASE_PARAMS)
+    f0s = {float(b.f0) for b in drive.bearings.values()}
+    if len(f0s) == 1:
+        out["f0"] = dc_replace(out["f0"], default=f0s.pop())
+    out["rotor_share"] = dc_replace(out["rotor_share"],
+                                    default=float(drive.motor.rotor_loss_share))
+    return out
 
 
 @dataclass(frozen=True)
@@ -125,9 +150,12 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
            "The inner ring runs warmer than the outer ring; the difference expands the inner "
            "ring more and raises the preload of the angular-contact pairs, so the friction "
            "heat rises with the shaft-housing temperature difference (a thermal feedback).",
-           (Param("k_preload_1_K", "1/K", 0.0, 0.0, 0.2,
-                  "relative rise of the bearing friction per K of inner-outer ring difference",
-                  log=False),)),
+           (Param("k_preload_1_K", "1/K", 0.0, 0.0, 1.0,
+                  "relative rise of the front bearing's friction per K of its inner-outer "
+                  "ring difference", log=False),
+            Param("k_preload_rear_1_K", "1/K", 0.0, 0.0, 1.0,
+                  "the same for the rear bearing (often spring-preloaded and floating, where "
+                  "it stays near 0)", log=False))),
     Effect("fixture_expansion",
            "The eddy-current sensor's holder is fixed to the housing's outside and moves with "
            "the air temperature, so P1 carries a term proportional to the ambient change.",
@@ -150,7 +178,7 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
     Effect("mount_conduction",
            "Heat leaves the housing through its mounting flange into the machine structure, "
            "which stays near the room temperature.",
-           (Param("G_mount_W_K", "W/K", 0.0, 0.0, 20.0,
+           (Param("G_mount_W_K", "W/K", 0.0, 0.0, 200.0,
                   "conductance from the housing's front face to the structure", log=False),)),
 )}
 
@@ -208,7 +236,7 @@ class GreyBox:
                        lag_channel, self._cache, self.discrepancy, self.base_extra)
 
     def parameters(self) -> dict[str, Param]:
-        out = dict(BASE_PARAMS)
+        out = base_params(self.drive)
         out.update({k: EXTRA_BASE_PARAMS[k] for k in self.base_extra})
         for e in self.effects:
             for p in EFFECTS[e].params:
@@ -272,6 +300,8 @@ class GreyBox:
             c = net.network.add(Convection("mount", Gc_W_K=1.0))  # set per parameter set
             net.network.connect(hous.masses[-1].block.port, c.port_a)
             net.network.connect(c.port_b, amb.port)
+        drag = (_preload_drag_flows(net) if "bearing_preload" in self.effects
+                and self.power_measured else [])
         model = LumpedModel(self.spec, network=net)
         groups = film_groups(self.spec)
         edge_group: list[str | None] = []
@@ -280,21 +310,66 @@ class GreyBox:
             if name.startswith("film:"):
                 edge_group.append(groups[name.split(":")[1]])
             elif name.startswith("contact:") and _is_contact_link(self.spec, name):
-                edge_group.append("contact")
+                edge_group.append("stator_contact" if _touches_stator(self.spec, name)
+                                  else "contact")
             else:
                 edge_group.append(None)
             adv = k if name == "coolant_advection" else adv
             mount = k if name == "mount" else mount
-        preload = [f for _, f in model.system.flows if f.across is not None]
-        self._cache[key] = (model, edge_group, preload, adv, mount)
+        preload = [(f, _preload_param(self.spec, f.source)) for _, f in model.system.flows
+                   if f.across is not None and not f.name.startswith("preload_drag")]
+        self._cache[key] = (model, edge_group, preload, adv, mount, drag)
         return self._cache[key]
+
+    def _p1(self, th: dict[str, float], growth_m: np.ndarray) -> np.ndarray:
+        """P1 [m] from the chain's growth at the grid points (expansion at alpha_eff = 1), with
+        the read-out effects, zeroed at the start as the bench zeroes it."""
+        inp = self.inputs
+        p1 = th["alpha_eff"] * growth_m
+        n_end = np.concatenate([[inp.speed_rpm[0]], inp.speed_rpm])  # speed over the step
+        if "centrifugal_shortening" in self.effects:
+            p1 = p1 - th["c_cf_um_krpm2"] * 1e-6 * (n_end / 1000.0) ** 2
+        if "fixture_expansion" in self.effects:
+            T_env = np.concatenate([[inp.T_env_K[0]], inp.T_env_K])
+            p1 = p1 + th["k_fix_um_K"] * 1e-6 * (T_env - T_env[0])
+        return p1 - p1[0]
+
+    def ring_drag_W(self, theta: dict[str, float]) -> dict[str, np.ndarray]:
+        """Per bearing heat source with rings: q_b (T_inner - T_outer) [W] at the grid points
+        (the interval's heat held), the extra friction a preload of 1/K would add: what the
+        power test (compare.fit.power_events) compares its measured drift with."""
+        model = self._structure()[0]
+        net = model.net
+        rows, names = {}, []
+        for src in self.spec.heat_sources:
+            if src.part is not None and net.parts[src.part].ring:
+                inner, outer = net.parts[src.part].masses
+                r = np.zeros(model.system.n_states)
+                r[inner.index], r[outer.index] = 1.0, -1.0
+                rows[f"ring:{src.name}"] = r
+                names.append(src.name)
+        out = self.simulate(theta, extra_rows=rows)
+        spec_values = base_params(self.drive)
+        src = self.sources(theta.get("f0", spec_values["f0"].default),
+                           theta.get("rotor_share", spec_values["rotor_share"].default),
+                           theta.get("friction_exponent", 0.0))
+        res = {}
+        for n in names:
+            q = np.concatenate([src[n][:1], src[n]])  # the heat of the interval ending here
+            res[n] = q * out[f"ring:{n}"]
+        return res
+
+    @property
+    def power_measured(self) -> bool:
+        """Whether the inputs carry a measured electrical power (a bench run)."""
+        return bool(np.isfinite(np.asarray(self.inputs.power_kW, dtype=float)).any())
 
     def _model(self, theta: dict[str, float]) -> LumpedModel:
         """The structure's model with this parameter set's conductances (a new
         ThermalSystem over the same network; nothing is rebuilt)."""
         from dataclasses import replace as dc_replace
 
-        model, edge_group, preload, adv, mount = self._structure()
+        model, edge_group, preload, adv, mount, drag = self._structure()
         base = model.system
         edges = []
         for k, (i, j, G, name) in enumerate(base.edges):
@@ -307,8 +382,13 @@ class GreyBox:
             if k == mount:
                 G = theta.get("G_mount_W_K", 0.0)
             edges.append((i, j, G, name))
-        for f in preload:
-            f.tc_1_K = theta.get("k_preload_1_K", 0.0)
+        for f, name in preload:
+            f.tc_1_K = theta.get(name, 0.0)
+        rs = theta["rotor_share"]
+        for neg, pos, motor_source, share in drag:
+            w = share * (rs if motor_source == "rotor" else 1.0 - rs)
+            neg.share, pos.share = -w, w
+            neg.tc_1_K = theta.get(_preload_param(self.spec, neg.source), 0.0)
         # systems (and their cached modes) are kept per set of the parameters that enter K:
         # a Jacobian column for a source or read-out parameter reuses them
         # (not with a bearing preload: its flows are shared and set per call, and its steps
@@ -330,10 +410,12 @@ class GreyBox:
         out.system = system
         return out
 
-    def simulate(self, theta: dict[str, float], x0_K: float | None = None
-                 ) -> dict[str, np.ndarray]:
+    def simulate(self, theta: dict[str, float], x0_K: float | None = None,
+                 extra_rows: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
         """Channel values at the grid points [K; m for P1] for parameters ``theta`` (missing
-        names take their defaults). Zero-order hold over each interval, exact."""
+        names take their defaults). Zero-order hold over each interval, exact.
+        ``extra_rows``: more read-outs, each a row over the model's states (mass
+        temperatures), returned under their names."""
         params = self.parameters()
         th = {k: theta.get(k, p.default) for k, p in params.items()}
         model = self._model(th)
@@ -341,12 +423,11 @@ class GreyBox:
         inp = self.inputs
         src = self.sources(th["f0"], th["rotor_share"], th.get("friction_exponent", 0.0))
         n_int = len(inp.grid_s) - 1
+        if "windage_loss" in self.effects:
+            src = windage_from_motor(src, th["c_w_W_krpm3"], inp.speed_rpm, inp.power_kW)
         cols = []
         for name in sys.source_names:
-            if name == "windage":
-                cols.append(th.get("c_w_W_krpm3", 0.0) * (inp.speed_rpm / 1000.0) ** 3)
-            else:
-                cols.append(src[name] if name in src else np.zeros(n_int))
+            cols.append(src[name] if name in src else np.zeros(n_int))
         for f in sys.fixed_sources:
             cols.append(inp.T_env_K if f == "ambient" else inp.T_coolant_K)
         U = np.column_stack(cols)
@@ -358,6 +439,8 @@ class GreyBox:
         has_p1 = "P1" in model.chain.rows
         if has_p1:
             rows.append(model.chain.rows["P1"])
+        extra = dict(extra_rows or {})
+        rows.extend(extra.values())
         readout = np.array(rows)
         Y = np.empty((n_int + 1, len(rows)))
         Y[0] = readout @ x
@@ -382,15 +465,11 @@ class GreyBox:
                     Y[i + 1] = readout @ x
             k = j
         out: dict[str, np.ndarray] = {n: Y[:, i] for i, n in enumerate(names)}
+        if extra:
+            out.update({n: Y[:, len(rows) - len(extra) + i] for i, n in enumerate(extra)})
+            Y = Y[:, :len(rows) - len(extra)]
         if has_p1:
-            p1 = th["alpha_eff"] * (Y[:, -1] - model.chain.T_ref * model.chain.rows["P1"].sum())
-            n_end = np.concatenate([[inp.speed_rpm[0]], inp.speed_rpm])  # speed over the step
-            if "centrifugal_shortening" in self.effects:
-                p1 = p1 - th["c_cf_um_krpm2"] * 1e-6 * (n_end / 1000.0) ** 2
-            if "fixture_expansion" in self.effects:
-                T_env = np.concatenate([[inp.T_env_K[0]], inp.T_env_K])
-                p1 = p1 + th["k_fix_um_K"] * 1e-6 * (T_env - T_env[0])
-            out["P1"] = p1 - p1[0]  # relative to the start, as the bench zeroes P1
+            out["P1"] = self._p1(th, Y[:, -1] - model.chain.T_ref * model.chain.rows["P1"].sum())
         for c, d in (self.discrepancy or {}).items():
             if c in out:  # before the lag: a lagging sensor lags the whole signal
                 out[c] = out[c] + d
@@ -398,6 +477,68 @@ class GreyBox:
             out[self.lag_channel] = first_order_lag(inp.grid_s, out[self.lag_channel],
                                                     th["tau_s"])
         return out
+
+
+def windage_from_motor(sources_W: dict[str, np.ndarray], c_W_krpm3: float,
+                       speed_rpm: np.ndarray, power_kW: np.ndarray) -> dict[str, np.ndarray]:
+    """The heat sources [W] per interval with a windage loss c (n / 1000 rpm)^3 [W] into the
+    rotor (source ``windage``).
+
+    Windage is a drag torque the motor supplies, so where the electrical power is measured it
+    is already in it: the power balance, which knows no windage, booked it as motor loss. There
+    the windage heat is taken from the motor sources (stator and rotor in proportion; at most
+    what they hold), and the total heat stays the measured one. Where the power is not
+    measured (nan: a cycle's motor model gives the losses) it comes on top."""
+    w = c_W_krpm3 * (np.asarray(speed_rpm, dtype=float) / 1000.0) ** 3
+    measured = ~np.isnan(np.asarray(power_kW, dtype=float))
+    motor = [k for k in MOTOR_SOURCES if k in sources_W]
+    out = dict(sources_W)
+    if motor and measured.any():
+        total = sum(sources_W[k] for k in motor)
+        take = np.where(measured, np.minimum(w, total), 0.0)
+        keep = np.divide(total - take, total, out=np.ones_like(total), where=total > 0)
+        for k in motor:
+            out[k] = sources_W[k] * keep
+        w = np.where(measured, take, w)
+    out["windage"] = w
+    return out
+
+
+def _preload_param(spec: Spec, source: str) -> str:
+    """The preload parameter of a bearing heat source: the front set's or the rear's."""
+    src = next(h for h in spec.heat_sources if h.name == source)
+    return ("k_preload_rear_1_K" if spec.part(src.part).role == "rear_bearing"
+            else "k_preload_1_K")
+
+
+def _preload_drag_flows(net) -> list[tuple]:
+    """Heat flows that take a bearing preload's extra friction out of the motor sources.
+
+    On a bench the motor supplies the extra friction torque, so the measured electrical power
+    already holds the extra heat, which the power balance (knowing no preload) booked as motor
+    loss. For each bearing with rings and each motor-source flow (share s of its source): a flow
+    -s w q_b (1 + k (T_in - T_out)) and a flow +s w q_b, which together take s w q_b k (T_in -
+    T_out) from that motor mass (w the source's fraction of the motor loss, set per parameter
+    set; k set with the preload's own flows). Returns (negative flow, constant flow, motor
+    source, s) per pair."""
+    masses = {m.name: m for pm in net.parts.values() for m in pm.masses}
+    motor = [b for b in net.network.blocks
+             if isinstance(b, PrescribedHeatFlow) and b.source in MOTOR_SOURCES]
+    rings = [(src.name, net.parts[src.part].masses) for src in net.spec.heat_sources
+             if src.part is not None and net.parts[src.part].ring]
+    out = []
+    for bearing, (inner, outer) in rings:
+        for f in motor:
+            mass = masses[f.name.split(":", 2)[2]]
+            neg = net.network.add(PrescribedHeatFlow(
+                f"preload_drag:{bearing}:{mass.name}", source=bearing, share=0.0, tc_1_K=0.0,
+                across=(inner.block.port, outer.block.port)))
+            pos = net.network.add(PrescribedHeatFlow(
+                f"preload_drag_base:{bearing}:{mass.name}", source=bearing, share=0.0))
+            net.network.connect(mass.block.port, neg.port)
+            net.network.connect(mass.block.port, pos.port)
+            out.append((neg, pos, f.source, f.share))
+    return out
 
 
 def film_groups(spec: Spec) -> dict[str, str]:
@@ -420,6 +561,12 @@ def _is_contact_link(spec: Spec, block_name: str) -> bool:
     a, b = block_name.split(":", 1)[1].split("-", 1)
     pa, pb = a.split("[")[0].split(".")[0], b.split("[")[0].split(".")[0]
     return any(isinstance(lk, ContactLink) and set(lk.parts) == {pa, pb} for lk in spec.links)
+
+
+def _touches_stator(spec: Spec, block_name: str) -> bool:
+    a, b = block_name.split(":", 1)[1].split("-", 1)
+    parts = {a.split("[")[0].split(".")[0], b.split("[")[0].split(".")[0]}
+    return any(spec.part(p).role == "stator" for p in parts)
 
 
 def _scaled(G, factor: float):

@@ -475,33 +475,39 @@ def diagnose(residuals: Mapping[str, Any], dt_s: float,
 
 
 # ------------------------------------------------------------------------------- 7. plots
-def plot_acf(ax: Any, r: Any, nlags: int, alpha: float = 0.05, dt_s: float | None = None) -> Any:
-    """Draw the ACF (stems) and its ±z/sqrt(n) white-noise band on ``ax``; lags in samples, or in
-    s with ``dt_s``. Returns ``ax``."""
+def plot_acf(ax: Any, r: Any, nlags: int, alpha: float = 0.05, dt_s: float | None = None,
+             color: str = "C0", label: str | None = None, band: bool = True) -> Any:
+    """Draw the ACF (stems, in ``color``, labelled ``label``) and, with ``band``, its
+    ±z/sqrt(n) white-noise band on ``ax``; lags in samples, or in s with ``dt_s``. Draw a
+    second residual on the same axes with another colour and ``band=False``. Returns ``ax``."""
     rho = acf(r, nlags)
     half = acf_band(int(np.isfinite(_as_series(r)).sum()), alpha)
     k = np.arange(nlags + 1) * (dt_s or 1)
-    ax.vlines(k, 0.0, rho, color="C0", lw=1.2)
-    ax.plot(k, rho, "o", color="C0", ms=3)
-    ax.axhline(0.0, color="k", lw=0.6)
-    for s in (-1, 1):
-        ax.axhline(s * half, color="C3", ls="--", lw=0.9,
-                   label=f"{_pct(alpha)} white-noise band" if s > 0 else None)
+    ax.vlines(k, 0.0, rho, color=color, lw=1.2, alpha=0.8)
+    ax.plot(k, rho, "o", color=color, ms=3, label=label)
+    if band:
+        ax.axhline(0.0, color="k", lw=0.6)
+        for s in (-1, 1):
+            ax.axhline(s * half, color="C3", ls="--", lw=0.9,
+                       label=f"{_pct(alpha)} white-noise band" if s > 0 else None)
     ax.set_xlabel("lag [s]" if dt_s else "lag [samples]")
     ax.set_ylabel("autocorrelation [-]")
     ax.legend(loc="upper right")
     return ax
 
 
-def plot_cumulated_periodogram(ax: Any, r: Any, alpha: float = 0.05, dt_s: float = 1.0) -> Any:
-    """Draw the cumulated periodogram, the white-noise diagonal and its KS band on ``ax``
-    (frequency in Hz). Returns ``ax``."""
-    freqs, c, band = cumulated_periodogram(r, dt_s, alpha)
+def plot_cumulated_periodogram(ax: Any, r: Any, alpha: float = 0.05, dt_s: float = 1.0,
+                               color: str = "C0", label: str = "cumulated periodogram",
+                               band: bool = True) -> Any:
+    """Draw the cumulated periodogram (in ``color``) and, with ``band``, the white-noise
+    diagonal and its KS band on ``ax`` (frequency in Hz). Returns ``ax``."""
+    freqs, c, ks = cumulated_periodogram(r, dt_s, alpha)
     diag = np.arange(1, c.size + 1) / c.size
-    ax.step(freqs, c, where="post", color="C0", lw=1.2, label="cumulated periodogram")
-    ax.plot(freqs, diag, color="k", lw=0.7, label="white noise")
-    ax.plot(freqs, band[0], color="C3", ls="--", lw=0.9, label=f"{_pct(alpha)} KS band")
-    ax.plot(freqs, band[1], color="C3", ls="--", lw=0.9)
+    ax.step(freqs, c, where="post", color=color, lw=1.2, label=label)
+    if band:
+        ax.plot(freqs, diag, color="k", lw=0.7, label="white noise")
+        ax.plot(freqs, ks[0], color="C3", ls="--", lw=0.9, label=f"{_pct(alpha)} KS band")
+        ax.plot(freqs, ks[1], color="C3", ls="--", lw=0.9)
     ax.set_xlim(0.0, freqs[-1])
     ax.set_ylim(0.0, 1.0)
     ax.set_xlabel("frequency [Hz]")

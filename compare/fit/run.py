@@ -18,7 +18,7 @@
 from __future__ import annotations
 
 import html
-import json
+import math
 import time
 import warnings
 from collections.abc import Callable
@@ -46,6 +46,7 @@ from compare.fit.greybox import (
     EXTRA_BASE_PARAMS,
     GreyBox,
     Inputs,
+    base_params,
     default_theta,
 )
 from compare.report import html_figure, html_page, html_table
@@ -168,7 +169,7 @@ class FitReport:
             "candidates_tried": sel.tried,
             "fem_anchor": None if self.anchor is None else {
                 "fem_level": self.anchor.fem_level,
-                "prior_centre": default_theta(BASE_PARAMS),
+                "prior_centre": default_theta(base_params(drive_for(self.spec))),
                 # where FEM = anchored lumped: the spec's values, or with --model fem the
                 # FEM-calibrated base parameters
                 "anchored_at": self.anchor.theta_ref,
@@ -269,7 +270,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         say("calibrating the base model")
         _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref})
     say("reading the events (speed steps) of the raw samples")
-    events = event_tests(run, cal.gb, base.theta, channels)
+    events = event_tests(run, cal.gb, base.theta, channels, alpha)
     sel = forward_selection(cal, candidates, alpha, base=base, min_gain=min_gain, events=events)
     final = sel.final
     for fit in (sel.base, final):  # nothing impossible is written (issue 14)
@@ -364,7 +365,7 @@ def _calibrate_on_fem(cal: Calibrator, fem_level: int, say: Callable[[str], None
     t0 = time.perf_counter()
     gb = cal.gb
     channels = list(cal.channels)
-    theta_spec = default_theta(BASE_PARAMS)
+    theta_spec = default_theta(base_params(gb.drive))
     plain = GreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, _cache=gb._cache)
     say(f"building the FEM reference (level {fem_level}) for the calibration")
     fem = FemGreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, fem_level,
@@ -504,16 +505,21 @@ def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
         rb = (rep.measured.values[c] - sel.base.model[c]) / TOLERANCE[c]
         ra = (rep.measured.values[c] - sel.final.model[c]) / TOLERANCE[c]
         ax = axes[i, 0]
-        ax.plot(g, rb, lw=0.8, label="before")
-        ax.plot(g, ra, lw=0.8, label="after")
+        ax.plot(g, rb, lw=0.8, color="C0", label="before")
+        ax.plot(g, ra, lw=0.8, color="C1", label="after")
         ax.axhspan(-1, 1, color="0.9")
         ax.set_ylabel(f"{c} residual / tol")
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
-        for r in (rb, ra):
+        first = True
+        for r, colour, label in ((rb, "C0", "before"), (ra, "C1", "after")):
             if (~np.isnan(r)).sum() > 20:
-                plot_acf(axes[i, 1], r, 40, 0.01, dt)
-                plot_cumulated_periodogram(axes[i, 2], r, 0.01, dt)
+                plot_acf(axes[i, 1], r, 40, 0.01, dt, color=colour, label=label, band=first)
+                plot_cumulated_periodogram(axes[i, 2], r, 0.01, dt, color=colour, label=label,
+                                           band=first)
+                first = False
+        axes[i, 1].legend(fontsize=7, loc="upper right")
+        axes[i, 2].legend(fontsize=7, loc="lower right")
         axes[i, 1].set_title(f"{c}: ACF (before, after)", fontsize=9)
         axes[i, 2].set_title(f"{c}: cumulated periodogram (before, after)", fontsize=9)
     atomic_write(out / "fit_residuals.png", lambda tmp: fig.savefig(tmp, dpi=110))
@@ -552,11 +558,7 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
                            "within tolerance [%]"], rows,
                           ["s", "s", ".3f", ".3f", "+.3f", "s", ".1f"])
 
-    eff = "".join(f"<li><b>{html.escape(e['name'])}</b> ({html.escape(str(e['parameters']))}; "
-                  f"p = {e['p_value']:.2g}, ΔBIC = {e['delta_bic']:.1f}; needed by "
-                  f"{html.escape(e['needed_by'])}): "
-                  f"{html.escape(e['explanation'])}</li>" for e in doc["effects"]) \
-        or "<li>none accepted</li>"
+    eff = _effects_html(doc)
     anchor = doc.get("fem_anchor")
     if anchor and rep.calibration_model == "fem":
         z = {k: v for k, v in (doc["parameters_prior_z"] or {}).items()}
@@ -595,18 +597,99 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
     unexpl = doc["unexplained"]
     return html_page("spindle-verify fit", [
         f"<h1>Fit of {html.escape(str(rep.run.path))} to {html.escape(rep.spec.name)}</h1>",
-        f"<p>Channels {rep.channels}; validation window {_spans_text(rep.measured)}, the "
+        f"<p>Channels {', '.join(rep.channels)}; validation window "
+        f"{_spans_text(rep.measured)}, the "
         f"rest fits; likelihood-ratio level {rep.alpha:g}; {rep.runtime_s:.1f} s.</p>",
         _cv_html(doc),
         anchor_html,
         _adequacy_html(doc),
-        "<h2>Effects accepted (in order)</h2><ul>" + eff + "</ul>",
+        "<h2>Effects accepted (in order)</h2>" + eff,
+        _events_html(doc),
         f"<p><b>Unexplained:</b> {'yes' if unexpl['unexplained'] else 'no'}. "
         f"{html.escape(unexpl['description'])}</p>",
         "<h2>Error before</h2>" + err_table(doc["error_before"]),
-        "<h2>Error after</h2>" + err_table(doc["error_after"]),
+        "<h2>Error after</h2>" + err_table(doc["error_after"])
+        + "".join(f"<p>{html.escape(n)}</p>" for n in error_notes(doc)),
         "<h2>Calibrated parameters (95 % intervals)</h2>" + params,
         *[html_figure(out / n, c) for n, c in pngs]])
+
+
+def error_notes(doc: dict) -> list[str]:
+    """Plain remarks where the validation error after the fit does not read one way: the RMS
+    fell but the largest error rose (or the other way round)."""
+    notes = []
+    before = doc["error_before"].get("validation", {})
+    for c, a in doc["error_after"].get("validation", {}).items():
+        b = before.get(c)
+        if not b or "rmse" not in a or "rmse" not in b:
+            continue
+        unit = a["unit"]
+        if a["rmse"] < b["rmse"] and a["max"] > b["max"]:
+            notes.append(f"{c}: the validation RMS fell ({b['rmse']:.3f} → {a['rmse']:.3f} "
+                         f"{unit}) but the largest error rose ({b['max']:.3f} → {a['max']:.3f} "
+                         f"{unit}): the final model follows the window better overall and "
+                         "misses more at its worst instant; the channel plot shows where.")
+        elif a["rmse"] > b["rmse"] and a["max"] < b["max"]:
+            notes.append(f"{c}: the largest validation error fell ({b['max']:.3f} → "
+                         f"{a['max']:.3f} {unit}) but the RMS rose ({b['rmse']:.3f} → "
+                         f"{a['rmse']:.3f} {unit}).")
+    return notes
+
+
+def p_text(p: float | None) -> str:
+    """A p-value as people read it (one below double precision's range is not 0)."""
+    if p is None or not math.isfinite(p):
+        return "n/a"
+    return "< 1e-300" if p < 1e-300 else f"{p:.2g}"
+
+
+def _effects_html(doc: dict) -> str:
+    """The accepted effects: each parameter with its value, 95 % interval and unit, the
+    evidence (the event test's statistic, or the likelihood-ratio test) and what needed it."""
+    from compare.fit.greybox import EFFECTS
+
+    if not doc["effects"]:
+        return "<p>None accepted.</p>"
+    units = {p.name: p.unit for e in EFFECTS.values() for p in e.params}
+    rows, notes = [], []
+    for e in doc["effects"]:
+        test = next((t for t in (doc.get("events") or {}).values()
+                     if e["needed_by"] == "event" and t["effect"] == e["name"]
+                     and (e["name"] != "sensor_lag"
+                          or t["channel"] == e["parameters"].get("channel"))), None)
+        evidence = (f"event test on {test['channel']}: z = {test['z'] or math.nan:.1f}, "
+                    f"p = {p_text(test['p_value'])}" if test else
+                    f"likelihood ratio: p = {p_text(e['p_value'])}, ΔBIC = {e['delta_bic']:.1f}")
+        for k, v in e["parameters"].items():
+            if not isinstance(v, int | float):
+                continue
+            lo, hi = e["confidence_intervals"].get(k, (math.nan, math.nan))
+            rows.append([e["name"], k, f"{v:.4g}", f"{lo:.4g} .. {hi:.4g}", units.get(k, ""),
+                         evidence, e["needed_by"]])
+        notes.append(f"<li><b>{html.escape(e['name'])}</b>: {html.escape(e['explanation'])}"
+                     "</li>")
+    return (html_table(["effect", "parameter", "value", "95 %", "unit", "evidence",
+                        "needed by"], rows, ["s"] * 7) + "<ul>" + "".join(notes) + "</ul>")
+
+
+def _events_html(doc: dict) -> str:
+    """Every event test of the raw samples: what it reads, its estimate and statistic, and
+    whether it applied to this run."""
+    events = doc.get("events") or {}
+    if not events:
+        return ""
+    rows = []
+    for label, t in events.items():
+        applies = t["p_value"] is not None and math.isfinite(t["p_value"])
+        rows.append([label, t["channel"],
+                     f"{t['estimate']:.4g} ± {t['se']:.2g}" if applies else "",
+                     t["unit"], f"{t['z']:.1f}" if applies else "", p_text(t["p_value"]),
+                     t["meaning"]])
+    return ("<h2>Event tests (raw samples)</h2><p>Effects with a signature the thermal "
+            "model's slow misfit cannot produce are judged on these alone where they apply "
+            "(docs/fit.md).</p>"
+            + html_table(["test", "channel", "estimate ± se", "unit", "z", "p", "what it reads"],
+                         rows, ["s"] * 7))
 
 
 def _adequacy_html(doc: dict) -> str:
@@ -644,9 +727,10 @@ def report_summary_text(rep: FitReport) -> str:
     for w in doc.get("warnings") or []:
         lines.append(f"  warning: {w}")
     for e in doc["effects"]:
-        lines.append(f"  effect {e['name']}: {json.dumps(e['parameters'])} "
-                     f"(p = {e['p_value']:.2g}, delta BIC {e['delta_bic']:.1f}, needed by "
-                     f"{e['needed_by']})")
+        pars = ", ".join(f"{k} = {v:.4g}" if isinstance(v, int | float) else f"{k} = {v}"
+                         for k, v in e["parameters"].items())
+        lines.append(f"  effect {e['name']}: {pars} (p = {p_text(e['p_value'])}, "
+                     f"delta BIC {e['delta_bic']:.1f}, needed by {e['needed_by']})")
     if not doc["effects"]:
         lines.append("  no effect accepted")
     lines.append(f"  unexplained: {doc['unexplained']['unexplained']}"
@@ -656,6 +740,7 @@ def report_summary_text(rep: FitReport) -> str:
         v = doc[key].get("validation", {})
         lines.append(f"  validation error {label}: " + ", ".join(
             f"{c} {e['rmse']:.3f} {e['unit']} rms / {e['max']:.3f} max" for c, e in v.items()))
+    lines += [f"  note: {n}" for n in error_notes(doc)]
     for key, label in (("base", "before"), ("final", "after")):
         pooled = (doc.get("cross_validation") or {}).get(key, {}).get("pooled")
         if pooled:

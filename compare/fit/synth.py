@@ -13,12 +13,14 @@ How each effect enters the reference:
   parts), scaled by a factor (the spl2782 shaft at 4300 rpm shortens only 0.26 µm; the scale
   stands for a more compliant rotor so that the effect is worth detecting);
 - ``bearing_preload``: bearing heat times (1 + k (T_inner - T_outer)) from the FEM's own ring
-  temperatures, by fixed-point iteration;
+  temperatures, by fixed-point iteration; the extra friction is a torque the motor supplies,
+  so the logged electrical power carries it too;
 - ``fixture_expansion``: P1 + k (T_env - T_env(0));
 - ``coolant_dynamics``: coolant temperature = supply + R Q_coolant(t) from the FEM's own heat
   into the coolant, by fixed-point iteration;
 - ``sensor_lag``: a first-order lag on T1 or P1;
-- ``windage_loss``: c (n / 1000)^3 W more into the rotor;
+- ``windage_loss``: c (n / 1000)^3 W more into the rotor, a drag the motor supplies (the
+  logged electrical power carries it, as a bench's does);
 - ``mount_conduction``: a conductance G from the housing's front face to ambient;
 - ``clean``: none; ``electronics_drift`` (outside the library, for the tests): a slow
   sinusoidal drift of the P1 electronics.
@@ -53,7 +55,8 @@ def draw_truth(effect: str, rng: np.random.Generator) -> dict:
     if effect == "centrifugal_shortening":
         return {"scale": float(rng.uniform(8.0, 15.0))}
     if effect == "bearing_preload":
-        return {"k_preload_1_K": float(rng.uniform(0.10, 0.20))}
+        k = float(rng.uniform(0.10, 0.20))  # both bearing sets alike
+        return {"k_preload_1_K": k, "k_preload_rear_1_K": k}
     if effect == "fixture_expansion":
         return {"k_fix_um_K": float(rng.choice([-1, 1]) * rng.uniform(0.8, 2.0))}
     if effect == "coolant_dynamics":
@@ -79,7 +82,7 @@ def _with_mount(spec: Spec, G_W_K: float) -> Spec:
     if not front:
         raise ValueError("mount_conduction needs a convective front face of the housing")
     s = front[0]
-    area = sum(f.area_m2 for f in surface_faces(s, faces))
+    area = sum(f.area_m2 for f in surface_faces(s, faces, spec))
     h = SpeedTable(s.h_W_m2K.speed_rpm, tuple(v + G_W_K / area for v in s.h_W_m2K.values))
     surfaces = tuple(replace(x, h_W_m2K=h) if x is s else x for x in spec.surfaces)
     return replace(spec, surfaces=surfaces)
@@ -89,7 +92,10 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
                   dt_s: float = 60.0) -> tuple[np.ndarray, dict[str, np.ndarray], dict]:
     """Times [s] and the channels T1, T2, T_stator [K], P1 [m] of the FEM with the effect, and
     the parts that follow the speed at once, by channel, as functions of the sample times [m]
-    (the centrifugal shortening; added by :func:`bench_rows` at the bench's own times)."""
+    (the centrifugal shortening; added by :func:`bench_rows` at the bench's own times). The
+    key ``"drag_W"`` of the latter, when present, is the extra mechanical power [W] the motor
+    supplies against the effect (windage, the preload's extra friction), which the logged
+    electrical power carries."""
     from reference import ReferenceModel
 
     T0 = float(case.T_ambient_K(0.0))
@@ -104,13 +110,22 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
                                                                        + extra),
                                                        src.interpolation)})
     ref = ReferenceModel(spec, level)
+    instant = {}
+    if effect == "windage_loss":
+        instant["drag_W"] = lambda ts: truth["c_w_W_krpm3"] * (
+            np.asarray(case.speed_rpm(ts), dtype=float) / 1000.0) ** 3
     if effect in ("coolant_dynamics", "bearing_preload"):
-        res, _ = _fixed_point(ref, case, effect, truth, dt_s, T0)
+        res, x, tx = _fixed_point(ref, case, effect, truth, dt_s, T0)
+        if effect == "bearing_preload":
+            bearings = [h for h in spec.heat_sources if h.part and spec.part(h.part).role
+                        in ("front_bearing", "rear_bearing")]
+            extra = sum(np.asarray(case.sources[h.name](tx)) * _k_preload(spec, h, truth) * dT
+                        for h, dT in zip(bearings, np.split(x, len(bearings)), strict=True))
+            instant["drag_W"] = lambda ts, tx=tx, extra=extra: np.interp(ts, tx, extra)
     else:
         res = ref.transient(case, dt_s, T0=T0)
     ch = {n: res.sensor(n) for n in ("T1", "T2", "T_stator") if n in res.names}
     ch["P1"] = res.growth_m["P1"].copy()
-    instant = {}
     if effect == "centrifugal_shortening":
         # the FEM's centrifugal part, scaled, follows the speed at once: it is evaluated at the
         # bench's own sample times (bench_rows), not interpolated from the model grid, where
@@ -127,6 +142,14 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
         ch["P1"] = ch["P1"] + truth["amplitude_um"] * 1e-6 * np.sin(
             2 * np.pi * t / (truth["period_h"] * 3600.0))
     return t, ch, instant
+
+
+def _k_preload(spec: Spec, source, truth: dict) -> float:
+    """The injected preload coefficient [1/K] of a bearing heat source (a truth written before
+    the rear coefficient existed holds one for both)."""
+    if spec.part(source.part).role == "rear_bearing":
+        return truth.get("k_preload_rear_1_K", truth["k_preload_1_K"])
+    return truth["k_preload_1_K"]
 
 
 def _anderson(G, x0: np.ndarray, tol: float, max_iter: int = 25, memory: int = 5
@@ -159,7 +182,7 @@ def _anderson(G, x0: np.ndarray, tol: float, max_iter: int = 25, memory: int = 5
 
 def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0: float,
                  tol_K: float = 1e-4):
-    """(result, fed-back input on the result's times [K]): the transient with the effect's
+    """(result, fed-back input [K], its times [s]): the transient with the effect's
     feedback from the FEM's own temperatures, solved to ``tol_K`` [K] on the fed-back input
     (the coolant's mean temperature, or each bearing's inner-outer ring difference)."""
     th = ref.thermal
@@ -194,7 +217,7 @@ def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0:
         parts = np.split(x, len(bearings))  # x: each bearing's ring difference [K]
         return case.with_sources({
             h.name: TimeSeries(tuple(t), tuple(np.asarray(case.sources[h.name](t))
-                                               * (1 + truth["k_preload_1_K"] * dT)))
+                                               * (1 + _k_preload(spec, h, truth) * dT)))
             for h, dT in zip(bearings, parts, strict=True)})
 
     def G(x: np.ndarray) -> np.ndarray:
@@ -214,7 +237,7 @@ def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0:
         x0 = np.concatenate([first.functionals[f"{h.part}.inner_ring"]
                              - first.functionals[f"{h.part}.outer_ring"] for h in bearings])
     x, _, _ = _anderson(G, x0, tol_K)
-    return ref.transient(with_input(x), dt_s, T0=T0), x
+    return ref.transient(with_input(x), dt_s, T0=T0), x, t
 
 
 def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, power_W,
@@ -233,7 +256,10 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
     t = t[(t < gap0) | (t > gap0 + 1200.0)]
     cols: dict[str, np.ndarray] = {"time_s": t}
     cols["speed_rpm"] = np.asarray(case.speed_rpm(t), dtype=float)
-    cols["power_kW"] = np.asarray(power_W(t), dtype=float) / 1e3 * (1 + rng.normal(0, 0.01, len(t)))
+    p_W = np.asarray(power_W(t), dtype=float)
+    if instant and "drag_W" in instant:
+        p_W = p_W + instant["drag_W"](t)
+    cols["power_kW"] = p_W / 1e3 * (1 + rng.normal(0, 0.01, len(t)))
     if torque_Nm is not None:
         cols["load_torque_Nm"] = np.asarray(torque_Nm(t), dtype=float)
     cols["T_env_C"] = np.asarray(case.T_ambient_K(t)) - ZERO_C_K

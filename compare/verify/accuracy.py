@@ -149,6 +149,7 @@ class AccuracyResult:
     def markdown(self) -> str:
         """The table as Markdown (without the ``kind`` column); runtimes to the millisecond."""
         t = self.table()
+        t["meets_tolerances"] = ["PASS" if v else "FAIL" for v in t["meets_tolerances"]]
         cols = [c for c in t if c != "kind"]
         fmts = [".3f" if c == "runtime_s" else ".3g" for c in cols]
         return markdown_table(cols, list(zip(*(t[c] for c in cols), strict=True)), fmts)
@@ -203,7 +204,7 @@ class AccuracyResult:
 
         plt = pyplot()
         if ax is None:
-            _, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
+            _, ax = plt.subplots(figsize=(10, 4.5), layout="constrained")
         sensors = [s for s in self.spec.temperature_sensors() if s.array == array]
         z = np.array([s.z for s in sensors]) * 1e3
         k = None
@@ -214,8 +215,10 @@ class AccuracyResult:
             v = np.asarray(e.sensors[n])
             return float(v[k] if k is not None else v) - ZERO_C_K
 
+        # the legend names the reference briefly; the tables carry its full description
+        short = self.reference_label.split(",")[0].split(" (")[0]
         ax.plot(z, [read(self.reference, s.name) for s in sensors], "k-", lw=2.5,
-                label=f"reference ({self.reference_label})")
+                label=f"reference ({short})")
         for e in self.entries:
             if not all(s.name in e.sensors for s in sensors):
                 continue
@@ -223,15 +226,18 @@ class AccuracyResult:
                 continue
             if e.kind == "fem" and e.level != 0:
                 continue
+            key = (e.kind, e.nodes if e.kind == "lumped" else e.level)
             ax.plot(z, [read(e, s.name) for s in sensors], "o--" if e.kind != "fem" else "s:",
-                    ms=4, lw=1, label=e.name + (f" ({e.preset})" if e.preset else ""))
+                    ms=4, lw=1, color=PROFILE_COLOURS.get(key),
+                    label=e.name + (f" ({e.preset})" if e.preset else ""))
         ax.set_xlabel("z [mm]")
         ax.set_ylabel("temperature [°C]")
         when = f" at t = {self.times_s[k] / 3600:.2f} h" if k is not None else ""
         ax.set_title(f"{self.spec.name}, {self.case_name}: the {len(sensors)} {array} sensors"
                      f"{when}", fontsize=9)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        # beside the axes, where it covers no data
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
         return ax
 
     def save(self, out: Path, stem: str, pictures: bool = True) -> list[Path]:
@@ -253,6 +259,12 @@ class AccuracyResult:
                 pyplot().close(ax.figure)
                 files.append(name)
         return [out / f for f in files]
+
+
+#: one colour per model in every profile figure (steady and transient alike): (kind, nodes
+#: for lumped models or level for the FEM) -> matplotlib colour
+PROFILE_COLOURS = {("lumped", 2): "C0", ("lumped", 5): "C1", ("lumped", 11): "C2",
+                   ("lumped", 41): "C3", ("fem", 0): "C4", ("eq14", None): "C5"}
 
 
 def worst_temperature_K(row: dict) -> float:

@@ -206,29 +206,72 @@ class ConvergenceResult:
         rows = zip(*(t[c] for c in head), strict=True)
         return markdown_table(head, list(rows), fmts)
 
+    #: the named sensors drawn in colour and labelled; the rest of a group in grey
+    NAMED = ("T1", "T2", "T_stator", "T_front_bearing", "T_rear_bearing", "P1", "TCP")
+
     def plot(self, ax=None):
-        """Difference to the extrapolated value against element size, log-log."""
+        """Difference to the Richardson extrapolation against element size, log-log, every
+        level drawn: one panel per unit (temperatures in K, growths in µm), the named sensors
+        labelled in colour with their observed order, the other sensors of the group in grey,
+        and a guide of the elements' theoretical order, named. ``ax``: one axes for
+        everything, or as many as there are units (None: a new figure)."""
         from spindle.plots import pyplot
 
         plt = pyplot()
+        units = sorted({self.units[q] for q in self.values}, key=lambda u: u != "K")
         if ax is None:
-            _, ax = plt.subplots(figsize=(7, 5), layout="constrained")
+            _, axes = plt.subplots(1, len(units), figsize=(6.2 * len(units), 4.8),
+                                   layout="constrained", squeeze=False)
+            axes = list(axes[0])
+        else:
+            axes = list(ax) if isinstance(ax, list | tuple | np.ndarray) else [ax] * len(units)
         h = np.array([2.0 ** -lv for lv in self.levels])
-        for q, vals in self.values.items():
-            g = self.gci(q, self.levels[-1])
-            if g.flag:
-                continue
-            err = np.abs(np.array(vals) - g.extrapolated)
-            if np.all(err[:-1] > 0):
-                ax.loglog(h[:-1], err[:-1], "o-", lw=0.8, ms=3,
-                          label=q if q in ("T1", "T2", "P1", "TCP", "T_stator") else None)
-        ax.loglog(h[:2], [1e-3, 1e-3 * (h[1] / h[0]) ** 3], "k--", lw=1, label="slope 3")
-        ax.set_xlabel("relative element size h / h0")
-        ax.set_ylabel("|value - Richardson extrapolation| [K or µm]")
-        ax.set_title(f"{self.spec.name}: grid convergence of every sensor ({self.case_name})")
-        ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=8)
-        return ax
+        colours = plt.get_cmap("tab10")
+        for a, unit in zip(axes, units, strict=True):
+            named = [q for q in self.values if self.units[q] == unit and q in self.NAMED]
+            others = [q for q in self.values if self.units[q] == unit and q not in self.NAMED]
+            floor = []
+            for q in others:
+                err = self._errors(q)
+                if err is not None:
+                    a.loglog(h, err, "-", color="0.7", lw=0.7, zorder=1)
+                    floor.append(err)
+            if floor:
+                a.plot([], [], "-", color="0.7", lw=0.7,
+                       label=f"other sensors ({len(floor)})")
+            for k, q in enumerate(named):
+                err = self._errors(q)
+                if err is None:
+                    continue
+                g = self.gci(q, self.levels[-1])
+                a.loglog(h, err, "o-", color=colours(k % 10), lw=1.4, ms=4, zorder=3,
+                         label=f"{q} (observed order {g.p:.2f})")
+            drawn = [self._errors(q) for q in (*named, *others)]
+            drawn = [e for e in drawn if e is not None]
+            if drawn:
+                top = float(np.nanmax([e[0] for e in drawn]))
+                a.loglog(h, top * (h / h[0]) ** 3, "k--", lw=1, zorder=2,
+                         label="h³: P2's order on smooth fields (the parts' corners and "
+                               "contact interfaces lower it)")
+            a.set_xlabel("relative element size h / h0 (level 0 at 1)")
+            a.set_ylabel(f"|value − Richardson extrapolation| [{'µm' if unit == 'um' else unit}]")
+            a.set_title(f"{'temperatures' if unit == 'K' else 'axial growth'}")
+            a.grid(alpha=0.3, which="both")
+            a.invert_xaxis()
+            a.legend(fontsize=8, loc="lower left")
+        fig = axes[0].figure
+        fig.suptitle(f"{self.spec.name}: grid convergence ({self.case_name}); the finest "
+                     f"level's error is its distance to the extrapolated value")
+        return axes if len(axes) > 1 else axes[0]
+
+    def _errors(self, q: str) -> np.ndarray | None:
+        """|value − extrapolated| per level, or None where the finest analysis is flagged
+        (nothing to extrapolate to) or a value equals it."""
+        g = self.gci(q, self.levels[-1])
+        if g.flag:
+            return None
+        err = np.abs(np.array(self.values[q]) - g.extrapolated)
+        return err if np.all(err > 0) else None
 
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         from spindle.outputs import atomic_write, write_csv, write_json
@@ -245,8 +288,9 @@ class ConvergenceResult:
             from spindle.plots import pyplot
 
             ax = self.plot()
-            atomic_write(out / "convergence.png", lambda tmp: ax.figure.savefig(tmp, dpi=130))
-            pyplot().close(ax.figure)
+            fig = (ax[0] if isinstance(ax, list) else ax).figure
+            atomic_write(out / "convergence.png", lambda tmp: fig.savefig(tmp, dpi=130))
+            pyplot().close(fig)
             files.append("convergence.png")
         return [out / f for f in files]
 

@@ -148,13 +148,13 @@ class NodeChoice:
         head = f"  {'N':>3} {'masses':>6}" + "".join(
             f" | {lb:<{wi + 10}}" for lb, wi in zip(labels, w, strict=True)) + " |"
         lines = [head, f"  {'':>3} {'':>6}" + "".join(
-            f" | {'worst T err K':>{wi}} {'P1 err um':>9}" for wi in w) + " | meets"]
+            f" | {'worst T err K':>{wi}} {'P1 err um':>9}" for wi in w) + " | verdict"]
         for i, n in enumerate(self.nodes):
             row = f"  {n:3d} {self.curves[0].masses[i]:6d}"
             for c, wi in zip(self.curves, w, strict=True):
                 p1 = "—" if math.isnan(c.p1_um[i]) else f"{c.p1_um[i]:.3f}"
                 row += f" | {c.worst_temp_K[i]:{wi}.3f} {p1:>9}"
-            mark = "yes" if self.meets(n) else "--"
+            mark = "PASS" if self.meets(n) else "FAIL"
             lines.append(row + f" | {mark}" + ("  <- chosen" if n == self.chosen else ""))
         return "\n".join(lines)
 

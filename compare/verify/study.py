@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.report import html_figure, html_page, html_table, markdown_to_html_table
+from compare.report import html_figure, html_page, markdown_to_html_table, verdict_cell
 from compare.verify.accuracy import (
     NODES,
     TOL_GROWTH_UM,
@@ -38,6 +38,7 @@ from compare.verify.accuracy import (
     eq14_entry,
     fem_entry,
     lumped_entries,
+    worst_temperature_K,
 )
 from compare.verify.convergence import ConvergenceResult, convergence_study
 from spindle.errors import InputError
@@ -75,19 +76,57 @@ class StudyResult:
                 "transient": self.transient.summary() if self.transient else None,
                 "failures": self.failures}
 
-    def verdicts(self) -> list[tuple[str, str, str]]:
-        """(case, model, verdict) for the lumped presets and eq. 14."""
+    def verdicts(self, every_model: bool = False) -> list[dict]:
+        """One row per case and model (the lumped presets and eq. 14; with ``every_model``
+        every model of the tables): ``case``, ``model``, ``passes`` (both tolerances met),
+        ``temperature_error_K`` (the worst), ``temperature_margin_K`` (tolerance minus error:
+        negative when it fails), ``P1_error_um``, ``P1_margin_um`` (nan without P1), and
+        the sentence ``verdict``."""
         out = []
         for acc in (self.steady, self.transient):
             if acc is None:
                 continue
             t = acc.table()
             for i, name in enumerate(t["model"]):
-                if t["preset"][i] or t["kind"][i] == "eq14":
-                    out.append((acc.case_name, name + (f" ({t['preset'][i]})"
-                                                       if t["preset"][i] else ""),
-                                t["verdict"][i]))
+                if not (every_model or t["preset"][i] or t["kind"][i] == "eq14"):
+                    continue
+                worst = worst_temperature_K({k: t[k][i] for k in t if k.endswith("_max_K")})
+                p1 = t.get("P1_max_um", [math.nan] * len(t["model"]))[i]
+                out.append({"case": acc.case_name,
+                            "model": name + (f" ({t['preset'][i]})" if t["preset"][i] else ""),
+                            "passes": bool(t["meets_tolerances"][i]),
+                            "temperature_error_K": worst,
+                            "temperature_margin_K": acc.tol_temp_K - worst,
+                            "P1_error_um": p1, "P1_margin_um": acc.tol_growth_um - p1,
+                            "verdict": t["verdict"][i]})
         return out
+
+    def headline(self) -> str:
+        """One paragraph: which models meet the paper's tolerances on which case, and the
+        ground truth they are measured against."""
+        conv = self.convergence
+        gt = self.ground_truth_level
+        worst = conv.summary()["worst_GCI_pct_per_level"].get(str(self.reference_level))
+        truth = (f"the FEM reference at level {gt} (worst grid convergence index "
+                 f"{worst:.2g} % over every sensor and growth reading)" if gt is not None and
+                 worst is not None else f"the FEM reference at its finest level "
+                 f"{self.reference_level}, whose GCI stays above {100 * conv.threshold:g} %")
+        sentences = []
+        for acc in (self.steady, self.transient):
+            if acc is None:
+                continue
+            rows = [v for v in self.verdicts() if v["case"] == acc.case_name]
+            good = [v["model"] for v in rows if v["passes"]]
+            bad = [v["model"] for v in rows if not v["passes"]]
+            kind = "transient" if acc.transient else "steady"
+            sentences.append(
+                f"On the {kind} case {acc.case_name}, "
+                + (f"{', '.join(good)} meet{'s' if len(good) == 1 else ''} both tolerances"
+                   if good else "no function-block model meets both tolerances")
+                + (f"; {', '.join(bad)} fail{'s' if len(bad) == 1 else ''}" if bad and good
+                   else f" ({', '.join(bad)} fail)" if bad else "") + ".")
+        return (f"Checked against {truth}, with the paper's tolerances {TOL_TEMP_K:g} K and "
+                f"±{TOL_GROWTH_UM:g} µm. " + " ".join(sentences))
 
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         from spindle.outputs import write_json
@@ -131,14 +170,15 @@ class StudyResult:
             f"<p>{html.escape(self.spec.description)}<br>Source: {html.escape(self.spec.source)}"
             f"<br>Run time {self.runtime_s:.1f} s. Tolerances (paper): {TOL_TEMP_K:g} K, "
             f"±{TOL_GROWTH_UM:g} µm.</p>",
-            "<h2>Verdicts</h2>" + html_table(["case", "model", "verdict"], self.verdicts(),
-                                             ["s"] * 3),
+            f'<p class="summary">{html.escape(self.headline())}</p>',
+            "<h2>Verdicts</h2>" + self._verdict_table(),
             self._failures_html(),
             "<h2>1. Grid convergence of the FEM reference</h2>",
             f"<p>Case: {html.escape(conv.case_name)}; levels {conv.levels} "
             f"({', '.join(f'{d} DOFs' for d in conv.dofs)}). Ground truth: "
             f"{html.escape(gt_text)}. Temperatures as rises above ambient [K], growth in µm. "
-            + (f"Flagged: {html.escape(str(flagged))}." if flagged else "No quantity is flagged "
+            + (f"Flagged: {html.escape(', '.join(f'{q} ({f})' for q, f in flagged.items()))}."
+               if flagged else "No quantity is flagged "
                "oscillatory or divergent on the finest triplet.") + "</p>",
             markdown_to_html_table(conv.markdown()), img("convergence.png", "grid convergence"),
             img("reference_3d.png", "reference temperature field, revolved"),
@@ -160,6 +200,28 @@ class StudyResult:
                 img("accuracy_transient_shaft_profile.png", "shaft sensors at the peak"),
             ]
         return html_page(f"spindle-verify study: {self.spec.name}", parts)
+
+    def _verdict_table(self) -> str:
+        """PASS / FAIL in words and colour, each error with its margin to the tolerance."""
+        def num(v: float, unit: str) -> str:
+            return "n/a" if math.isnan(v) else f"{v:.2f} {unit}"
+
+        def margin(v: float, unit: str) -> str:
+            if math.isnan(v):
+                return "n/a"
+            return (f"{v:.2f} {unit} to spare" if v >= 0 else f"over by {-v:.2f} {unit}")
+
+        head = ["case", "model", "verdict", "worst temperature error", "margin to 1 K",
+                "P1 error", "margin to ±1.5 µm"]
+        rows = "".join(
+            "<tr>" + f"<td>{html.escape(v['case'])}</td><td>{html.escape(v['model'])}</td>"
+            + verdict_cell(v["passes"])
+            + "".join(f"<td>{html.escape(x)}</td>" for x in (
+                num(v["temperature_error_K"], "K"), margin(v["temperature_margin_K"], "K"),
+                num(v["P1_error_um"], "µm"), margin(v["P1_margin_um"], "µm"))) + "</tr>"
+            for v in self.verdicts())
+        th = "".join(f"<th>{html.escape(h)}</th>" for h in head)
+        return f"<table><thead><tr>{th}</tr></thead><tbody>{rows}</tbody></table>"
 
     def _time_html(self) -> str:
         ti = self.time_integration
