@@ -58,8 +58,18 @@ class ThermoelasticModel:
         self.f_cf = asm(centrifugal, self.basis, rho_rot=fields["rho_rot"])
         self.P = self._reduction(fixed_axial)
         self.K_red = (self.P.T @ K @ self.P).tocsr()
-        self._lu = factorize(self.K_red)
+        self._lu_cache = None  # the factorisation of K_red, made when first needed
         self._gains: dict[str, tuple[np.ndarray, float]] = {}
+
+    @property
+    def _lu(self):
+        if self._lu_cache is None:
+            self._lu_cache = factorize(self.K_red)
+        return self._lu_cache
+
+    def release(self) -> None:
+        """Drop the factorisation (memory; it is made again when next needed)."""
+        self._lu_cache = None
 
     # ------------------------------------------------------------------ setup
     def element_fields(self):

@@ -38,6 +38,13 @@ class ReferenceModel:
     def readings(self) -> list[str]:
         return list(self.elastic.growth_points()) if self.elastic else []
 
+    def release(self) -> None:
+        """Drop the thermal and elastic factorisations, keeping the mesh, the operators and
+        every result (a study holding several levels' results needs no more)."""
+        self.thermal.release()
+        if self.elastic is not None:
+            self.elastic.release()
+
     def steady(self, case: LoadCase | None = None, t: float = 0.0) -> SteadyResult:
         res = self.thermal.solve_steady(case, t)
         if self.elastic is not None:

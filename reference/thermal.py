@@ -257,6 +257,10 @@ class ThermalModel:
                                   "([[surfaces]] with h_W_m2K > 0)") from None
         return self._lu[key]
 
+    def release(self) -> None:
+        """Drop the cached factorisations (memory; they are made again when next needed)."""
+        self._lu.clear()
+
     def solve_steady(self, case: LoadCase | None = None, t: float = 0.0):
         """Steady state for the inputs of ``case`` at time ``t`` [s]."""
         from reference.results import SteadyResult

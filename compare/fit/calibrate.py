@@ -547,6 +547,8 @@ class _Judge:
         if ok and self.cv_blocks:
             # the split's validation window is one stretch of the run; over blocks of the
             # whole run a sink for the base model's misfit predicts little better
+            if cal.progress:
+                cal.progress(f"cross-validating {name} over {self.cv_blocks} blocks")
             if self._cv_now is None:
                 self._cv_now = cv_score(cross_validate(cal, self.current, self.cv_blocks))
             cv = (self._cv_now, cv_score(cross_validate(cal, full, self.cv_blocks)))
@@ -591,7 +593,7 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                 label = name + (f"({lag_ch})" if lag_ch else "")
                 if label in judged:
                     continue
-                say(f"trying {label}")
+                say(f"round {len(steps) + 1}: trying {label}")
                 effects = current.effects + (name,)
                 # screen: a short joint fit (the base parameters may already have absorbed
                 # part of the effect, so holding them would hide it), started inside the
@@ -619,7 +621,7 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
         x0, v0, odd0 = judge.x0, judge.v0, judge.odd0
         refits = []
         for name, screen, lag_ch in sorted(screens, key=lambda s: -gain(s[1]))[:refit_top]:
-            say(f"refitting with {name}" + (f" ({lag_ch})" if lag_ch else ""))
+            say(f"round {len(steps) + 1}: refitting with {name}" + (f" ({lag_ch})" if lag_ch else ""))
             full = cal.fit(current.effects + (name,), start=screen.theta,
                            lag_channel=lag_ch or current.lag_channel)
             if gain(full) < gain(screen):  # the joint fit may stop early; keep the better

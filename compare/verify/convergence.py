@@ -332,6 +332,7 @@ def convergence_study(spec: Spec, case: LoadCase | None = None, levels: Sequence
         vals, units = quantities(spec, res, case)
         for k, v in vals.items():
             values.setdefault(k, []).append(v)
+        model.release()  # a finer level comes next: its factorisations need the memory
         if keep_results:
             results.append(res)
     return ConvergenceResult(spec, case.name, list(levels), elements, dofs, runtime, values,
