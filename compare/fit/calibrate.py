@@ -550,8 +550,9 @@ class _Judge:
             if cal.progress:
                 cal.progress(f"cross-validating {name} over {self.cv_blocks} blocks")
             if self._cv_now is None:
-                self._cv_now = cv_score(cross_validate(cal, self.current, self.cv_blocks))
-            cv = (self._cv_now, cv_score(cross_validate(cal, full, self.cv_blocks)))
+                self._cv_now = cv_score(cross_validate(cal, self.current, self.cv_blocks),
+                                        cal.floor)
+            cv = (self._cv_now, cv_score(cross_validate(cal, full, self.cv_blocks), cal.floor))
             ok = cv[1] <= (1.0 - self.cv_gain) * cv[0]
         return ok, x1, why, bound, cv
 
@@ -561,11 +562,12 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                       min_gain: float = 0.25, refit_top: int = 3,
                       screen_nfev: int = 12,
                       events: Mapping[str, EventTest] | None = None,
-                      cv_blocks: int = 5, cv_gain: float = 0.15) -> Selection:
+                      cv_blocks: int = 5, cv_gain: float = 0.25) -> Selection:
     """Bacher-Madsen forward selection over the candidate effects. A candidate of the
     open-loop loop that passes the likelihood-ratio test, is needed and lies inside its range
-    must also lower the blocked cross-validated error (``cv_blocks`` blocks; 0: not asked) by
-    ``cv_gain`` (15 %). With ``events`` (the
+    must also lower the blocked cross-validated error above the noise floor (``cv_blocks``
+    blocks; 0: not asked) by ``cv_gain``, the same 25 % the split asks of the validation
+    window (``min_gain``). With ``events`` (the
     run's event tests, compare.fit.events.event_tests) the event-signature effects are
     judged on them where a test applies: added first when it is significant, never
     otherwise."""
@@ -697,12 +699,16 @@ def cross_validate(cal: Calibrator, fit: Fit, blocks: int = 5, max_nfev: int = 2
     return {"blocks": blocks, "folds": folds, "pooled": total}
 
 
-def cv_score(cv: dict) -> float:
-    """The pooled cross-validated open-loop RMS of :func:`cross_validate`, in tolerance units,
-    averaged over the channels."""
-    rows = cv["pooled"]  # rmse in K, or in µm for P1
-    return float(np.mean([r["rmse"] / (TOLERANCE[c] * (1e6 if c == "P1" else 1.0))
-                          for c, r in rows.items()]))
+def cv_score(cv: dict, floor: Mapping[str, float] | None = None) -> float:
+    """The pooled cross-validated open-loop error of :func:`cross_validate` above the noise
+    ``floor`` (per channel, tolerance units): sum over the channels of RMS² − floor²
+    [tolerance units squared], as :meth:`Calibrator.validation_excess` does for the split."""
+    total = 0.0
+    for c, r in cv["pooled"].items():  # rmse in K, or in µm for P1
+        w = r["rmse"] / (TOLERANCE[c] * (1e6 if c == "P1" else 1.0))
+        f = (floor or {}).get(c, 0.0)
+        total += max(w * w - f * f, 0.0)
+    return total
 
 
 def _error_row(channel: str, d: np.ndarray) -> dict:

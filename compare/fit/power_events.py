@@ -55,7 +55,7 @@ NO_LOAD_NM = 0.5
 MOVING_RPM = 300.0
 #: the windage test needs this many no-load speed levels spanning this factor in speed
 MIN_LEVELS = 5
-MIN_SPAN = 2.0
+MIN_SPAN = 3.0
 #: speeds within this many rpm are one level
 LEVEL_RPM = 50.0
 
