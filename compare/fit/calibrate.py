@@ -468,7 +468,9 @@ def event_supported(events: Mapping[str, EventTest], alpha: float
     applies, at alpha over their number (Bonferroni: one lag is looked for in several
     channels). (effect, lag channel, test) in that order."""
     out: list[tuple[str, str | None, EventTest]] = []
-    for name in ("centrifugal_shortening", "bearing_preload", "windage_loss"):
+    for name in EVENT_EFFECTS:
+        if name == "sensor_lag":  # one test per channel, below
+            continue
         c = events.get(name)
         if c is not None and c.significant(alpha):
             out.append((name, None, c))

@@ -43,8 +43,7 @@ from spindle.spec import Spec
 ROTATING = ("shaft", "tool", "rotor")
 #: the parameters that change the conductance matrix K (the others change sources or read-outs)
 _K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact", "heat_capacity",
-             "R_adv_K_W",
-             "G_mount_W_K", "k_preload_1_K", "k_preload_rear_1_K")
+             "R_adv_K_W", "G_mount_W_K", "k_preload_1_K", "k_preload_rear_1_K")
 CHANNELS = ("T1", "T2", "T_stator", "P1")
 
 
@@ -349,10 +348,8 @@ class GreyBox:
                 rows[f"ring:{src.name}"] = r
                 names.append(src.name)
         out = self.simulate(theta, extra_rows=rows)
-        spec_values = base_params(self.drive)
-        src = self.sources(theta.get("f0", spec_values["f0"].default),
-                           theta.get("rotor_share", spec_values["rotor_share"].default),
-                           theta.get("friction_exponent", 0.0))
+        th = {k: theta.get(k, p.default) for k, p in self.parameters().items()}
+        src = self.sources(th["f0"], th["rotor_share"], th.get("friction_exponent", 0.0))
         res = {}
         for n in names:
             q = np.concatenate([src[n][:1], src[n]])  # the heat of the interval ending here
@@ -385,10 +382,10 @@ class GreyBox:
         for f, name in preload:
             f.tc_1_K = theta.get(name, 0.0)
         rs = theta["rotor_share"]
-        for neg, pos, motor_source, share in drag:
+        for neg, pos, motor_source, share, k_name in drag:
             w = share * (rs if motor_source == "rotor" else 1.0 - rs)
             neg.share, pos.share = -w, w
-            neg.tc_1_K = theta.get(_preload_param(self.spec, neg.source), 0.0)
+            neg.tc_1_K = theta.get(k_name, 0.0)
         # systems (and their cached modes) are kept per set of the parameters that enter K:
         # a Jacobian column for a source or read-out parameter reuses them
         # (not with a bearing preload: its flows are shared and set per call, and its steps
@@ -520,7 +517,7 @@ def _preload_drag_flows(net) -> list[tuple]:
     -s w q_b (1 + k (T_in - T_out)) and a flow +s w q_b, which together take s w q_b k (T_in -
     T_out) from that motor mass (w the source's fraction of the motor loss, set per parameter
     set; k set with the preload's own flows). Returns (negative flow, constant flow, motor
-    source, s) per pair."""
+    source, s, the bearing's preload parameter) per pair."""
     masses = {m.name: m for pm in net.parts.values() for m in pm.masses}
     motor = [b for b in net.network.blocks
              if isinstance(b, PrescribedHeatFlow) and b.source in MOTOR_SOURCES]
@@ -537,7 +534,7 @@ def _preload_drag_flows(net) -> list[tuple]:
                 f"preload_drag_base:{bearing}:{mass.name}", source=bearing, share=0.0))
             net.network.connect(mass.block.port, neg.port)
             net.network.connect(mass.block.port, pos.port)
-            out.append((neg, pos, f.source, f.share))
+            out.append((neg, pos, f.source, f.share, _preload_param(net.spec, bearing)))
     return out
 
 
@@ -555,18 +552,21 @@ def film_groups(spec: Spec) -> dict[str, str]:
     return out
 
 
+def _edge_parts(block_name: str) -> set[str]:
+    """The two parts an edge block such as ``contact:shaft[3]-rotor[1]`` joins."""
+    a, b = block_name.split(":", 1)[1].split("-", 1)
+    return {a.split("[")[0].split(".")[0], b.split("[")[0].split(".")[0]}
+
+
 def _is_contact_link(spec: Spec, block_name: str) -> bool:
     from spindle.spec import ContactLink
 
-    a, b = block_name.split(":", 1)[1].split("-", 1)
-    pa, pb = a.split("[")[0].split(".")[0], b.split("[")[0].split(".")[0]
-    return any(isinstance(lk, ContactLink) and set(lk.parts) == {pa, pb} for lk in spec.links)
+    parts = _edge_parts(block_name)
+    return any(isinstance(lk, ContactLink) and set(lk.parts) == parts for lk in spec.links)
 
 
 def _touches_stator(spec: Spec, block_name: str) -> bool:
-    a, b = block_name.split(":", 1)[1].split("-", 1)
-    parts = {a.split("[")[0].split(".")[0], b.split("[")[0].split(".")[0]}
-    return any(spec.part(p).role == "stator" for p in parts)
+    return any(spec.part(p).role == "stator" for p in _edge_parts(block_name))
 
 
 def _scaled(G, factor: float):

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from compare.fit.events import STEP_RPM, EventTest
+from compare.fit.events import STEP_RPM, EventTest, _through_origin
 
 #: no-load segments shorter than this [s] are not read for a drift
 MIN_SEGMENT_S = 1800.0
@@ -163,8 +163,6 @@ def preload_drift_test(segs: list[Segment], model_drift=None) -> EventTest:
         return EventTest("bearing_preload", "power", math.nan, math.nan, math.nan, math.nan,
                          len(D), unit, meaning + " (too few long no-load segments after a "
                          "speed change: no drift can be read)", per_step=rows)
-    from compare.fit.events import _through_origin
-
     b, se = _through_origin(np.array(D), np.array(X), np.array(S))
     z = b / se
     return EventTest("bearing_preload", "power", b, se, z, float(norm.sf(z)), len(D), unit,
@@ -203,8 +201,6 @@ def preload_parameter(test: EventTest, gb, theta: dict[str, float]) -> dict | No
     the model's drifts are nil). The front set: a motor spindle's rigidly preloaded set, whose
     preload rises as the inner ring warms (the rear set floats on springs); the thermal fit
     then decides both coefficients."""
-    from compare.fit.events import _through_origin
-
     if not test.per_step:
         return None
     drift = model_drift_of(gb, theta, front_only=True)

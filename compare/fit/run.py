@@ -646,8 +646,6 @@ def p_text(p: float | None) -> str:
 def _effects_html(doc: dict) -> str:
     """The accepted effects: each parameter with its value, 95 % interval and unit, the
     evidence (the event test's statistic, or the likelihood-ratio test) and what needed it."""
-    from compare.fit.greybox import EFFECTS
-
     if not doc["effects"]:
         return "<p>None accepted.</p>"
     units = {p.name: p.unit for e in EFFECTS.values() for p in e.params}

@@ -117,8 +117,7 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
     if effect in ("coolant_dynamics", "bearing_preload"):
         res, x, tx = _fixed_point(ref, case, effect, truth, dt_s, T0)
         if effect == "bearing_preload":
-            bearings = [h for h in spec.heat_sources if h.part and spec.part(h.part).role
-                        in ("front_bearing", "rear_bearing")]
+            bearings = _bearing_sources(spec)
             extra = sum(np.asarray(case.sources[h.name](tx)) * _k_preload(spec, h, truth) * dT
                         for h, dT in zip(bearings, np.split(x, len(bearings)), strict=True))
             instant["drag_W"] = lambda ts, tx=tx, extra=extra: np.interp(ts, tx, extra)
@@ -142,6 +141,13 @@ def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: i
         ch["P1"] = ch["P1"] + truth["amplitude_um"] * 1e-6 * np.sin(
             2 * np.pi * t / (truth["period_h"] * 3600.0))
     return t, ch, instant
+
+
+def _bearing_sources(spec: Spec) -> list:
+    """The spec's bearing heat sources, in the order the preload's fixed point stacks their
+    ring differences."""
+    return [h for h in spec.heat_sources
+            if h.part and spec.part(h.part).role in ("front_bearing", "rear_bearing")]
 
 
 def _k_preload(spec: Spec, source, truth: dict) -> float:
@@ -206,8 +212,7 @@ def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0:
                     names.append(f"{p.name}.{sec.name}")
         P = th.probe_matrix(np.array(pts).T).toarray()
         functionals = {n: P[i] for i, n in enumerate(names)}
-    bearings = [h for h in spec.heat_sources
-                if h.part and spec.part(h.part).role in ("front_bearing", "rear_bearing")]
+    bearings = _bearing_sources(spec)
     first = th.solve_transient(case, dt_s, 1.0, T0, 0, None, functionals)
     t = first.times_s  # inputs below are given on this grid, so it stays the grid
 

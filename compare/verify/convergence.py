@@ -227,27 +227,22 @@ class ConvergenceResult:
             axes = list(ax) if isinstance(ax, list | tuple | np.ndarray) else [ax] * len(units)
         h = np.array([2.0 ** -lv for lv in self.levels])
         colours = plt.get_cmap("tab10")
+        errors = {q: self._errors(q) for q in self.values}
         for a, unit in zip(axes, units, strict=True):
-            named = [q for q in self.values if self.units[q] == unit and q in self.NAMED]
-            others = [q for q in self.values if self.units[q] == unit and q not in self.NAMED]
-            floor = []
+            named = [q for q in self.values if self.units[q] == unit and q in self.NAMED
+                     and errors[q] is not None]
+            others = [q for q in self.values if self.units[q] == unit
+                      and q not in self.NAMED and errors[q] is not None]
             for q in others:
-                err = self._errors(q)
-                if err is not None:
-                    a.loglog(h, err, "-", color="0.7", lw=0.7, zorder=1)
-                    floor.append(err)
-            if floor:
+                a.loglog(h, errors[q], "-", color="0.7", lw=0.7, zorder=1)
+            if others:
                 a.plot([], [], "-", color="0.7", lw=0.7,
-                       label=f"other sensors ({len(floor)})")
+                       label=f"other sensors ({len(others)})")
             for k, q in enumerate(named):
-                err = self._errors(q)
-                if err is None:
-                    continue
                 g = self.gci(q, self.levels[-1])
-                a.loglog(h, err, "o-", color=colours(k % 10), lw=1.4, ms=4, zorder=3,
+                a.loglog(h, errors[q], "o-", color=colours(k % 10), lw=1.4, ms=4, zorder=3,
                          label=f"{q} (observed order {g.p:.2f})")
-            drawn = [self._errors(q) for q in (*named, *others)]
-            drawn = [e for e in drawn if e is not None]
+            drawn = [errors[q] for q in (*named, *others)]
             if drawn:
                 top = float(np.nanmax([e[0] for e in drawn]))
                 a.loglog(h, top * (h / h[0]) ** 3, "k--", lw=1, zorder=2,

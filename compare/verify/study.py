@@ -76,9 +76,9 @@ class StudyResult:
                 "transient": self.transient.summary() if self.transient else None,
                 "failures": self.failures}
 
-    def verdicts(self, every_model: bool = False) -> list[dict]:
-        """One row per case and model (the lumped presets and eq. 14; with ``every_model``
-        every model of the tables): ``case``, ``model``, ``passes`` (both tolerances met),
+    def verdicts(self) -> list[dict]:
+        """One row per case and model (the lumped presets and eq. 14): ``case``, ``model``,
+        ``passes`` (both tolerances met),
         ``temperature_error_K`` (the worst), ``temperature_margin_K`` (tolerance minus error:
         negative when it fails), ``P1_error_um``, ``P1_margin_um`` (nan without P1), and
         the sentence ``verdict``."""
@@ -88,7 +88,7 @@ class StudyResult:
                 continue
             t = acc.table()
             for i, name in enumerate(t["model"]):
-                if not (every_model or t["preset"][i] or t["kind"][i] == "eq14"):
+                if not (t["preset"][i] or t["kind"][i] == "eq14"):
                     continue
                 worst = worst_temperature_K({k: t[k][i] for k in t if k.endswith("_max_K")})
                 p1 = t.get("P1_max_um", [math.nan] * len(t["model"]))[i]
@@ -112,10 +112,11 @@ class StudyResult:
                  worst is not None else f"the FEM reference at its finest level "
                  f"{self.reference_level}, whose GCI stays above {100 * conv.threshold:g} %")
         sentences = []
+        verdicts = self.verdicts()
         for acc in (self.steady, self.transient):
             if acc is None:
                 continue
-            rows = [v for v in self.verdicts() if v["case"] == acc.case_name]
+            rows = [v for v in verdicts if v["case"] == acc.case_name]
             good = [v["model"] for v in rows if v["passes"]]
             bad = [v["model"] for v in rows if not v["passes"]]
             kind = "transient" if acc.transient else "steady"
