@@ -70,7 +70,7 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     ap.add_argument("--cycle", default="random",
-                    help="random, random-loaded, or a cycle name (default random)")
+                    help="random, random-loaded, random-ramped-load, or a cycle name (default random)")
     ap.add_argument("--spec", default="spl2782")
     ap.add_argument("--only", nargs="*", help="effects to run (default: all, clean, "
                     "electronics_drift)")

@@ -40,8 +40,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="the spindle the data come from: a shipped name or a spec file "
                          "(default spl2782)")
     sy.add_argument("--cycle", default="spl-16h",
-                    help="cycle: a shipped name or cycle file, or random / random-loaded (non-"
-                         "monotonic steps up to 6000 rpm drawn from the seed) (default spl-16h)")
+                    help="cycle: a shipped name or cycle file, or random / random-loaded / "
+                         "random-ramped-load (non-monotonic steps up to 6000 rpm drawn from the "
+                         "seed; the last ramps the load within each speed step, as a loaded "
+                         "bench run does) (default spl-16h)")
     sy.add_argument("--effect", default="clean", metavar="EFFECT",
                     help="effect to inject: clean (none, the default), one of the fit's "
                          f"library ({', '.join(EFFECTS)}) or one outside it "

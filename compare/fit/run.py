@@ -211,25 +211,31 @@ def _check_base_extra(base_extra: tuple[str, ...], model: str) -> None:
                          "contacts and sources only", "drop --base-extra or --model fem")
 
 
-def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
-            nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
-            min_gain: float = 0.25, progress: Callable[[str], None] | None = None,
-            fem_level: int | None = 0, model: str = "lumped",
-            base_extra: tuple[str, ...] = (), blocks: int = 1,
-            cv_blocks: int = 5) -> FitReport:
-    """The whole loop (module docstring). ``model``: "lumped" calibrates the base parameters
-    on the lumped grey box anchored to the FEM at the spec's values; "fem" calibrates them on
-    the FEM reference itself (level ``fem_level``), then anchors the lumped grey box there
-    and selects effects on it. ``base_extra``: names of EXTRA_BASE_PARAMS calibrated with
-    the base (lumped calibration only). ``blocks``: the run is cut into that many blocks, of
-    which about 1 - ``fit_fraction`` validate, spread over the run (1: the fit window is the
-    first ``fit_fraction``). ``cv_blocks``: blocked cross-validation of the base and the
-    final model over that many blocks, each left out in turn (compare.fit.calibrate.
-    cross_validate; 0: none)."""
-    from compare.fit.discrepancy import fem_discrepancy
-    from compare.fit.residuals import diagnose
+@dataclass
+class BaseCalibration:
+    """Where the effect loop starts: the bench run, its channels, the grey box's inputs, the
+    measured data with its windows, the calibrator, the calibrated base fit, the spec's own
+    parameter values, and the FEM anchor and FEM calibration details (None where unused)."""
 
-    t0 = time.perf_counter()
+    run: BenchRun
+    channels: list[str]
+    inputs: Inputs
+    measured: Measured
+    cal: Calibrator
+    base: Fit
+    spec_values: dict[str, float]
+    anchor: object | None = None
+    fem_calibration: dict | None = None
+
+
+def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, nodes: int = 11,
+                   grid_s: float = 60.0, progress: Callable[[str], None] | None = None,
+                   fem_level: int | None = 0, model: str = "lumped",
+                   base_extra: tuple[str, ...] = (), blocks: int = 1) -> BaseCalibration:
+    """The first half of :func:`run_fit`: read the run, check it against the spec, anchor the
+    grey box to the FEM reference and calibrate the base parameters (arguments as there)."""
+    from compare.fit.discrepancy import fem_discrepancy
+
     say = progress or (lambda _m: None)
     if model not in ("lumped", "fem"):
         raise InputError("command line", "--model", f"unknown model '{model}'",
@@ -269,6 +275,34 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         cal.gb.discrepancy = anchor.offsets
         say("calibrating the base model")
         _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref})
+    return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
+                           fem_cal_info)
+
+
+def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
+            nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
+            min_gain: float = 0.25, progress: Callable[[str], None] | None = None,
+            fem_level: int | None = 0, model: str = "lumped",
+            base_extra: tuple[str, ...] = (), blocks: int = 1,
+            cv_blocks: int = 5) -> FitReport:
+    """The whole loop (module docstring). ``model``: "lumped" calibrates the base parameters
+    on the lumped grey box anchored to the FEM at the spec's values; "fem" calibrates them on
+    the FEM reference itself (level ``fem_level``), then anchors the lumped grey box there
+    and selects effects on it. ``base_extra``: names of EXTRA_BASE_PARAMS calibrated with
+    the base (lumped calibration only). ``blocks``: the run is cut into that many blocks, of
+    which about 1 - ``fit_fraction`` validate, spread over the run (1: the fit window is the
+    first ``fit_fraction``). ``cv_blocks``: blocked cross-validation of the base and the
+    final model over that many blocks, each left out in turn (compare.fit.calibrate.
+    cross_validate; 0: none)."""
+    from compare.fit.residuals import diagnose
+
+    t0 = time.perf_counter()
+    say = progress or (lambda _m: None)
+    prep = calibrate_base(path, spec, fit_fraction, nodes, grid_s, progress, fem_level, model,
+                          base_extra, blocks)
+    run, channels, inputs, measured = prep.run, prep.channels, prep.inputs, prep.measured
+    cal, base, spec_values, anchor = prep.cal, prep.base, prep.spec_values, prep.anchor
+    fem_cal_info = prep.fem_calibration
     say("reading the events (speed steps) of the raw samples")
     events = event_tests(run, cal.gb, base.theta, channels, alpha)
     sel = forward_selection(cal, candidates, alpha, base=base, min_gain=min_gain, events=events)

@@ -288,7 +288,7 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
 
 
 #: cycles synth makes itself (compare.fit.mismatch.random_cycle) rather than load
-RANDOM_CYCLES = ("random", "random-loaded")
+RANDOM_CYCLES = ("random", "random-loaded", "random-ramped-load")
 #: the top speed of a random cycle [rpm]: the SPL2782 family's bench runs go to 6000 rpm
 #: (a peer's runs in ../shared/bench-runs), above the spl-16h cycle's rated 4300 rpm
 RANDOM_MAX_SPEED_RPM = 6000.0
@@ -298,8 +298,9 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
           dt_s: float = 60.0, mismatch: bool = False) -> dict:
     """Write the synthetic run and its truth sidecar; returns the truth.
 
-    ``cycle_name``: a shipped cycle or cycle file, or ``random`` / ``random-loaded`` (a cycle
-    drawn from the seed, :func:`compare.fit.mismatch.random_cycle`). ``mismatch``: the data
+    ``cycle_name``: a shipped cycle or cycle file, or ``random`` / ``random-loaded`` /
+    ``random-ramped-load`` (a cycle drawn from the seed,
+    :func:`compare.fit.mismatch.random_cycle`). ``mismatch``: the data
     come from a spindle that differs from ``spec`` (:func:`compare.fit.mismatch.draw_mismatch`,
     drawn from the seed; its FEM level replaces ``level``), recorded in the truth."""
     from compare.fit.mismatch import draw_mismatch, random_cycle
@@ -316,7 +317,8 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
     # and bench sampling stay what they were without them
     if cycle_name in RANDOM_CYCLES:
         cycle = random_cycle(np.random.default_rng([seed, 2]), RANDOM_MAX_SPEED_RPM,
-                             loaded=cycle_name == "random-loaded")
+                             loaded=cycle_name == "random-loaded",
+                             ramped=cycle_name == "random-ramped-load")
     else:
         cycle = load_cycle(cycle_name)
     drive = drive_for(spec)
