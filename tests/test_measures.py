@@ -388,7 +388,12 @@ def test_command_on_the_uniform_body(tmp_path, capsys):
     # the command says so with exit status 1; everything else is written
     assert rc == 1
     assert "FAILED sweep film alpha=0 W/m2K" in captured.out
-    assert "FAILED: " in captured.err and "[1/" in captured.err  # progress lines
+    # progress (compare/progress.py): the failed case is always written, on its own line,
+    # with its count; the run ends with the final line
+    failed = [ln for ln in captured.err.splitlines() if "FAILED: " in ln]
+    assert len(failed) == 1 and failed[0].startswith("measures: [")
+    assert "sweep film alpha=0 W/m2K" in failed[0]
+    assert captured.err.splitlines()[-1].startswith("measures: done in ")
     for f in ("measures.csv", "indicators.csv", "inverse.csv", "sweeps.csv", "measures.md",
               "measures.json", "fig15_temperature_drop.png", "fig16_sensitivity.png"):
         assert (out / f).is_file(), f

@@ -1,0 +1,160 @@
+"""The one progress style (compare/progress.py): a rewritten bar on a terminal, a line per
+stage and per 10 % in a log, nothing but the final line for a short run; and the commands
+that use it (solve: few lines for a quick run, the set-up named before the heavy work)."""
+
+from __future__ import annotations
+
+import io
+import subprocess
+import sys
+from pathlib import Path
+
+from compare.progress import DELAY_S, Progress
+from spindle.outputs import atomic_write, expect_pictures
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+class FakeClock:
+    """Seconds that move only when the test says so."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def make(tty: bool, quiet: bool = False) -> tuple[Progress, io.StringIO, FakeClock]:
+    stream, clock = io.StringIO(), FakeClock()
+    return Progress("solve", quiet=quiet, stream=stream, tty=tty, clock=clock, ticker=False), \
+        stream, clock
+
+
+def test_log_mode_writes_a_line_per_stage_and_per_10_percent_with_elapsed_seconds():
+    progress, stream, clock = make(tty=False)
+    clock.now = 1.0  # past the short-run delay
+    progress.stage("meshing level 2 and assembling P2")
+    progress.stage("transient", 0.0)
+    for k in range(1, 101):  # 100 steps of 1 %: lines at 10, 20, ... 100 %
+        clock.now = 1.0 + k / 100
+        progress.fraction(k / 100)
+    progress.fraction(1.0)  # reported again by the solver: not written twice
+    progress.done()
+    lines = stream.getvalue().splitlines()
+    assert lines[0] == "solve: meshing level 2 and assembling P2  (1.0 s)"
+    assert lines[1] == "solve: transient   0 %  (1.0 s)"
+    assert [ln.split("transient")[1].split("%")[0].strip() for ln in lines[2:-1]] == \
+        [str(p) for p in range(10, 101, 10)]
+    assert lines[-2] == "solve: transient 100 %  (2.0 s)"
+    assert lines[-1] == "solve: done in 2.0 s"
+    assert "\r" not in stream.getvalue()  # a log gets plain lines
+
+
+def test_terminal_mode_rewrites_one_bar_line():
+    progress, stream, clock = make(tty=True)
+    clock.now = 1.0
+    progress.stage("transient", 0.0)
+    clock.now = 3.1
+    progress.fraction(0.42)
+    progress.fraction(0.421)  # the same whole percent: no redraw
+    text = stream.getvalue()
+    assert "\n" not in text  # one line, rewritten in place
+    assert text.count("\r") == 2
+    assert text.endswith("solve: transient [####......]  42 %  3.1 s")
+    progress.done()
+    assert stream.getvalue().endswith("\r\033[Ksolve: done in 3.1 s\n")  # bar cleared, final line
+
+
+def test_a_short_run_prints_only_its_final_line():
+    """A 0.1 s lumped transient reported 11 lines before (0, 10, ... 100 %); now 1."""
+    for tty in (False, True):
+        progress, stream, clock = make(tty=tty)
+        progress.stage("building the lumped model (11 nodes)")
+        progress.stage("transient", 0.0)
+        for k in range(1, 961):
+            clock.now = 0.1 * k / 960
+            progress.fraction(k / 960)
+            progress.tick()
+        progress.done()
+        assert stream.getvalue().replace("\r\033[K", "") == "solve: done in 0.1 s\n"
+
+
+def test_a_long_set_up_is_named_once_the_delay_has_passed():
+    """No silence beyond the delay: the ticker (here called by hand) shows the stage."""
+    progress, stream, clock = make(tty=False)
+    progress.stage("meshing level 2 and assembling P2")
+    progress.tick()
+    assert stream.getvalue() == ""
+    clock.now = DELAY_S
+    progress.tick()
+    progress.tick()  # written once, not at every tick
+    assert stream.getvalue() == "solve: meshing level 2 and assembling P2  (0.5 s)\n"
+
+
+def test_failures_are_kept_and_counted_messages_set_the_fraction():
+    progress, stream, clock = make(tty=False)
+    progress.say("[1/4] A_M=0.02 m2 FAILED: no convergence")  # at once, despite the delay
+    clock.now = 1.0
+    progress.say("[2/4] A_M=0.03 m2 done 0.4 s")
+    lines = stream.getvalue().splitlines()
+    assert lines == ["solve: [1/4] A_M=0.02 m2 FAILED: no convergence",
+                     "solve: [2/4] A_M=0.03 m2 done 0.4 s  50 %  (1.0 s)"]
+
+
+def test_quiet_prints_nothing():
+    progress, stream, clock = make(tty=False, quiet=True)
+    clock.now = 5.0
+    progress.stage("transient", 0.5)
+    progress.say("[1/2] x FAILED: y")
+    progress.done()
+    assert stream.getvalue() == ""
+
+
+def test_pictures_are_counted_as_they_are_written(tmp_path):
+    progress, stream, clock = make(tty=False)
+    clock.now = 1.0
+    with progress.pictures():
+        expect_pictures(2)
+        for name in ("temperature_section.png", "temperature_3d.png"):
+            atomic_write(tmp_path / name, lambda tmp: tmp.write_bytes(b"png"))
+        atomic_write(tmp_path / "summary.json", lambda tmp: tmp.write_text("{}"))  # not a picture
+    atomic_write(tmp_path / "after.png", lambda tmp: tmp.write_bytes(b"png"))  # not listened to
+    assert stream.getvalue().splitlines() == [
+        "solve: rendering 2 pictures   0 %  (1.0 s)",
+        "solve: rendering 2 pictures: 1/2 temperature_section.png  50 %  (1.0 s)",
+        "solve: rendering 2 pictures: 2/2 temperature_3d.png 100 %  (1.0 s)"]
+
+
+def _solve(*args: str, out: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "compare", "solve", "spl2782", *args,
+                           "--out", str(out)], cwd=ROOT, capture_output=True, text=True,
+                          timeout=600)
+
+
+def test_a_quick_lumped_solve_prints_few_progress_lines(tmp_path):
+    """A lumped steady solve and a lumped 16 h transient (each well under 2 s of work) print
+    at most their set-up, picture and final lines to stderr, not one per 10 %."""
+    steady = _solve("--model", "lumped", "--nodes", "11", "--case", "nominal",
+                    out=tmp_path / "steady")
+    transient = _solve("--model", "lumped", "--nodes", "11", "--cycle", "spl-16h",
+                       "--no-pictures", out=tmp_path / "transient")
+    for r in (steady, transient):
+        assert r.returncode == 0, r.stderr
+        lines = r.stderr.splitlines()
+        assert lines and lines[-1].startswith("solve: done in "), r.stderr
+        assert len(lines) <= 5, r.stderr  # was 11 lines for the transient alone
+        assert "wrote " in r.stdout and "done in" not in r.stdout  # stdout: results only
+    assert not any("transient 'spl-16h'  10 %" in ln for ln in transient.stderr.splitlines())
+
+
+def test_a_fem_transient_names_its_set_up_first(tmp_path):
+    """The first progress line of ``solve --cycle`` names the meshing and assembly, written
+    before the transient starts (there were 3 s of silence before the first line at level 2)."""
+    r = _solve("--cycle", "spl-16h", "--level", "1", "--no-pictures", out=tmp_path / "x")
+    assert r.returncode == 0, r.stderr
+    lines = r.stderr.splitlines()
+    assert lines[0].startswith("solve: meshing level 1 and assembling P2"), r.stderr
+    transient = [ln for ln in lines if "transient 'spl-16h'" in ln]
+    assert lines.index(transient[0]) > 0
+    assert sum(" 100 %" in ln for ln in transient) == 1  # 100 % once
