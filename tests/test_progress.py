@@ -158,3 +158,15 @@ def test_a_fem_transient_names_its_set_up_first(tmp_path):
     transient = [ln for ln in lines if "transient 'spl-16h'" in ln]
     assert lines.index(transient[0]) > 0
     assert sum(" 100 %" in ln for ln in transient) == 1  # 100 % once
+
+
+def test_counted_cases_are_one_stage_with_a_line_per_10_percent():
+    """36 finished cases (the executor's "[k/36] ... done") in a log: 11 lines, not 36."""
+    progress, stream, clock = make(tty=False)
+    clock.now = 1.0
+    for k in range(1, 37):
+        progress.say(f"[{k}/36] sweep point {k} done 0.1 s")
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == 11
+    assert lines[0] == "solve: [1/36] sweep point 1 done 0.1 s   2 %  (1.0 s)"
+    assert lines[-1] == "solve: [36/36] sweep point 36 done 0.1 s 100 %  (1.0 s)"
