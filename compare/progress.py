@@ -5,10 +5,12 @@ A :class:`Progress` names the stage a run is in ("meshing level 2 and assembling
 
 - On a terminal: one line, rewritten in place: ``solve: transient [####......]  42 %  3.1 s``.
 - In a log (stderr not a terminal): one line per stage and per 10 % of a stage, each with the
-  elapsed seconds: ``solve: transient  40 %  (3.1 s)``.
-- A run that ends within ``delay_s`` (0.5 s) prints nothing but its final line
-  (``solve: done in 0.1 s``); a longer one shows the stage it is in at ``delay_s``, so a long
-  set-up is never silent for more than half a second.
+  elapsed seconds: ``solve: transient  40 %  (3.1 s)``; a stage that ends within ``delay_s``
+  (0.5 s) is not written, and its lines come at most every ``delay_s`` (but for its 100 %),
+  so a 0.1 s transient does not write eleven lines.
+- A run that ends within ``delay_s`` prints nothing but its final line
+  (``solve: done in 0.1 s``); a stage that lasts longer is shown once it has run ``delay_s``,
+  so a long set-up is never silent for more than half a second.
 - Failures (a message containing ``FAILED``) are always printed, on a line of their own.
 - ``quiet``: nothing at all.
 
@@ -22,6 +24,8 @@ is ``k/n``: a log gets a line per 10 % of the cases, not one per case.
 
 from __future__ import annotations
 
+import math
+import os
 import re
 import shutil
 import sys
@@ -53,11 +57,15 @@ class Progress:
                  clock: Callable[[], float] = time.perf_counter, ticker: bool = True):
         self.label, self.quiet, self.delay_s, self.clock = label, quiet, delay_s, clock
         self.stream = stream if stream is not None else sys.stderr
-        self.tty = bool(tty if tty is not None else getattr(self.stream, "isatty", lambda: False)())
+        if tty is None:  # a terminal that cannot clear a line (TERM=dumb) gets the log style
+            tty = getattr(self.stream, "isatty", lambda: False)() and os.environ.get("TERM") != "dumb"
+        self.tty = bool(tty)
         self.start = clock()
         self.stage_name = ""
         self.stage_fraction: float | None = None
         self._counted: int | None = None  # the n of a stage of "[k/n] ..." messages
+        self._stage_start = self.start
+        self._stage_written = -math.inf  # when this stage's last line was written
         self.shown = False  # something was written (the short-run rule no longer holds)
         self._pending = False  # the current state is not yet written
         self._last_step = -1  # log mode: the last 10 % step written of this stage
@@ -77,6 +85,8 @@ class Progress:
         with self._lock:
             self.stage_name, self.stage_fraction = name, None
             self._counted = None
+            self._stage_start = self.clock()
+            self._stage_written = -math.inf  # when this stage's last line was written
             self._last_step = -1
             self._pending = True
             if fraction is not None:
@@ -96,8 +106,7 @@ class Progress:
         done, total = int(m[1]), max(int(m[2]), 1)
         with self._lock:
             if self._counted == total:  # the next of the same cases: the stage goes on
-                self.stage_name = message.strip()
-                self.fraction(done / total)
+                self._continue(message.strip(), done / total)
                 return
             self.stage(message.strip(), done / total)
             self._counted = total
@@ -152,14 +161,17 @@ class Progress:
 
     @contextmanager
     def pictures(self, total: int | None = None) -> Iterator[None]:
-        """While the block runs, report each PNG written (``rendering pictures: 2/4 x.png``).
-        ``total``: the number expected, if known; a writer that knows it may also announce it
-        through :func:`spindle.outputs.expect_pictures`."""
+        """A stage "writing the outputs"; while the block runs, each PNG written is reported
+        (``rendering 4 pictures: 2/4 written, x.png``). ``total``: the number expected, if
+        known; a writer that knows it announces it through
+        :func:`spindle.outputs.expect_pictures`."""
         from spindle import outputs
 
         self._pictures, self._pictures_total = 0, total
         if total:
             self.stage(self._pictures_stage(), 0.0)
+        else:  # tables and fields first, pictures announced or counted as they come
+            self.stage("writing the outputs")
         outputs.PICTURE_LISTENERS.append(self._picture)
         try:
             yield
@@ -172,19 +184,30 @@ class Progress:
         head = f"rendering {total} pictures" if total else "rendering pictures"
         if not name:
             return head
-        return f"{head}: {n}/{total} {name}" if total else f"{head}: {n} written, {name}"
+        return f"{head}: {n}/{total} written, {name}" if total else f"{head}: {n} written, {name}"
 
     def _picture(self, path: Path | None, total: int | None = None) -> None:
         if path is None:  # an announcement: ``total`` more pictures are coming
             self._pictures_total = self._pictures + (total or 0)
-            self.stage(self._pictures_stage(), self._pictures / max(self._pictures_total, 1))
+            self._continue(self._pictures_stage(), self._pictures / max(self._pictures_total, 1))
             return
         self._pictures += 1
         total = self._pictures_total
         if total is not None and self._pictures > total:
             self._pictures_total = total = None
-        self.stage(self._pictures_stage(Path(path).name),
-                   self._pictures / total if total else None)
+        self._continue(self._pictures_stage(Path(path).name),
+                       self._pictures / total if total else None)
+
+    def _continue(self, name: str, fraction: float | None) -> None:
+        """The stage goes on under a new name (the latest case, picture): its clock runs on."""
+        with self._lock:
+            self.stage_name = name
+            if fraction is None:
+                self.stage_fraction = None
+                self._pending = True
+                self._show()
+            else:
+                self.fraction(fraction)
 
     def tick(self) -> None:
         """Write what is due: the pending state once ``delay_s`` has passed; on a terminal
@@ -201,15 +224,23 @@ class Progress:
     def _show(self, new_step: int | None = None) -> None:
         if self.quiet or not self._pending or not self.stage_name:
             return
-        elapsed = self.clock() - self.start
-        if not self.shown and elapsed < self.delay_s:
+        now = self.clock()
+        elapsed = now - self.start
+        if self.tty and not self.shown and elapsed < self.delay_s:
             return  # the short-run rule: wait, the run may be over before anyone looks
+        if not self.tty:  # a log: a stage over within delay_s is not written, and a stage's
+            # lines come at most every delay_s, but for its 100 %
+            if now - self._stage_start < self.delay_s:
+                return
+            if now - self._stage_written < self.delay_s and self.stage_fraction != 1.0:
+                return
         if new_step is not None:
             self._last_step = new_step
         elif self.stage_fraction is not None:
             self._last_step = int(100 * self.stage_fraction) // (1 if self.tty else 10)
         self._pending = False
         self.shown = True
+        self._stage_written = now
         f = self.stage_fraction
         if self.tty:
             if f is None:
@@ -242,4 +273,4 @@ class Progress:
 def command_progress(label: str, quiet: bool) -> Progress:
     """The progress of the command ``label`` on stderr (nothing with ``--quiet``); use it as
     a context manager, so that a run that fails stops its ticker and ends its line."""
-    return Progress(label, quiet=quiet)
+    return Progress(label, quiet=quiet, delay_s=DELAY_S)

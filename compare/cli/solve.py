@@ -91,7 +91,6 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
         result = ref.steady(case)
     t_solve = time.perf_counter() - t0 - t_asm
     result.check_plausible(spec.path)
-    progress.stage("writing the outputs")
     with output_dir(out, inputs=inputs) as tmp, progress.pictures():
         files = result.save(tmp, pictures=not args.no_pictures)
     progress.done()
