@@ -4,13 +4,12 @@ A :class:`Progress` names the stage a run is in ("meshing level 2 and assembling
 "transient", "rendering pictures") and, where it is known, the fraction of that stage done.
 
 - On a terminal: one line, rewritten in place: ``solve: transient [####......]  42 %  3.1 s``.
-- In a log (stderr not a terminal): one line per stage and per 10 % of a stage, each with the
-  elapsed seconds: ``solve: transient  40 %  (3.1 s)``; a stage that ends within ``delay_s``
-  (0.5 s) is not written, and its lines come at most every ``delay_s`` (but for its 100 %),
-  so a 0.1 s transient does not write eleven lines.
+- In a log (stderr not a terminal): a line when a stage begins, then one per 10 % of it, each
+  with the elapsed seconds (``solve: transient  40 %  (3.1 s)``), but at most one line every
+  ``delay_s`` (0.5 s) within a stage: a 0.1 s transient writes one line, not eleven.
 - A run that ends within ``delay_s`` prints nothing but its final line
-  (``solve: done in 0.1 s``); a stage that lasts longer is shown once it has run ``delay_s``,
-  so a long set-up is never silent for more than half a second.
+  (``solve: done in 0.1 s``); a longer one shows the stage it is in at ``delay_s``, so a long
+  set-up is never silent for more than half a second.
 - Failures (a message containing ``FAILED``) are always printed, on a line of their own.
 - ``quiet``: nothing at all.
 
@@ -64,7 +63,6 @@ class Progress:
         self.stage_name = ""
         self.stage_fraction: float | None = None
         self._counted: int | None = None  # the n of a stage of "[k/n] ..." messages
-        self._stage_start = self.start
         self._stage_written = -math.inf  # when this stage's last line was written
         self.shown = False  # something was written (the short-run rule no longer holds)
         self._pending = False  # the current state is not yet written
@@ -85,7 +83,6 @@ class Progress:
         with self._lock:
             self.stage_name, self.stage_fraction = name, None
             self._counted = None
-            self._stage_start = self.clock()
             self._stage_written = -math.inf  # when this stage's last line was written
             self._last_step = -1
             self._pending = True
@@ -226,14 +223,10 @@ class Progress:
             return
         now = self.clock()
         elapsed = now - self.start
-        if self.tty and not self.shown and elapsed < self.delay_s:
+        if not self.shown and elapsed < self.delay_s:
             return  # the short-run rule: wait, the run may be over before anyone looks
-        if not self.tty:  # a log: a stage over within delay_s is not written, and a stage's
-            # lines come at most every delay_s, but for its 100 %
-            if now - self._stage_start < self.delay_s:
-                return
-            if now - self._stage_written < self.delay_s and self.stage_fraction != 1.0:
-                return
+        if not self.tty and now - self._stage_written < self.delay_s:
+            return  # a log: a stage's further lines come at most every delay_s
         if new_step is not None:
             self._last_step = new_step
         elif self.stage_fraction is not None:
