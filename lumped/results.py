@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from spindle import plots
-from spindle.outputs import write_csv, write_json
+from spindle.outputs import expect_pictures, write_csv, write_json
 from spindle.results import SteadyTable, TransientTable
 from spindle.units import ZERO_C_K
 
@@ -81,6 +81,7 @@ class LumpedSteadyResult(SteadyTable):
         write_csv(out / "masses.csv", list(masses), zip(*masses.values(), strict=True))
         files = ["summary.json", "sensors.csv", "masses.csv"]
         if pictures:
+            expect_pictures(2)
             plt = plots.pyplot()
             ax = self.plot()
             atomic_write(out / "masses.png", lambda tmp: ax.figure.savefig(tmp, dpi=130))
@@ -120,6 +121,7 @@ class LumpedTransientResult(TransientTable):
         write_csv(out / "sensors_timeseries.csv", *self.timeseries_rows())
         files = ["summary.json", "sensors_timeseries.csv"]
         if pictures:
+            expect_pictures(1 + ("P1" in self.growth_m and "T1" in self.names))
             title = f"{self.model.spec.name}: {self.case.name}, lumped {self.model.nodes} nodes"
             arrays = {s.name: s.array for s in self.model.spec.temperature_sensors() if s.array}
             plots.timeseries_png(self.times_s, self.names, self.sensor_K - ZERO_C_K,

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from spindle import plots as shared_plots
-from spindle.outputs import atomic_write
+from spindle.outputs import atomic_write, expect_pictures
 from spindle.outputs import write_csv as _write_csv
 from spindle.outputs import write_json as _write_json
 from spindle.results import SteadyTable, TransientTable
@@ -75,6 +75,8 @@ class SteadyResult(SteadyTable):
             add_displacement(grid, self.elastic, self.U)
         atomic_write(out / "temperature.vtu", lambda tmp: grid.save(str(tmp)))
         files = ["summary.json", "sensors.csv", "temperature.vtu"]
+        if pictures:
+            expect_pictures(3 + (self.U is not None))
         if self.U is not None and pictures:
             plots.deformed_png(grid, out / "deformation_section.png", self._title(), self.growth_m)
             files.append("deformation_section.png")
@@ -151,6 +153,7 @@ class TransientResult(TransientTable):
         atomic_write(out / "temperature.pvd", lambda tmp: tmp.write_text(pvd, "utf-8"))
         files = ["summary.json", "sensors_timeseries.csv", "temperature.pvd"]
         if pictures:
+            expect_pictures(3 + ("P1" in self.growth_m and "T1" in self.names))
             title = f"{self.model.spec.name}: {self.case.name}"
             arrays = {s.name: s.array for s in self.model.spec.temperature_sensors() if s.array}
             shared_plots.timeseries_png(self.times_s, self.names, self.sensor_K - ZERO_C_K,

@@ -11,7 +11,7 @@ import os
 import re
 import shutil
 import tempfile
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -24,8 +24,20 @@ _UMASK = os.umask(0)
 os.umask(_UMASK)
 
 
+#: called as ``listener(path)`` after each PNG :func:`atomic_write` wrote, and as
+#: ``listener(None, n)`` by :func:`expect_pictures` (``compare.progress`` reports them)
+PICTURE_LISTENERS: list[Callable[..., None]] = []
+
+
+def expect_pictures(n: int) -> None:
+    """Tell the progress that ``n`` pictures are about to be rendered."""
+    for listener in list(PICTURE_LISTENERS):
+        listener(None, n)
+
+
 def atomic_write(path: Path, write) -> None:
-    """Call ``write(tmp_path)`` and move the result into ``path`` in one step."""
+    """Call ``write(tmp_path)`` and move the result into ``path`` in one step (a PNG is
+    reported to :data:`PICTURE_LISTENERS`)."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
@@ -36,6 +48,9 @@ def atomic_write(path: Path, write) -> None:
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+    if path.suffix == ".png":
+        for listener in list(PICTURE_LISTENERS):
+            listener(path)
 
 
 def safe_name(name: str) -> str:

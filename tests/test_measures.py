@@ -388,7 +388,12 @@ def test_command_on_the_uniform_body(tmp_path, capsys):
     # the command says so with exit status 1; everything else is written
     assert rc == 1
     assert "FAILED sweep film alpha=0 W/m2K" in captured.out
-    assert "FAILED: " in captured.err and "[1/" in captured.err  # progress lines
+    # progress (compare/progress.py): the failed case is always written, on its own line,
+    # with its count; the run ends with the final line
+    failed = [ln for ln in captured.err.splitlines() if "FAILED: " in ln]
+    assert len(failed) == 1 and failed[0].startswith("measures: [")
+    assert "sweep film alpha=0 W/m2K" in failed[0]
+    assert captured.err.splitlines()[-1].startswith("measures: done in ")
     for f in ("measures.csv", "indicators.csv", "inverse.csv", "sweeps.csv", "measures.md",
               "measures.json", "fig15_temperature_drop.png", "fig16_sensitivity.png"):
         assert (out / f).is_file(), f
@@ -450,3 +455,41 @@ def test_report_tables_as_rows_and_dataframes(body):
     frames = rep.to_pandas()
     assert isinstance(frames["measures"], pd.DataFrame)
     assert frames["measures"]["lambda_formula"].iloc[0] == pytest.approx(1.5)
+
+
+def test_fig15_spreads_lambdas_near_one_and_survives_a_loss(tmp_path, monkeypatch):
+    """Fig. 15's left panel is log-log in lambda_tr - 1 and Delta T, so measures whose
+    lambdas lie within 1.002..1.08 (spl2782's) land apart; a measure that makes things worse
+    (lambda < 1, no point on a log axis) is drawn at the axis's lower end, not dropped."""
+    from types import SimpleNamespace
+
+    from compare.design import plots
+
+    rows = {"fins": (1.0024, 1.0188), "air": (1.0067, 1.0566), "worse": (1.003, 0.98)}
+
+    def measure(name, lf, lr):
+        row = {"lambda_formula": lf, "lambda_ref_mean": lr}
+        return SimpleNamespace(measure=SimpleNamespace(name=name), to_row=lambda: row)
+
+    rep = SimpleNamespace(spec_name="s", case_name="c",
+                          baseline=SimpleNamespace(mean_rise_K=34.8),
+                          measures=[measure(n, *v) for n, v in rows.items()])
+    fig_axes = []
+    plt = plots.pyplot()
+    real_close = plt.close
+
+    def keep(fig):  # the axes of the figure fig15_png closes
+        fig_axes.extend(fig.axes)
+        real_close(fig)
+
+    monkeypatch.setattr(plt, "close", keep)
+    plots.fig15_png(rep, tmp_path / "fig15.png")
+    assert (tmp_path / "fig15.png").stat().st_size > 0
+    left = fig_axes[0]
+    assert left.get_xscale() == "log" and left.get_yscale() == "log"
+    squares = [ln.get_xdata()[0] for ln in left.lines if ln.get_marker() == "s"]
+    assert squares == pytest.approx([0.0188, 0.0566, plots._LAMBDA_EXCESS_RANGE[0]])
+    assert "worse (lambda <= 1 + 1e-3 drawn at the axis)" in [
+        t.get_text() for t in left.get_legend().get_texts()]
+    labels = [t.get_text() for t in fig_axes[1].get_yticklabels()]
+    assert labels[0].startswith("fins\no 0.08 K, ■ 0.64 K")  # eq. 24: 34.8 * 0.0188 / 1.0188

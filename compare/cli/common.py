@@ -1,5 +1,5 @@
-"""Helpers shared by the commands: the options several commands take, the progress printer
-and reading a ``--case``/``--cycle`` argument.
+"""Helpers shared by the commands: the options several commands take, their progress
+(:func:`with_progress`) and reading a ``--case``/``--cycle`` argument.
 
 Kept free of numpy and the feature packages so that building the parser stays fast; the
 helpers that need more import it when they run.
@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from compare.progress import Progress
     from spindle.loads import LoadCase
     from spindle.spec import Spec
 
@@ -82,13 +82,24 @@ def add_quiet(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
 
 
-def progress(quiet: bool) -> Callable[[str], None]:
-    """A progress printer: one indented line per message on stderr, nothing when ``quiet``."""
-    def say(msg: str) -> None:
-        if not quiet:
-            print(f"  ... {msg}", file=sys.stderr, flush=True)
+def with_progress(label: str) -> Callable[[Callable[[argparse.Namespace, Progress], int]],
+                                         Callable[[argparse.Namespace], int]]:
+    """Decorate a command ``fn(args, progress)`` into ``fn(args)``: ``progress`` is the
+    command's :class:`compare.progress.Progress` (stderr, silent with ``--quiet``), closed
+    when the command ends, also by an error."""
+    import functools
 
-    return say
+    def wrap(fn: Callable[[argparse.Namespace, Progress], int]) -> Callable[[argparse.Namespace], int]:
+        @functools.wraps(fn)
+        def run(args: argparse.Namespace) -> int:
+            from compare.progress import command_progress
+
+            with command_progress(label, getattr(args, "quiet", False)) as progress:
+                return fn(args, progress)
+
+        return run
+
+    return wrap
 
 
 def load_case_input(spec: Spec, source: str, base: LoadCase, inputs: list[str]) -> LoadCase:

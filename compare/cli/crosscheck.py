@@ -5,11 +5,20 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from compare.cli.common import MESH_LEVEL, add_out, add_spec, load_case_input, out_folder
+from compare.cli.common import (
+    MESH_LEVEL,
+    add_out,
+    add_quiet,
+    add_spec,
+    load_case_input,
+    out_folder,
+    with_progress,
+)
 from spindle.units import ZERO_C_K
 
 if TYPE_CHECKING:
     from compare.crosscheck import CrosscheckResult
+    from compare.progress import Progress
 
 
 def _print_comparison(spec_name: str, result: CrosscheckResult) -> None:
@@ -33,7 +42,8 @@ def _print_comparison(spec_name: str, result: CrosscheckResult) -> None:
           f"precision {result.nodal['max_print_bound_K']:.1e} K)")
 
 
-def _cmd_crosscheck(args: argparse.Namespace) -> int:
+@with_progress("crosscheck")
+def _cmd_crosscheck(args: argparse.Namespace, progress: Progress) -> int:
     """``spindle-verify crosscheck``: print the comparison table, write JSON and CSV."""
     # imported here so that building the parser stays fast (compare/cli/common.py)
     from compare.crosscheck import crosscheck
@@ -45,10 +55,12 @@ def _cmd_crosscheck(args: argparse.Namespace) -> int:
     inputs: list[str] = []
     case = (None if args.case is None
             else load_case_input(spec, args.case, spec.default_load_case(), inputs))
+    progress.stage(f"solving level {args.level} with scikit-fem and with CalculiX")
     with output_dir(out, inputs=[spec.path, *inputs]) as tmp:
         result = crosscheck(spec, args.level, case,
                             keep_dir=(tmp / "ccx") if args.keep_deck else None)
         files = result.save(tmp)
+    progress.done()
     _print_comparison(spec.name, result)
     print("wrote " + ", ".join(str(out / f.name) for f in files)
           + (f", {out / 'ccx'}/" if args.keep_deck else ""))
@@ -71,4 +83,5 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_out(cp, "results/<spec>/crosscheck")
     cp.add_argument("--keep-deck", action="store_true",
                     help="keep the ccx decks, result files and logs in <out>/ccx")
+    add_quiet(cp)
     cp.set_defaults(func=_cmd_crosscheck)

@@ -4,10 +4,20 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from compare.cli.common import NODE_COUNT, add_no_pictures, add_quiet, number, out_folder
-from compare.cli.common import progress as _progress
+from compare.cli.common import (
+    NODE_COUNT,
+    add_no_pictures,
+    add_quiet,
+    number,
+    out_folder,
+    with_progress,
+)
 from spindle.errors import InputError
+
+if TYPE_CHECKING:
+    from compare.progress import Progress
 
 _CV_RANGE = number(0, 20, integer=True)
 
@@ -21,7 +31,8 @@ def cv_blocks(text: str) -> int:
     return value
 
 
-def _cmd_fit(args: argparse.Namespace) -> int:
+@with_progress("fit")
+def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
     from compare.fit.run import report_summary_text, run_fit, save_report
     from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
@@ -35,12 +46,13 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     out = out_folder(args.out, default, [spec.path, args.run])
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
-                  progress=_progress(args.quiet),
+                  progress=progress.say,
                   fem_level=None if args.lumped_only else args.fem_level, model=args.model,
                   base_extra=tuple(args.base_extra or ()), blocks=args.blocks,
                   cv_blocks=args.cv_blocks)
-    with output_dir(out, inputs=[spec.path, args.run]) as tmp:
+    with output_dir(out, inputs=[spec.path, args.run]) as tmp, progress.pictures():
         save_report(rep, tmp, pictures=not args.no_pictures)
+    progress.done()
     print(report_summary_text(rep))
     print(f"wrote {out}/report.json, {out}/report.html")
     return 0

@@ -4,6 +4,7 @@ measures, inverse problems, sweeps)."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from compare.cli.common import (
     MESH_LEVEL,
@@ -15,14 +16,18 @@ from compare.cli.common import (
     load_case_input,
     number,
     out_folder,
+    with_progress,
 )
 from spindle.errors import InputError
 
+if TYPE_CHECKING:
+    from compare.progress import Progress
 
-def _cmd_measures(args: argparse.Namespace) -> int:
+
+@with_progress("measures")
+def _cmd_measures(args: argparse.Namespace, progress: Progress) -> int:
     from compare.design.measure_file import read_measures, shipped_measures
     from compare.design.report import run_measures
-    from compare.executor import stderr_progress
     from lumped.build import PRESETS
     from spindle.drive import load_case
     from spindle.outputs import output_dir, safe_name
@@ -54,9 +59,10 @@ def _cmd_measures(args: argparse.Namespace) -> int:
     rep = run_measures(spec, mfile, case, args.level, tuple(args.lumped_nodes),
                        sweeps=not args.no_sweeps, points=args.points or 7,
                        scheduler=args.scheduler, workers=args.workers,
-                       progress=stderr_progress(not args.quiet))
-    with output_dir(out, inputs=inputs) as tmp:
+                       progress=progress.say)
+    with output_dir(out, inputs=inputs) as tmp, progress.pictures():
         files = rep.save(tmp, pictures=not args.no_pictures)
+    progress.done()
     b = rep.baseline
     print(f"{spec.name}: thermal stiffness strategy at '{case.name}' ({rep.speed_rpm:g} rpm, "
           f"{b.losses_W:.0f} W), FEM level {args.level}; {rep.runtime_s:.1f} s")

@@ -6,13 +6,25 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from compare.cli.common import MESH_LEVEL, NODE_COUNT, POSITIVE, TIME_STEP_S, add_quiet, add_spec
-from compare.cli.common import progress as _progress
+from compare.cli.common import (
+    MESH_LEVEL,
+    NODE_COUNT,
+    POSITIVE,
+    TIME_STEP_S,
+    add_quiet,
+    add_spec,
+    with_progress,
+)
 from spindle.errors import InputError
 
+if TYPE_CHECKING:
+    from compare.progress import Progress
 
-def _cmd_baseline(args: argparse.Namespace) -> int:
+
+@with_progress("baseline")
+def _cmd_baseline(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.regression import make_baseline
     from spindle.outputs import atomic_write
     from spindle.spec import load_spec
@@ -26,19 +38,22 @@ def _cmd_baseline(args: argparse.Namespace) -> int:
     settings = {"levels": sorted(set(args.levels)), "nodes": sorted(set(args.nodes)),
                 "dt_s": args.dt, "transient": not args.steady_only}
     tolerances = {"temperature_K": args.tol_temp, "growth_um": args.tol_growth}
-    doc = make_baseline(args.spec, settings, tolerances, _progress(args.quiet))
+    doc = make_baseline(args.spec, settings, tolerances, progress.say)
     out.parent.mkdir(parents=True, exist_ok=True)
     atomic_write(out, lambda tmp: tmp.write_text(json.dumps(doc, indent=1) + "\n", "utf-8"))
+    progress.done()
     print(f"{spec.name}: {len(doc['figures'])} figures in {doc['created_with_runtime_s']:.1f} s; "
           f"wrote {out}")
     return 0
 
 
-def _cmd_check(args: argparse.Namespace) -> int:
+@with_progress("check")
+def _cmd_check(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.regression import check, read_baseline
 
     doc = read_baseline(args.file)
-    changes = check(doc, progress=_progress(args.quiet))
+    changes = check(doc, progress=progress.say)
+    progress.done()
     moved = [c for c in changes if c.moved]
     if moved:
         print(f"{args.file}: {len(moved)} of {len(changes)} figures moved beyond their "

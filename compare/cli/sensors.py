@@ -3,9 +3,17 @@
 from __future__ import annotations
 
 import argparse
-import sys
+from typing import TYPE_CHECKING
 
-from compare.cli.common import MESH_LEVEL, NODE_COUNT, POSITIVE, TIME_STEP_S, number, out_folder
+from compare.cli.common import (
+    MESH_LEVEL,
+    NODE_COUNT,
+    POSITIVE,
+    TIME_STEP_S,
+    number,
+    out_folder,
+    with_progress,
+)
 from compare.verify.accuracy import (
     NODES,
     TOL_GROWTH_UM,
@@ -16,9 +24,13 @@ from compare.verify.nodecount import choose_nodes
 from compare.verify.placement import METHODS, TRAIN_FRACTION, rank_sensors
 from spindle.errors import InputError
 
+if TYPE_CHECKING:
+    from compare.progress import Progress
+
 
 # ============================================================================ command line
-def run(args: argparse.Namespace) -> int:
+@with_progress("sensors")
+def run(args: argparse.Namespace, progress: Progress) -> int:
     """``spindle-verify sensors``: the node count, and with ``--rank K`` the sensor ranking.
     Returns the exit status (0; bad input raises :class:`spindle.errors.InputError`)."""
     from spindle.outputs import output_dir, safe_name
@@ -26,12 +38,7 @@ def run(args: argparse.Namespace) -> int:
 
     spec = load_spec(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", [spec.path])
-    quiet = args.quiet
-
-    def say(msg: str) -> None:
-        if not quiet:
-            print(f"  ... {msg}", file=sys.stderr, flush=True)
-
+    say = progress.say
     cases = load_cases(spec, args.cases) if args.cases else None
     if args.rank is not None and args.rank < 1:
         raise InputError("command line", "--rank", f"{args.rank} sensors", "give --rank K >= 1")
@@ -45,10 +52,11 @@ def run(args: argparse.Namespace) -> int:
             f"(dt {args.rank_dt:g} s)")
         ranking = rank_sensors(spec, rank_case, args.rank, args.candidates, None, args.method,
                                args.rank_level, args.rank_dt, args.tol_temp, args.tol_growth)
-    with output_dir(out, inputs=[spec.path]) as tmp:
+    with output_dir(out, inputs=[spec.path]) as tmp, progress.pictures():
         files = choice.save(tmp, pictures=not args.no_pictures)
         if ranking is not None:
             files += ranking.save(tmp, pictures=not args.no_pictures)
+    progress.done()
     print(f"{spec.name}: lumped node count against {choice.curves[0].reference_label.split(',')[0]}"
           f" ({choice.runtime_s:.1f} s)")
     for c in choice.curves:

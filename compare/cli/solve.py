@@ -6,6 +6,7 @@ import argparse
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from compare.cli.common import (
     MESH_LEVEL,
@@ -19,9 +20,13 @@ from compare.cli.common import (
     load_case_input,
     number,
     out_folder,
+    with_progress,
 )
 from spindle.errors import InputError
 from spindle.units import ZERO_C_K
+
+if TYPE_CHECKING:
+    from compare.progress import Progress
 
 
 def _print_sensor_table(table: dict, title: str) -> None:
@@ -32,9 +37,8 @@ def _print_sensor_table(table: dict, title: str) -> None:
               f"{table['T_C'][i]:9.3f} {table['rise_K'][i]:8.3f}")
 
 
-def _cmd_solve(args: argparse.Namespace) -> int:
-    from compare.progress import Progress
-    from reference import ReferenceModel
+@with_progress("solve")
+def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.loads import TimeSeries
     from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
@@ -42,6 +46,7 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     if args.case and args.cycle:
         raise InputError("command line", "--case", "--case (a steady load point) and --cycle (a "
                          "transient) exclude each other", "give one of them")
+    progress.stage("reading the spec")
     spec = load_spec(args.spec)
     inputs = [spec.path, *(x for x in (args.case, args.cycle) if x and Path(x).is_file())]
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/solve", inputs)
@@ -50,10 +55,14 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         from lumped import build
 
         nodes = int(args.nodes) if args.nodes.isdigit() else args.nodes
+        progress.stage(f"building the lumped model ({nodes} nodes)")
         ref = build(spec, nodes)
         header = (f"{spec.name}: lumped function-block model, {ref.nodes} nodes along shaft "
                   f"and housing, {ref.n_states} masses")
     else:
+        progress.stage(f"meshing level {args.level} and assembling P{args.order}")
+        from reference import ReferenceModel
+
         ref = ReferenceModel(spec, args.level, args.order, centrifugal=args.centrifugal,
                              elastic=not args.thermal_only)
         c = ref.thermal.smesh.counts(args.order)
@@ -66,23 +75,32 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         case = load_case_input(spec, args.case, case, inputs)
     if args.speed is not None:
         case = replace(case, speed_rpm=TimeSeries.constant(args.speed))
-    quiet = args.quiet
     if args.cycle:
         case = load_case_input(spec, args.cycle, case, inputs)
+        progress.stage(f"transient '{case.name}'", 0.0)
         if args.model == "lumped":  # exact zero-order hold: no theta, no fields
             result = ref.transient(case, args.dt, T0=float(case.T_ambient_K(0.0)),
-                                   progress=Progress("transient", not quiet))
+                                   progress=progress.fraction)
         else:
             result = ref.transient(case, args.dt, theta=args.theta,
                                    T0=float(case.T_ambient_K(0.0)),
                                    save_every=max(1, int(round(args.save_every / args.dt))),
-                                   progress=Progress("transient", not quiet))
+                                   progress=progress.fraction)
     else:
+        progress.stage("steady solve")
         result = ref.steady(case)
     t_solve = time.perf_counter() - t0 - t_asm
     result.check_plausible(spec.path)
-    with output_dir(out, inputs=inputs) as tmp:
+    with output_dir(out, inputs=inputs) as tmp, progress.pictures():
         files = result.save(tmp, pictures=not args.no_pictures)
+    progress.done()
+    _print_result(args, ref, result, case, header, t_asm, t_solve)
+    print("wrote " + ", ".join(str(out / f.name) for f in files))
+    return 0
+
+
+def _print_result(args: argparse.Namespace, ref, result, case, header: str, t_asm: float,
+                  t_solve: float) -> None:
     print(f"{header}; {'build' if args.model == 'lumped' else 'assembly'} {t_asm:.2f} s, "
           f"solve {t_solve:.2f} s")
     if args.cycle:
@@ -114,8 +132,6 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         e = result.energy
         print(f"energy: in {e['heat_in_W']:.3f} W, out {e['heat_out_W']:.3f} W, relative "
               f"imbalance {e['relative_imbalance']:.1e}; relative residual {result.residual:.1e}")
-    print("wrote " + ", ".join(str(out / f.name) for f in files))
-    return 0
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from compare.cli.common import (
     MESH_LEVEL,
@@ -16,12 +17,16 @@ from compare.cli.common import (
     add_spec,
     out_folder,
     pass_fail,
+    with_progress,
 )
-from compare.cli.common import progress as _progress
 from spindle.errors import InputError
 
+if TYPE_CHECKING:
+    from compare.progress import Progress
 
-def _cmd_study(args: argparse.Namespace) -> int:
+
+@with_progress("study")
+def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.accuracy import worst_temperature_K
     from compare.verify.study import run_study
     from spindle.outputs import output_dir, safe_name
@@ -32,13 +37,13 @@ def _cmd_study(args: argparse.Namespace) -> int:
     if args.workers < 1:
         raise InputError("command line", "--workers", f"{args.workers} is below 1",
                          "give --workers 1 (serial) or more")
-    say = _progress(args.quiet)
     levels, nodes = sorted(set(args.levels)), sorted(set(args.nodes))
     result = run_study(spec, levels, nodes, transient=not args.steady_only, dt_s=args.dt,
-                       threshold=args.threshold / 100.0, progress=say, workers=args.workers,
+                       threshold=args.threshold / 100.0, progress=progress.say, workers=args.workers,
                        scheduler=args.scheduler)
-    with output_dir(out, inputs=[spec.path]) as tmp:
+    with output_dir(out, inputs=[spec.path]) as tmp, progress.pictures():
         result.save(tmp, pictures=not args.no_pictures)
+    progress.done()
     conv = result.convergence
     gt = result.ground_truth_level
     print(f"{spec.name}: verification study, {result.runtime_s:.1f} s")

@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from compare.cli.common import MESH_LEVEL, number
+from compare.cli.common import MESH_LEVEL, add_quiet, number, with_progress
 from spindle.errors import InputError
 
+if TYPE_CHECKING:
+    from compare.progress import Progress
 
-def _cmd_synth(args: argparse.Namespace) -> int:
+
+@with_progress("synth")
+def _cmd_synth(args: argparse.Namespace, progress: Progress) -> int:
     from compare.fit.greybox import EFFECTS
     from compare.fit.synth import OUTSIDE, synth
     from spindle.spec import load_spec
@@ -22,8 +27,10 @@ def _cmd_synth(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.suffix.lower() != ".csv":
         raise InputError(str(out), "--out", "is not a .csv file name", "give e.g. run.csv")
+    progress.stage(f"FEM level {args.level} run of '{args.cycle}' with the effect '{args.effect}'")
     truth = synth(spec, args.cycle, args.effect, args.seed, out, level=args.level,
                   mismatch=args.mismatch)
+    progress.done()
     print(f"wrote {out} and {out.with_suffix('.truth.json')} (effect {truth['effect']}, "
           f"seed {truth['seed']})")
     return 0
@@ -57,4 +64,5 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          "contacts, axial length, friction, loss split, FEM level; drawn from "
                          "the seed and recorded in the truth; docs/fit.md)")
     sy.add_argument("--out", required=True, help="the CSV to write")
+    add_quiet(sy)
     sy.set_defaults(func=_cmd_synth)

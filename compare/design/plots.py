@@ -2,9 +2,10 @@
 :mod:`compare.design.report`.
 
 - :func:`fig15_png`: the paper's Fig. 15, the temperature drop Delta T = T1 (lambda - 1) /
-  lambda (eq. 24) against the heat stiffness ratio lambda_tr, with each measure's lambda
-  from the formulas and from the reference on it (T1: the reference's mean excess
-  temperature before the measures).
+  lambda (eq. 24) against the heat stiffness ratio lambda_tr (log axes of lambda_tr - 1 and
+  Delta T), with each measure's lambda from the formulas and from the reference on it
+  (T1: the reference's mean excess temperature before the measures); beside it one row per
+  measure with both temperature drops written out.
 - :func:`fig16_png`: Fig. 16-style sensitivities, heat stiffness K_alpha against added area,
   length, film coefficient and heat flow: reference (mean and maximum) and the simplified
   formula 1 / sum(alpha_i A_i).
@@ -36,42 +37,79 @@ def _points(rep: MeasuresReport):
     return out
 
 
-def _draw_fig15(ax, T1: float, lam_max: float, pts, zoom: bool) -> None:
-    lam = np.linspace(1.0, lam_max, 400)
-    ax.plot(lam, temperature_drop_K(T1, lam), color="k", lw=1.5,
+#: the left panel's x axis, lambda_tr - 1, on a log scale: a measure below the lower end
+#: (no gain, or a loss: lambda <= 1) is drawn at it and says so in the legend
+_LAMBDA_EXCESS_RANGE = (1e-3, 10.0)
+_COLORS = ("tab:blue", "tab:orange", "tab:red", "tab:purple", "tab:brown", "tab:pink",
+           "tab:olive", "tab:cyan", "tab:gray")
+
+
+def _excess(lam: float) -> float:
+    """lambda_tr - 1 for the log axis, held at the axis's lower end."""
+    return max(lam - 1.0, _LAMBDA_EXCESS_RANGE[0])
+
+
+def _draw_fig15_curve(ax, T1: float, pts) -> None:
+    """Eq. 24 against lambda_tr - 1 on a log axis: the measures' lambdas, from 1.002 to 1.7
+    on spl2782, spread over three decades instead of crowding at lambda = 1."""
+    lo, hi = _LAMBDA_EXCESS_RANGE
+    x = np.geomspace(lo, hi, 400)
+    ax.plot(x, temperature_drop_K(T1, 1.0 + x), color="k", lw=1.5,
             label=f"eq. 24: T1 (lambda - 1) / lambda, T1 = {T1:.1f} K")
-    if not zoom:
-        ax.axvspan(*PAPER_LAMBDA_RANGE, color="tab:green", alpha=0.08,
-                   label="paper's recommended 1.1 < lambda <= 5..6")
-    colors = iter(("tab:blue", "tab:orange", "tab:red", "tab:purple", "tab:brown", "tab:pink",
-                   "tab:olive", "tab:cyan", "tab:gray"))
-    for name, lf, lr in pts:
-        c = next(colors, "tab:gray")
-        ax.plot([lf], [temperature_drop_K(T1, lf)], "o", mfc="none", mec=c, ms=8)
-        ax.plot([lr], [temperature_drop_K(T1, lr)], "s", color=c, ms=6, label=name)
-        ax.annotate("", xy=(lr, temperature_drop_K(T1, lr)),
-                    xytext=(lf, temperature_drop_K(T1, lf)),
+    ax.axvspan(PAPER_LAMBDA_RANGE[0] - 1.0, PAPER_LAMBDA_RANGE[1] - 1.0, color="tab:green",
+               alpha=0.08, label="paper's recommended 1.1 < lambda <= 5..6")
+    for (name, lf, lr), c in zip(pts, _COLORS * len(pts), strict=False):
+        below = " (lambda <= 1 + 1e-3 drawn at the axis)" if min(lf, lr) - 1.0 < lo else ""
+        ax.plot([_excess(lf)], [temperature_drop_K(T1, max(lf, 1.0 + lo))], "o", mfc="none",
+                mec=c, ms=8)
+        ax.plot([_excess(lr)], [temperature_drop_K(T1, max(lr, 1.0 + lo))], "s", color=c,
+                ms=6, label=name + below)
+        ax.annotate("", xy=(_excess(lr), temperature_drop_K(T1, max(lr, 1.0 + lo))),
+                    xytext=(_excess(lf), temperature_drop_K(T1, max(lf, 1.0 + lo))),
                     arrowprops={"arrowstyle": "->", "color": c, "lw": 0.8})
-    ax.set_xlabel("heat stiffness ratio lambda_tr = K_alpha1 / K_alpha2")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlim(lo, hi)
+    ax.set_ylim(temperature_drop_K(T1, 1.0 + lo) / 1.5, T1 * 1.5)
+    ax.set_xlabel("heat stiffness ratio minus one, lambda_tr - 1 = K_alpha1 / K_alpha2 - 1")
     ax.set_ylabel("drop of the mean excess temperature Delta T [K]")
     ax.grid(alpha=0.3)
-    ax.set_xlim(1.0, lam_max)
-    ax.set_ylim(bottom=0.0)
+
+
+def _draw_fig15_rows(ax, T1: float, pts) -> None:
+    """One row per measure: the temperature drop by the formulas (o) and by the FEM
+    reference (■), with both values in the row's label."""
+    names = []
+    for row, ((name, lf, lr), c) in enumerate(zip(pts, _COLORS * len(pts), strict=False)):
+        df, dr = temperature_drop_K(T1, lf), temperature_drop_K(T1, lr)
+        ax.plot([df], [row], "o", mfc="none", mec=c, ms=8)
+        ax.plot([dr], [row], "s", color=c, ms=6)
+        ax.annotate("", xy=(dr, row), xytext=(df, row),
+                    arrowprops={"arrowstyle": "->", "color": c, "lw": 0.8})
+        names.append(f"{name}\no {df:.2f} K, ■ {dr:.2f} K (lambda {lf:.3f}, {lr:.3f})")
+    ax.set_yticks(range(len(names)), names, fontsize=8)
+    ax.set_ylim(len(names) - 0.5, -0.5)
+    if pts and min(temperature_drop_K(T1, v) for _, lf, lr in pts for v in (lf, lr)) > 0:
+        ax.set_xscale("log")
+    ax.set_xlabel("drop of the mean excess temperature Delta T [K] (eq. 24)")
+    ax.grid(alpha=0.3, axis="x")
 
 
 def fig15_png(rep: MeasuresReport, path: Path) -> None:
     """Fig. 15 with the measures: open circle = formula's lambda, filled square = the
-    reference's; the right panel zooms on the measures' range."""
+    reference's. Left: eq. 24 on log axes, so that lambdas a little above 1 stay apart;
+    right: one row per measure with its temperature drops written out."""
     plt = pyplot()
     T1 = rep.baseline.mean_rise_K
     pts = _points(rep)
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.8), layout="constrained")
-    _draw_fig15(a1, T1, 6.0, pts, zoom=False)
-    a1.set_title("paper Fig. 15: Delta T against lambda_tr (eq. 24)", fontsize=10)
-    a1.legend(fontsize=7, loc="lower right")
-    top = max([1.0] + [max(lf, lr) for _, lf, lr in pts])
-    _draw_fig15(a2, T1, 1.0 + 1.15 * (top - 1.0) if top > 1.0 else 1.1, pts, zoom=True)
-    a2.set_title("zoom on the measures: o formulas (eq. 25-30), ■ FEM reference", fontsize=10)
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 5.2), layout="constrained",
+                                 width_ratios=(1.1, 1.0))
+    _draw_fig15_curve(a1, T1, pts)
+    a1.set_title("paper Fig. 15: Delta T against lambda_tr (eq. 24), log axes; o formulas, "
+                 "■ FEM", fontsize=10)
+    a1.legend(fontsize=7, loc="upper left")
+    _draw_fig15_rows(a2, T1, pts)
+    a2.set_title("each measure: o formulas (eq. 25-30) -> ■ FEM reference", fontsize=10)
     fig.suptitle(f"{rep.spec_name}, {rep.case_name}: heat stiffness ratio of the measures",
                  fontsize=11)
     atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=130))

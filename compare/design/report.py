@@ -97,7 +97,7 @@ class MeasuresReport:
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         """measures.csv, indicators.csv, inverse.csv, sweeps.csv, measures.md, measures.json
         and (``pictures``) the Fig. 15 and Fig. 16 PNGs, each written atomically."""
-        from spindle.outputs import atomic_write, write_csv, write_json
+        from spindle.outputs import atomic_write, expect_pictures, write_csv, write_json
 
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
@@ -116,6 +116,7 @@ class MeasuresReport:
         if pictures:
             from compare.design import plots
 
+            expect_pictures(1 + bool(self.sweeps))
             plots.fig15_png(self, out / "fig15_temperature_drop.png")
             files.append("fig15_temperature_drop.png")
             if self.sweeps:
@@ -207,7 +208,9 @@ def run_measures(spec: Spec, mfile: MeasureFile, case: LoadCase, level: int = 1,
     from compare.executor import run_cases
 
     t0 = time.perf_counter()
+    say = progress or (lambda _m: None)
     speed = case_speed_rpm(case)
+    say(f"baseline: FEM level {level} and the lumped models {', '.join(map(str, nodes))}")
     # the baseline runs here first: it fails loudly on a bad spec, and the pool's forked
     # workers inherit its assembled model
     base = MeasureCase(spec, case, None, level, tuple(nodes)).run()
@@ -218,7 +221,10 @@ def run_measures(spec: Spec, mfile: MeasureFile, case: LoadCase, level: int = 1,
     cases += [InverseCase(spec, case, t, by_name[t.measure], level) for t in mfile.inverse]
     cases += [SweepCase(spec, case, sw, float(x), level) for sw in sweep_specs for x in sw.values]
     if sweep_specs:  # the sweeps' thermal-only model, also inherited by the workers
+        say(f"assembling the sweeps' thermal-only FEM model (level {level})")
         reference_model(spec, level, elastic=False)
+    say(f"{len(cases)} cases: {len(mfile.measures)} measures, {len(mfile.inverse)} inverse "
+        f"problems, {len(cases) - len(mfile.measures) - len(mfile.inverse)} sweep points")
     outcomes = run_cases(run_case, cases, scheduler=scheduler, workers=workers,
                          progress=progress)
     measures, inverse, points, failures = [], [], [], []
