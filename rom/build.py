@@ -77,7 +77,7 @@ def build_rom(reference, training: LoadCase, dt_s: float = 60.0, tol_temp_K: flo
               tol_growth_um: float = 0.1, sizes: Sequence[int] = SIZES,
               speeds_rpm: Sequence[float] | None = None, shifts: Sequence[float] = DEFAULT_SHIFTS,
               fem_training: tuple[np.ndarray, np.ndarray] | None = None, keep_basis: bool = True,
-              safety: float = SAFETY, level: int = -1,
+              safety: float = SAFETY, level: int = -1, indicator: bool = True,
               progress: Callable[[str], None] | None = None) -> tuple[ReducedModel, BuildReport]:
     """A ROM of ``reference`` (a :class:`reference.ReferenceModel` of mesh ``level``) with the
     smallest size of ``sizes`` that meets the tolerances divided by ``safety`` on ``training``
@@ -134,10 +134,27 @@ def build_rom(reference, training: LoadCase, dt_s: float = 60.0, tol_temp_K: flo
     info = {"level": level, "training": training.name, "safety": safety,
             "dt_s": dt_s, "candidates": int(W.shape[1])}
     rom = reduced_model(reference, red, V if keep_basis else None, full, info)
+    if indicator:
+        t5 = time.perf_counter()
+        rom.indicator = _calibrated_indicator(full, V, rom, training, dt_s, Y_ref)
+        timings["indicator"] = time.perf_counter() - t5
     timings["build_total_excluding_fem"] = time.perf_counter() - t0 - timings.get("fem_training", 0)
     report = BuildReport(training.name, dt_s, int(W.shape[1]), tried, errors, chosen, tol_temp_K,
                          tol_growth_um, safety, timings, [float(s) for s in speeds_rpm], list(shifts))
     return rom, report
+
+
+def _calibrated_indicator(full: FullSystem, V: np.ndarray, rom: ReducedModel,
+                          training: LoadCase, dt_s: float, Y_ref: np.ndarray):
+    """The residual indicator (rom.indicator) of basis V, its sensor calibration the ratio of
+    the true worst sensor error on the training cycle to its bound there."""
+    from rom.indicator import residual_indicator
+
+    ind = residual_indicator(full, V)
+    grid, Z = rom.system.simulate(rom.inputs, training, dt_s, rom.initial(), "be")
+    true = output_errors(full, rom.outputs(Z), Y_ref)["temperature_max_K"]
+    ind.calibration_K = true / max(float(ind.bound(rom, training, grid, Z).max()), 1e-300)
+    return ind
 
 
 def _steady_columns(cand, full: FullSystem, training: LoadCase, dt_s: float,

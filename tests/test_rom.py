@@ -137,3 +137,24 @@ def test_c_export_matches_the_predictor(spl0, tmp_path):
         worst = max(worst, float(np.abs(y - pred.outputs_now()).max()))
     assert worst < 1e-9
     assert {f.suffix for f in files} == {".npz", ".json", ".h", ".c"}
+
+
+def test_error_indicator_tracks_the_true_error(spl0):
+    """The residual bound of a run falls with the size as the true error does, and on a
+    held-out cycle its calibrated estimate is within a factor 10 of the true worst sensor
+    error (the calibration is a ratio from another cycle: an order of magnitude is what a
+    user needs to decide whether to trust a run)."""
+    ref, rom, _ = spl0
+    case = named_case(ref.spec, "spl-16h")
+    fem = ref.transient(case, DT)
+    res = rom.transient(case, DT)
+    true = np.abs(res.sensor_K - fem.sensor_K).max()
+    est = res.error_estimate["estimated_max_K"]
+    assert true / 10 <= est <= true * 10
+    # a much smaller ROM: the bound and the true error both grow
+    small, _ = build_rom(ref, named_case(ref.spec, "random-loaded", 0), DT, 5.0, 5.0,
+                         sizes=(4,), level=0)
+    res_s = small.transient(case, DT)
+    true_s = np.abs(res_s.sensor_K - fem.sensor_K).max()
+    assert true_s > true
+    assert res_s.error_estimate["bound_rms_K"] > res.error_estimate["bound_rms_K"]
