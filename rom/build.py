@@ -102,7 +102,7 @@ def build_rom(reference, training: LoadCase, dt_s: float = 60.0, tol_temp_K: flo
     T0 = full.T_initial_K
     _, Zc = cand.simulate(full.inputs, training, dt_s, cand.z_one * T0, "be")
     Phi, _ = pod_directions(cand, Zc - np.outer(np.ones(len(Zc)), cand.z_one * T0),
-                            _steady_columns(cand, full, training, dt_s, speeds_rpm))
+                            _response_columns(cand, full, training, dt_s, speeds_rpm, shifts))
     timings["pod"] = time.perf_counter() - t2
     if fem_training is None:
         say(f"FEM backward Euler on {training.name} (dt {dt_s:g} s) for the size choice")
@@ -157,11 +157,13 @@ def _calibrated_indicator(full: FullSystem, V: np.ndarray, rom: ReducedModel,
     return ind
 
 
-def _steady_columns(cand, full: FullSystem, training: LoadCase, dt_s: float,
-                    speeds_rpm: Sequence[float]) -> np.ndarray:
-    """Reduced steady responses to each input at each basis speed, scaled to the input's
-    swing on the training cycle (at least 100 W for a source, 1 K for a temperature), so
-    that inputs the training cycle barely moves still get their directions."""
+def _response_columns(cand, full: FullSystem, training: LoadCase, dt_s: float,
+                      speeds_rpm: Sequence[float], shifts: Sequence[float]) -> np.ndarray:
+    """Reduced responses (K_r(n) + s I)^-1 B_r(n) to each input at each basis speed n and
+    shift s (s = 0: the steady response; s > 0: about the step response at t = 1/s), scaled
+    to the input's swing on the training cycle (at least 100 W for a source, 1 K for a
+    temperature), so that inputs and time scales the training cycle barely excites still
+    get their directions."""
     grid = time_grid(training, dt_s)
     U = full.inputs(training, grid)
     swing = U.max(axis=0) - U.min(axis=0)
@@ -169,9 +171,11 @@ def _steady_columns(cand, full: FullSystem, training: LoadCase, dt_s: float,
     swing[:m] = np.maximum(swing[:m], 100.0)
     swing[m:] = np.maximum(swing[m:], 1.0)
     cols = []
+    eye = np.eye(cand.r)
     for n in speeds_rpm:
         K, B = cand.K(float(n)), cand.B(float(n))
-        cols.append(np.linalg.solve(K, B * swing[None, :]))
+        for s in shifts:
+            cols.append(np.linalg.solve(K + s * eye, B * swing[None, :]))
     return np.hstack(cols)
 
 

@@ -46,7 +46,7 @@ from spindle.spec import BearingLink
 TWO_PI = 2.0 * math.pi
 #: Krylov shifts [1/s]: 0 (steady state) to 0.1 1/s (10 s), covering the thermal time
 #: constants of a spindle (minutes to hours) and the 1 s sample time of a controller
-DEFAULT_SHIFTS = (0.0, 3e-5, 3e-4, 3e-3, 3e-2)
+DEFAULT_SHIFTS = (0.0, 3e-5, 3e-4, 3e-3, 3e-2, 0.3)
 #: speeds of the Krylov vectors, as fractions of the top speed (4 points over 0..top)
 SPEED_FRACTIONS = (0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0)
 
@@ -163,8 +163,7 @@ def fem_transient(full: FullSystem, case: LoadCase, dt_s: float, T0: float | Non
         dt, n = grid[k] - grid[k - 1], float(speeds[k - 1])
         key = (round(dt, 9), n)
         if key not in lus:
-            if len(lus) > 12:
-                lus.clear()
+            lus.clear()  # one LU at a time: at level 2 each holds about 100 MB
             lus[key] = factorize(full.M / dt + full.K(n))
         if n not in Bs:
             Bs[n] = full.B(n)

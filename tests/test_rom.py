@@ -158,3 +158,25 @@ def test_error_indicator_tracks_the_true_error(spl0):
     true_s = np.abs(res_s.sensor_K - fem.sensor_K).max()
     assert true_s > true
     assert res_s.error_estimate["bound_rms_K"] > res.error_estimate["bound_rms_K"]
+
+
+def test_study_rom_row():
+    """The ROM as a row of the study's tables (fin-shaft, whose reference is exact in time):
+    its error against the reference is the projection error, below the ROM's tolerance,
+    while the steady reference is the Richardson extrapolation of the levels (the ROM of the
+    finest level inherits that level's discretisation error, below 1e-3 K on fin-shaft,
+    tests/test_study.py)."""
+    from compare.verify.study import run_study
+    from spindle.spec import load_spec
+
+    study = run_study(load_spec("fin-shaft"), levels=(0, 1, 2), nodes=(3,), dt_s=600.0, rom=True)
+    for acc in (study.steady, study.transient):
+        t = acc.table()
+        i = [k for k, kind in enumerate(t["kind"]) if kind == "rom"]
+        assert len(i) == 1
+        worst = max(v[i[0]] for k, v in t.items() if k.endswith("_max_K"))
+        assert worst <= TOL_K + 1e-3
+        assert t["unknowns"][i[0]] <= 100
+    fig = study.transient.plot().figure
+    labels = [text.get_text() for text in fig.axes[0].get_legend().get_texts()]
+    assert any("ROM" in lab for lab in labels)

@@ -315,7 +315,7 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
               steady_case: LoadCase | None = None, transient_case: LoadCase | None = None,
               transient: bool = True, dt_s: float = 60.0, threshold: float = 0.01,
               progress: Callable[[str], None] | None = None, workers: int = 1,
-              scheduler: str | None = None) -> StudyResult:
+              scheduler: str | None = None, rom: bool = False) -> StudyResult:
     """Run the whole study (see the module docstring).
 
     The steady FEM levels (grid convergence) run first, here. Then every independent run (the
@@ -329,6 +329,11 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
 
     A run that fails does not stop the study: it is reported through ``progress`` and
     listed in :attr:`StudyResult.failures`, and its model is missing from the tables.
+
+    ``rom``: also a reduced-order model of the reference level (rom.build_rom, trained on
+    the random-loaded:0 cycle, 0.05 K / 0.1 µm) as a row of both tables, integrated in time
+    as the reference was. Off by default: on spl2782 it adds about a minute and the
+    build's 0.5-1 GB of candidate vectors (docs/rom.md).
     """
     from compare.executor import import_dask, run_cases
 
@@ -391,6 +396,12 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
             else:
                 failures.append(_failure(o))
 
+    if rom:
+        rom_rows = _rom_rows(spec, ref_level, s_case, t_case if reference is not None else None,
+                             dt_s, T0, reference.time_method if reference else "", progress)
+        got["steady"].append(rom_rows[0])
+        if reference is not None:
+            got["lumped"].append(rom_rows[1])
     eq14 = eq14_entry(spec, s_case)
     steady = AccuracyResult(spec, s_case.name, False, ref_entry, label,
                             ([eq14] if eq14 else []) + got["steady"] + fem)
@@ -412,6 +423,30 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     ref_res = conv.results[conv.levels.index(ref_level)]
     return StudyResult(spec, conv, steady, trans, gt, ref_level, time.perf_counter() - t0,
                        s_case, ref_res, failures, time_integration)
+
+
+def _rom_rows(spec: Spec, level: int, s_case: LoadCase, t_case: LoadCase | None, dt_s: float,
+              T0: float, time_method: str, progress: Callable[[str], None] | None
+              ) -> list[Entry]:
+    """The ROM of FEM ``level``: its steady row, and its transient row if ``t_case``."""
+    from compare.verify.accuracy import rom_entry
+    from reference import ReferenceModel
+    from rom import build_rom
+    from rom.build import named_case
+
+    if progress:
+        progress(f"ROM of FEM level {level} (trained on random-loaded:0)")
+    ref = ReferenceModel(spec, level)
+    train = named_case(spec, "random-loaded", 0)
+    if t_case is not None and t_case.extra_times_s:  # read 1 ... 64 s after the steps too:
+        train = train.with_jump_ladder()  # then the ROM is chosen on those times as well
+    model, _ = build_rom(ref, train, 60.0, level=level, keep_basis=False, indicator=False)
+    ref.release()
+    del ref
+    rows = [rom_entry(model, s_case, None, None)]
+    if t_case is not None:
+        rows.append(rom_entry(model, t_case, dt_s, T0, time_method))
+    return rows
 
 
 def _failure(outcome) -> dict[str, str]:
