@@ -180,3 +180,18 @@ def test_study_rom_row():
     fig = study.transient.plot().figure
     labels = [text.get_text() for text in fig.axes[0].get_legend().get_texts()]
     assert any("ROM" in lab for lab in labels)
+
+
+def test_sensors_considers_the_rom():
+    """`sensors` with the ROM on spl2782 (level 0, to be fast): the lumped 11-node model
+    fails the paper's 1 K / 1.5 µm (the harness's headline) while the ROM sized for them
+    meets them on both cases, against the same FEM reference."""
+    from compare.verify.nodecount import choose_nodes
+    from spindle.spec import load_spec
+
+    choice = choose_nodes(load_spec("spl2782"), None, 1.0, 1.5, (11,), 0, 600.0, rom=True)
+    assert choice.chosen is None
+    assert choice.rom["meets"] and choice.rom["states"] <= 100
+    assert len(choice.rom["cases"]) == 2
+    assert all(c["worst_err_K"] <= 1.0 and c["err_P1_um"] <= 1.5 for c in choice.rom["cases"])
+    assert "reduced-order model" in choice.message() and choice.summary()["rom"] is choice.rom
