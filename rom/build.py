@@ -88,6 +88,7 @@ def build_rom(reference, training: LoadCase, dt_s: float = 60.0, tol_temp_K: flo
     timings = {}
     t0 = time.perf_counter()
     full = full_system(reference)
+    reference.release()  # the elastic LU of the growth gains is no longer needed
     timings["read-outs"] = time.perf_counter() - t0
     if speeds_rpm is None:
         grid = time_grid(training, dt_s)

@@ -183,16 +183,23 @@ def fem_steady(full: FullSystem, case: LoadCase, t: float = 0.0) -> np.ndarray:
 
 
 # ============================================================================ basis
+def _gram(W: np.ndarray, M, chunk: int = 64) -> np.ndarray:
+    """W^T M W, M W formed a block of columns at a time (memory: one block, not W again)."""
+    G = np.empty((W.shape[1], W.shape[1]))
+    for a in range(0, W.shape[1], chunk):
+        G[:, a:a + chunk] = W.T @ (M @ W[:, a:a + chunk])
+    return 0.5 * (G + G.T)
+
+
 def m_orthonormalize(W: np.ndarray, M, rtol: float = 1e-11) -> np.ndarray:
     """Columns spanning W's range (directions above rtol of the largest dropped), orthonormal
     in the M inner product; two passes of the Gram-matrix method (the second restores
-    orthonormality to round-off)."""
-    norms = np.sqrt(np.einsum("ij,ij->j", W, M @ W))
-    W = W[:, norms > 0] / norms[norms > 0][None, :]  # an input the spec lacks is zero
+    orthonormality to round-off). W is overwritten."""
+    norms = np.sqrt(np.diag(_gram(W, M)))
+    W = W[:, norms > 0]  # an input the spec lacks is zero
+    W /= norms[norms > 0][None, :]
     for _ in range(2):
-        G = W.T @ (M @ W)
-        G = 0.5 * (G + G.T)
-        lam, U = np.linalg.eigh(G)
+        lam, U = np.linalg.eigh(_gram(W, M))
         keep = lam > rtol * lam.max()
         W = W @ (U[:, keep] / np.sqrt(lam[keep])[None, :])
     return W
@@ -205,17 +212,19 @@ def krylov_candidates(full: FullSystem, speeds_rpm: Sequence[float],
     orthonormal in M."""
     from reference.thermal import factorize
 
-    cols = [np.ones((full.n, 1))]
     Ot = full.O.T
+    m = full.F_src.shape[1] + 2 + Ot.shape[1]
+    W = np.empty((full.n, 1 + len(speeds_rpm) * len(shifts) * m))
+    W[:, 0] = 1.0
+    j = 1
     for n in speeds_rpm:
         K, B = full.K(float(n)), full.B(float(n))
         rhs = np.hstack([B, Ot])
         for s in shifts:
             if progress:
                 progress(f"Krylov vectors at {n:g} rpm, shift {s:g} 1/s")
-            X = factorize(K + s * full.M if s else K).solve(rhs)
-            cols.append(X)
-    W = np.hstack(cols)
+            W[:, j:j + m] = factorize(K + s * full.M if s else K).solve(rhs)
+            j += m
     return m_orthonormalize(W, full.M)
 
 
