@@ -51,9 +51,9 @@ int main(int argc, char **argv) {
 
 
 def main() -> None:
+    from compare.verify.romstudy import named_case
     from reference import ReferenceModel
     from rom import build_rom
-    from rom.build import named_case
     from rom.export import export
     from rom.realtime import ROMPredictor
 

@@ -15,8 +15,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from lumped.realtime import _CHUNK, modal_recursion
+from lumped.realtime import modal_recursion
 from rom.model import ReducedModel, _phi
+
+_CHUNK = 16384  # samples per block of the batch replay (as lumped.realtime: stays in cache)
 
 
 class ROMPredictor:

@@ -11,9 +11,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from compare.verify.romstudy import named_case
 from reference import ReferenceModel
 from rom import build_rom
-from rom.build import named_case
 from rom.model import fem_transient, full_system
 from rom.realtime import ROMPredictor
 

@@ -40,9 +40,9 @@ def _check_cycles(texts: list[str]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from compare.verify.romstudy import rom_study
     from rom.export import export
     from rom.realtime import ROMPredictor
-    from rom.run import rom_study
     from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 

@@ -311,9 +311,9 @@ def choose_nodes(spec: Spec, cases: Sequence[LoadCase] | None = None,
 def _rom_for(spec: Spec, level: int, tol_temp_K: float, tol_growth_um: float,
              progress: Callable[[str], None] | None):
     """The ROM of FEM ``level`` sized for the tolerances (rom.build_rom)."""
+    from compare.verify.romstudy import named_case
     from reference import ReferenceModel
     from rom import build_rom
-    from rom.build import named_case
 
     if progress:
         progress(f"reduced-order model of FEM level {level} for {tol_temp_K:g} K / "

@@ -430,9 +430,9 @@ def _rom_rows(spec: Spec, level: int, s_case: LoadCase, t_case: LoadCase | None,
               ) -> list[Entry]:
     """The ROM of FEM ``level``: its steady row, and its transient row if ``t_case``."""
     from compare.verify.accuracy import rom_entry
+    from compare.verify.romstudy import named_case
     from reference import ReferenceModel
     from rom import build_rom
-    from rom.build import named_case
 
     if progress:
         progress(f"ROM of FEM level {level} (trained on random-loaded:0)")

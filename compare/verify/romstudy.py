@@ -1,4 +1,4 @@
-"""The ``rom`` command's work: build a ROM at a FEM level, check it on held-out cycles, export.
+"""The ``rom`` command's work: build a ROM (rom/) at a FEM level, check it on held-out cycles.
 
 :func:`rom_study` builds the ROM (rom.build.build_rom) on the training cycle, runs the FEM
 (backward Euler on the same grid, or the steady solve for a steady cycle) and the ROM on
@@ -15,8 +15,31 @@ from pathlib import Path
 
 import numpy as np
 
-from rom.build import BuildReport, build_rom, meets, named_case, output_errors
+from rom.build import BuildReport, build_rom, meets, output_errors
 from rom.model import ReducedModel, fem_steady, fem_transient, full_system
+from spindle.loads import LoadCase
+
+
+def named_case(spec, name: str, seed: int = 0) -> LoadCase:
+    """The load case of a shipped cycle (or cycle file) through the spec's power balance, or
+    of ``random`` / ``random-loaded``: the cycle ``spindle-verify synth`` draws from ``seed``
+    (compare.fit.mismatch.random_cycle, top speed RANDOM_MAX_SPEED_RPM), named with its
+    seed."""
+    from dataclasses import replace
+
+    from compare.fit.mismatch import random_cycle
+    from compare.fit.synth import RANDOM_CYCLES, RANDOM_MAX_SPEED_RPM
+    from spindle.cycles import load_cycle
+    from spindle.drive import cycle_load_case
+
+    if name in RANDOM_CYCLES:
+        cycle = random_cycle(np.random.default_rng([seed, 2]), RANDOM_MAX_SPEED_RPM,
+                             loaded=name == "random-loaded")
+        return replace(cycle_load_case(spec, cycle), name=f"{name} (seed {seed})")
+    cycle = load_cycle(name)
+    case = cycle_load_case(spec, cycle)
+    return replace(case, duration_s=0.0) if cycle.steady else case
+
 
 #: the held-out cycles of the issue: the paper's 16 h cycle, the nominal steady state, a
 #: loaded random cycle and a no-load random cycle (seeds other than the training's)
