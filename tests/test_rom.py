@@ -195,3 +195,34 @@ def test_sensors_considers_the_rom():
     assert len(choice.rom["cases"]) == 2
     assert all(c["worst_err_K"] <= 1.0 and c["err_P1_um"] <= 1.5 for c in choice.rom["cases"])
     assert "reduced-order model" in choice.message() and choice.summary()["rom"] is choice.rom
+
+
+def test_rom_command_writes_its_outputs(tmp_path, capsys):
+    import json
+
+    from compare.cli import main
+
+    out = tmp_path / "rom"
+    assert main(["rom", "spl2782", "--level", "0", "--dt", "600", "--held-out", "spl-16h",
+                 "nominal", "--quiet", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "held-out cycles: PASS" in text
+    summary = json.loads((out / "rom.json").read_text())
+    assert summary["states"] <= 100 and summary["meets_tolerances_on_held_out"]
+    assert [h["case"] for h in summary["held_out"]] == ["spl-16h", "nominal"]
+    for name in ("rom_errors.csv", "rom.npz", "rom_size.png", "controller/spindle_rom.c",
+                 "controller/spindle_rom.h", "controller/spindle_rom.json"):
+        assert (out / name).exists(), name
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--held-out", "no-such-cycle"], "neither a shipped cycle"),
+    (["--cycle", "random:x"], "is not a whole number"),
+    (["--tol-temp", "0"], "argument --tol-temp"),
+])
+def test_rom_command_bad_options_exit_2(tmp_path, capsys, args, words):
+    from compare.cli import main
+
+    assert main(["rom", "fin-shaft", *args, "--out", str(tmp_path / "x")]) == 2
+    assert words in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
