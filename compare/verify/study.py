@@ -397,7 +397,8 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
                 failures.append(_failure(o))
 
     if rom:
-        rom_rows = _rom_rows(spec, ref_level, s_case, t_case if reference is not None else None,
+        ref_res = conv.results[conv.levels.index(ref_level)]
+        rom_rows = _rom_rows(ref_res, ref_level, s_case, t_case if reference is not None else None,
                              dt_s, T0, reference.time_method if reference else "", progress)
         got["steady"].append(rom_rows[0])
         if reference is not None:
@@ -425,10 +426,11 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
                        s_case, ref_res, failures, time_integration)
 
 
-def _rom_rows(spec: Spec, level: int, s_case: LoadCase, t_case: LoadCase | None, dt_s: float,
+def _rom_rows(ref_res, level: int, s_case: LoadCase, t_case: LoadCase | None, dt_s: float,
               T0: float, time_method: str, progress: Callable[[str], None] | None
               ) -> list[Entry]:
-    """The ROM of FEM ``level``: its steady row, and its transient row if ``t_case``."""
+    """The ROM of FEM ``level`` (built on the operators of its steady result ``ref_res``):
+    its steady row, and its transient row if ``t_case``."""
     from compare.verify.accuracy import rom_entry
     from compare.verify.romstudy import named_case
     from reference import ReferenceModel
@@ -436,13 +438,13 @@ def _rom_rows(spec: Spec, level: int, s_case: LoadCase, t_case: LoadCase | None,
 
     if progress:
         progress(f"ROM of FEM level {level} (trained on random-loaded:0)")
-    ref = ReferenceModel(spec, level)
+    ref = ReferenceModel.from_parts(ref_res.model, ref_res.elastic)
+    spec = ref.spec
     train = named_case(spec, "random-loaded", 0)
     if t_case is not None and t_case.extra_times_s:  # read 1 ... 64 s after the steps too:
         train = train.with_jump_ladder()  # then the ROM is chosen on those times as well
     model, _ = build_rom(ref, train, 60.0, level=level, keep_basis=False, indicator=False)
     ref.release()
-    del ref
     rows = [rom_entry(model, s_case, None, None)]
     if t_case is not None:
         rows.append(rom_entry(model, t_case, dt_s, T0, time_method))
