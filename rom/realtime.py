@@ -5,8 +5,9 @@
 fixed sample time (M_r = I and K_r(n) symmetric, so exp(-K_r dt) comes from one small
 eigendecomposition per speed, cached to ``speed_resolution_rpm``), fused with the read-out
 into one matrix acting on [z, u, 1]: ``step(u, speed) -> (sensor temperatures [K], P1 [m])``.
-:meth:`ROMPredictor.run` replays a whole record through the lumped predictor's modal
-recursion (no Python loop over samples).
+:meth:`ROMPredictor.run` replays a whole record mode by mode: each mode is a first-order
+recursion, run by scipy.signal.lfilter (no Python loop over samples; the lumped predictor's
+blocked cumulative sums would take tiny blocks here, as the ROM keeps modes of a few seconds).
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from lumped.realtime import modal_recursion
 from rom.model import ReducedModel, _phi
 
 _CHUNK = 16384  # samples per block of the batch replay (as lumped.realtime: stays in cache)
@@ -108,7 +108,20 @@ class ROMPredictor:
             w = Q.T @ z
             for c0 in range(a0, b0, _CHUNK):
                 c1 = min(c0 + _CHUNK, b0)
-                Y[c0:c1], w = modal_recursion(e, Bm, U[c0:c1], w, out)
+                Y[c0:c1], w = _first_order(e, Bm, U[c0:c1], w, out)
             z = Q @ w
         self.xu[:self.n] = z
         return Y + self.offset
+
+
+def _first_order(a: np.ndarray, Bm: np.ndarray, U: np.ndarray, w0: np.ndarray,
+                 out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Outputs out @ w_k (samples x outputs) of w_k = a w_(k-1) + Bm u_k per mode, and the
+    last modal state."""
+    from scipy.signal import lfilter
+
+    D = U @ Bm.T  # (samples, modes)
+    W = np.empty_like(D)
+    for j in range(len(a)):
+        W[:, j] = lfilter([1.0], [1.0, -a[j]], D[:, j], zi=[a[j] * w0[j]])[0]
+    return W @ out.T, W[-1].copy()
