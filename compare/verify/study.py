@@ -188,6 +188,7 @@ class StudyResult:
             f"<p>Reference: {html.escape(self.steady.reference_label)}.</p>",
             markdown_to_html_table(self.steady.markdown()),
             img("accuracy_steady_error.png", "error against unknowns"),
+            img("accuracy_steady_runtime.png", "error against runtime"),
             img("accuracy_steady_shaft_profile.png", "shaft sensors per model (paper Fig. 4)"),
         ]
         if self.transient is not None:
@@ -198,6 +199,7 @@ class StudyResult:
                 self._time_html(),
                 markdown_to_html_table(self.transient.markdown()),
                 img("accuracy_transient_error.png", "error against unknowns"),
+                img("accuracy_transient_runtime.png", "error against runtime"),
                 img("accuracy_transient_shaft_profile.png", "shaft sensors at the peak"),
             ]
         return html_page(f"spindle-verify study: {self.spec.name}", parts)
