@@ -74,6 +74,10 @@ def test_rom_steady_against_the_fem(spl0):
     for k, v in fem.sensors.items():
         assert abs(red.sensors[k] - v) <= TOL_K
     assert abs(red.growth_m["P1"] - fem.growth_m["P1"]) * 1e6 <= TOL_UM
+    # the result interface of the other models
+    assert list(red.to_pandas()["sensor"]) == list(fem.sensors)
+    assert red.summary()["model"]["kind"] == "rom"
+    assert red.plot() is not None
 
 
 def test_rom_exact_time_integration_against_modal_fem():
