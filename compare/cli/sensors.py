@@ -89,7 +89,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    help="time step of the transient cases [s] (default 60)")
     p.add_argument("--rom", action="store_true",
                    help="also consider a reduced-order model of the reference level sized for "
-                        "the tolerances (spindle-verify rom; about a minute more at level 2)")
+                        "the tolerances (spindle-verify rom; 40-100 s more at level 2)")
     p.add_argument("--rank", type=number(1, 1000, integer=True), metavar="K",
                    help="also rank the first K sensor positions")
     p.add_argument("--method", choices=METHODS, default="greedy",

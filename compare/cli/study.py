@@ -91,7 +91,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     st.add_argument("--steady-only", action="store_true", help="skip the transient comparison")
     st.add_argument("--rom", action="store_true",
                     help="add a reduced-order model of the reference level (spindle-verify rom, "
-                         "0.05 K / 0.1 µm) as a row of the tables; about a minute more on "
+                         "0.05 K / 0.1 µm) as a row of the tables; 40-100 s more on "
                          "spl2782 (default off)")
     st.add_argument("--scheduler", metavar="ADDRESS",
                     help="run the independent runs on a Dask cluster (tcp://host:8786, or "
