@@ -74,6 +74,29 @@ class ROMTransientResult(TransientTable):
     energy_out_J: float = float("nan")
     energy_stored_J: float = float("nan")
 
+    def save(self, out, pictures: bool = True) -> list:
+        """Summary JSON, sensor and growth time series CSV, PNG of the sensors."""
+        from pathlib import Path
+
+        from spindle import plots
+        from spindle.outputs import write_csv, write_json
+        from spindle.units import ZERO_C_K
+
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        write_json(out / "summary.json", self.summary())
+        write_csv(out / "sensors_timeseries.csv", *self.timeseries_rows())
+        files = [out / "summary.json", out / "sensors_timeseries.csv"]
+        if pictures:
+            title = (f"{self.model.spec.name}: {self.case.name}, ROM {self.model.n_states} states "
+                     f"of FEM level {self.model.level}")
+            plots.timeseries_png(self.times_s, self.names, self.sensor_K - ZERO_C_K,
+                                 out / "sensors_timeseries.png", title,
+                                 {t.name: t.array for t in self.model.spec.temperature_sensors()
+                                  if t.array})
+            files.append(out / "sensors_timeseries.png")
+        return files
+
     def summary(self) -> dict:
         return {"spec": self.model.spec.name, "kind": "transient", "case": self.case.name,
                 "model": _model_info(self.model), "method": self.method,

@@ -248,3 +248,16 @@ def test_rom_at_the_ground_truth_level():
         res = rom.transient(case, 60.0)
         assert np.abs(res.sensor_K - fem.sensor_K).max() <= TOL_K, cycle
         assert np.abs(res.growth_m["P1"] - fem.growth_m["P1"]).max() * 1e6 <= TOL_UM, cycle
+
+
+def test_rom_transient_result_saves(spl0, tmp_path):
+    import json
+
+    ref, rom, _ = spl0
+    res = rom.transient(named_case(ref.spec, "spl-16h"), DT)
+    files = res.save(tmp_path)
+    assert {f.name for f in files} == {"summary.json", "sensors_timeseries.csv",
+                                        "sensors_timeseries.png"}
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["model"]["states"] == rom.n_states
+    assert summary["error_estimate"]["estimated_max_K"] > 0
