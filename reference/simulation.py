@@ -34,6 +34,16 @@ class ReferenceModel:
         self.thermal = ThermalModel(build_mesh(spec, level), order)
         self.elastic = ThermoelasticModel(self.thermal) if elastic else None
 
+    @classmethod
+    def from_parts(cls, thermal: ThermalModel, elastic: ThermoelasticModel | None,
+                   centrifugal: bool = False) -> ReferenceModel:
+        """A reference on models already assembled (e.g. a steady result's ``model`` and
+        ``elastic``), sharing their matrices and factorisations."""
+        self = cls.__new__(cls)
+        self.spec, self.centrifugal = thermal.spec, centrifugal
+        self.thermal, self.elastic = thermal, elastic
+        return self
+
     @property
     def readings(self) -> list[str]:
         return list(self.elastic.growth_points()) if self.elastic else []

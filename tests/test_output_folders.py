@@ -79,7 +79,7 @@ def test_the_default_output_folders_do_not_nest(capsys):
     results/<spec> itself, which would hold the others and be replaced with them)."""
     from compare.cli import main
 
-    for cmd in ("solve", "study", "measures", "fit", "sensors", "crosscheck", "mesh"):
+    for cmd in ("solve", "study", "measures", "fit", "sensors", "crosscheck", "mesh", "rom"):
         assert main([cmd, "--help"]) == 0
         line = " ".join(capsys.readouterr().out.split())
         assert "results/<spec>/" in line, (cmd, line)

@@ -40,10 +40,11 @@ def build_parser() -> argparse.ArgumentParser:
     synth.register(sub)
     measures.register(sub)
 
-    from compare.cli import crosscheck, sensors
+    from compare.cli import crosscheck, rom, sensors
 
     sensors.register(sub)
     crosscheck.register(sub)
+    rom.register(sub)
     return p
 
 

@@ -43,7 +43,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     if args.rank is not None and args.rank < 1:
         raise InputError("command line", "--rank", f"{args.rank} sensors", "give --rank K >= 1")
     choice = choose_nodes(spec, cases, args.tol_temp, args.tol_growth, args.nodes, args.level,
-                          args.dt, say)
+                          args.dt, say, rom=args.rom)
     ranking = None
     if args.rank is not None:
         rank_case = (load_cases(spec, [args.rank_case], steady_cycles=False)[0]
@@ -95,6 +95,9 @@ def register(subparsers) -> argparse.ArgumentParser:
                    help="FEM level of the reference for the node count (default 2)")
     p.add_argument("--dt", type=TIME_STEP_S, default=60.0,
                    help="time step of the transient cases [s] (default 60)")
+    p.add_argument("--rom", action="store_true",
+                   help="also consider a reduced-order model of the reference level sized for "
+                        "the tolerances (spindle-verify rom; 40-100 s more at level 2)")
     p.add_argument("--rank", type=number(1, 1000, integer=True), metavar="K",
                    help="also rank the first K sensor positions")
     p.add_argument("--method", choices=METHODS, default="greedy",

@@ -40,7 +40,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     levels, nodes = sorted(set(args.levels)), sorted(set(args.nodes))
     result = run_study(spec, levels, nodes, transient=not args.steady_only, dt_s=args.dt,
                        threshold=args.threshold / 100.0, progress=progress.say, workers=args.workers,
-                       scheduler=args.scheduler)
+                       scheduler=args.scheduler, rom=args.rom)
     with output_dir(out, inputs=[spec.path]) as tmp, progress.pictures():
         result.save(tmp, pictures=not args.no_pictures)
     progress.done()
@@ -94,6 +94,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          "(default 1)")
     st.add_argument("--dt", type=TIME_STEP_S, default=60.0, help="transient time step [s] (default 60)")
     st.add_argument("--steady-only", action="store_true", help="skip the transient comparison")
+    st.add_argument("--rom", action="store_true",
+                    help="add a reduced-order model of the reference level (spindle-verify rom, "
+                         "0.05 K / 0.1 µm) as a row of the tables; 40-100 s more on "
+                         "spl2782 (default off)")
     st.add_argument("--scheduler", metavar="ADDRESS",
                     help="run the independent runs on a Dask cluster (tcp://host:8786, or "
                          "'local' with --workers processes); needs "

@@ -165,8 +165,9 @@ class AccuracyResult:
                             for k, v in t.items()} for i in range(len(t["model"]))]}
 
     # ------------------------------------------------------------------ pictures
-    def plot(self, ax=None):
-        """Worst temperature error against unknowns, log-log, with the fitted slopes."""
+    def plot(self, ax=None, against: str = "unknowns"):
+        """Worst temperature error against unknowns (or ``against="runtime"``: against each
+        model's runtime), log-log, with the fitted slopes (against unknowns)."""
         from spindle.plots import pyplot
 
         plt = pyplot()
@@ -175,21 +176,25 @@ class AccuracyResult:
         t = self.table()
         slopes = self.slopes()
         for kind, style, label in (("lumped", "o-", "lumped N nodes"), ("fem", "s-", "FEM levels"),
-                                   ("eq14", "D", "eq. 14")):
+                                   ("eq14", "D", "eq. 14"), ("rom", "*", "ROM of the FEM")):
             idx = [i for i, k in enumerate(t["kind"]) if k == kind]
-            pts = [(t["unknowns"][i], _worst_temp(t, i)) for i in idx]
-            pts = [(x, y) for x, y in pts if y > 0 and not math.isnan(y)]
+            xs = t["runtime_s" if against == "runtime" else "unknowns"]
+            pts = [(xs[i], _worst_temp(t, i)) for i in idx]
+            pts = [(x, y) for x, y in pts if x > 0 and y > 0 and not math.isnan(y)]
             if not pts:
                 continue
-            lab = label + (f" (slope {slopes[kind]:.2f})" if kind in slopes else "")
+            lab = label + (f" (slope {slopes[kind]:.2f})"
+                           if kind in slopes and against != "runtime" else "")
             ax.loglog(*zip(*pts, strict=True), style, label=lab)
             for i in idx:
                 if t["preset"][i]:
-                    ax.annotate(t["preset"][i], (t["unknowns"][i], _worst_temp(t, i)),
+                    ax.annotate(t["preset"][i], (xs[i], _worst_temp(t, i)),
                                 textcoords="offset points", xytext=(4, 6), fontsize=8)
         ax.axhline(self.tol_temp_K, color="tab:red", ls="--", lw=1,
                    label=f"tolerance {self.tol_temp_K:g} K")
-        ax.set_xlabel("unknowns (lumped masses, FEM DOFs)")
+        ax.set_xlabel("runtime [s] (lumped: build and run; FEM: assembly and solve; ROM: run, "
+                      "its build excluded)" if against == "runtime" else
+                      "unknowns (lumped masses, FEM DOFs, ROM states)")
         ax.set_ylabel("worst sensor temperature error [K]")
         ax.set_title(f"{self.spec.name}, {self.case_name}: error against the reference "
                      f"({self.reference_label})", fontsize=9)
@@ -253,7 +258,8 @@ class AccuracyResult:
                                                                       "utf-8"))
         files = [f"{stem}.csv", f"{stem}.json", f"{stem}.md"]
         if pictures:
-            for suffix, ax in (("error", self.plot()), ("shaft_profile", self.profile_plot())):
+            for suffix, ax in (("error", self.plot()), ("runtime", self.plot(against="runtime")),
+                               ("shaft_profile", self.profile_plot())):
                 name = f"{stem}_{suffix}.png"
                 atomic_write(out / name, lambda tmp, f=ax.figure: f.savefig(tmp, dpi=130))
                 pyplot().close(ax.figure)
@@ -368,6 +374,23 @@ def fem_entry(spec: Spec, level: int, case: LoadCase, dt_s: float | None, T0: fl
     return Entry(f"FEM level {level}", "fem", int(model.thermal.basis.N),
                  time.perf_counter() - t, sensors, growth, level=level, time_error=err,
                  time_method=method)
+
+
+def rom_entry(rom, case: LoadCase, dt_s: float | None, T0: float | None,
+              time_method: str = "richardson") -> Entry:
+    """A reduced-order model (rom.ReducedModel) as a row: steady (dt_s None) or transient,
+    integrated as the reference was (``time_method`` "exact", or "richardson": backward
+    Euler at dt and dt/2 extrapolated), so that its error is the projection error."""
+    t = time.perf_counter()
+    if dt_s is None:
+        sensors, growth = _read_outs(rom, case, None, T0)
+    elif time_method == "exact":
+        res = rom.transient(case, dt_s, T0=T0, method="exact")
+        sensors, growth = {k: res.sensor(k) for k in res.names}, res.growth_m
+    else:
+        sensors, growth, _ = richardson_transient(rom, case, dt_s, T0)
+    return Entry(f"ROM {rom.n_states} states", "rom", rom.n_states, time.perf_counter() - t,
+                 sensors, growth, level=rom.level)
 
 
 def richardson_transient(model, case: LoadCase, dt_s: float, T0: float | None

@@ -26,6 +26,7 @@ from compare.verify.accuracy import (
     AccuracyResult,
     fem_entry,
     lumped_entries,
+    rom_entry,
 )
 from compare.verify.cases import check_level, check_positive, default_cases, save_result
 from spindle.errors import InputError
@@ -71,6 +72,9 @@ class NodeChoice:
     reference_level: int
     dt_s: float
     runtime_s: float = 0.0
+    #: the reduced-order model of the reference considered too (choose_nodes(rom=True)):
+    #: its states, per case its worst temperature and P1 errors, and whether it meets both
+    rom: dict | None = None
 
     def meets(self, n: int, tol_temp_K: float | None = None,
               tol_growth_um: float | None = None) -> bool:
@@ -115,11 +119,22 @@ class NodeChoice:
         cases = ", ".join(c.name for c in self.curves)
         if self.chosen is not None:
             return (f"N = {self.chosen} is the smallest node count in {self.nodes} that meets "
-                    f"{tol} on every case ({cases}); its worst errors: {errs(self.chosen)}")
+                    f"{tol} on every case ({cases}); its worst errors: {errs(self.chosen)}"
+                    + self._rom_message())
         b = self.best()
         return (f"no N in {self.nodes} meets {'both tolerances' if has_p1 else 'the tolerance'} "
                 f"({tol}) on every case ({cases}); "
-                f"the best is N={b} with {errs(b)}")
+                f"the best is N={b} with {errs(b)}" + self._rom_message())
+
+    def _rom_message(self) -> str:
+        if not self.rom:
+            return ""
+        r = self.rom
+        t = max(c["worst_err_K"] for c in r["cases"])
+        p = [c["err_P1_um"] for c in r["cases"] if not math.isnan(c["err_P1_um"])]
+        errs = f"{t:.3g} K" + (f" / {max(p):.3g} µm" if p else "")
+        return (f". The reduced-order model of FEM level {r['level']} with {r['states']} states "
+                f"{'meets' if r['meets'] else 'does NOT meet'} them on every case ({errs})")
 
     def table(self) -> dict[str, list]:
         """Long table: one row per case and N, with the whole accuracy row."""
@@ -170,7 +185,7 @@ class NodeChoice:
                                "growth_um": self.tol_growth_um},
                 "chosen_nodes": self.chosen,
                 "best": {"nodes": b, "worst_err_K": bt, "err_P1_um": clean(bp)},
-                "message": self.message(), "runtime_s": self.runtime_s,
+                "message": self.message(), "runtime_s": self.runtime_s, "rom": self.rom,
                 "cases": [{"case": c.name, "kind": c.kind, "reference": c.reference_label,
                            "reference_runtime_s": c.reference_runtime_s,
                            "worst_err_K": c.worst_temp_K,
@@ -224,8 +239,8 @@ class NodeChoice:
 def choose_nodes(spec: Spec, cases: Sequence[LoadCase] | None = None,
                  tol_temp_K: float = TOL_TEMP_K, tol_growth_um: float = TOL_GROWTH_UM,
                  nodes: Sequence[int] = NODES, reference_level: int | None = None,
-                 dt_s: float = 60.0, progress: Callable[[str], None] | None = None
-                 ) -> NodeChoice:
+                 dt_s: float = 60.0, progress: Callable[[str], None] | None = None,
+                 rom: bool = False) -> NodeChoice:
     """The smallest lumped node count N that meets both tolerances on every case.
 
     ``cases``: load cases; one with ``duration_s > 0`` runs as a transient (backward Euler
@@ -234,7 +249,9 @@ def choose_nodes(spec: Spec, cases: Sequence[LoadCase] | None = None,
     transient case of :func:`compare.verify.study.study_cases`. ``tol_temp_K`` [K] bounds the worst
     sensor temperature error, ``tol_growth_um`` [µm] the P1 error (ignored for a spec
     without P1). ``reference_level``: the FEM P2 mesh level of the reference (default 2).
-    ``progress`` receives one message per model run.
+    ``progress`` receives one message per model run. ``rom``: also build the reduced-order
+    model of the reference level that meets the tolerances (rom.build_rom, trained on
+    random-loaded:0) and check it on every case against the same reference (NodeChoice.rom).
     """
     from spindle.loads import time_grid
 
@@ -253,6 +270,8 @@ def choose_nodes(spec: Spec, cases: Sequence[LoadCase] | None = None,
                          "give at least one cycle name, e.g. --cases nominal spl-16h")
     t0 = time.perf_counter()
     curves = []
+    rom_model = _rom_for(spec, level, tol_temp_K, tol_growth_um, progress) if rom else None
+    rom_cases = []
     for case in cases:
         transient = case.duration_s > 0
         dt = dt_s if transient else None
@@ -271,10 +290,36 @@ def choose_nodes(spec: Spec, cases: Sequence[LoadCase] | None = None,
         for row in rows:
             temps = [v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)]
             worst.append(max(temps) if temps else math.nan)
+        if rom_model is not None:
+            row = acc.errors(rom_entry(rom_model, case, dt, T0, ref.time_method or "richardson"))
+            rom_cases.append({"case": case.name, "worst_err_K": max(
+                v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)),
+                "err_P1_um": row.get("P1_max_um", math.nan)})
         curves.append(CaseCurve(case.name, transient, label, nodes, [e.size for e in entries],
                                 worst, [row.get("P1_max_um", math.nan) for row in rows], rows,
                                 ref.runtime_s))
     result = NodeChoice(spec.name, nodes, curves, tol_temp_K, tol_growth_um, None, level, dt_s,
                         time.perf_counter() - t0)
     result.chosen = result.choose()
+    if rom_model is not None:
+        result.rom = {"states": rom_model.n_states, "level": level, "cases": rom_cases,
+                      "meets": all(_meets(c["worst_err_K"], c["err_P1_um"], tol_temp_K,
+                                          tol_growth_um) for c in rom_cases)}
     return result
+
+
+def _rom_for(spec: Spec, level: int, tol_temp_K: float, tol_growth_um: float,
+             progress: Callable[[str], None] | None):
+    """The ROM of FEM ``level`` sized for the tolerances (rom.build_rom)."""
+    from compare.verify.romstudy import named_case
+    from reference import ReferenceModel
+    from rom import build_rom
+
+    if progress:
+        progress(f"reduced-order model of FEM level {level} for {tol_temp_K:g} K / "
+                 f"{tol_growth_um:g} µm (trained on random-loaded:0)")
+    ref = ReferenceModel(spec, level)
+    model, _ = build_rom(ref, named_case(spec, "random-loaded", 0), 60.0, tol_temp_K,
+                         tol_growth_um, level=level, keep_basis=False, indicator=False)
+    ref.release()
+    return model

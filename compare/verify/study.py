@@ -188,6 +188,7 @@ class StudyResult:
             f"<p>Reference: {html.escape(self.steady.reference_label)}.</p>",
             markdown_to_html_table(self.steady.markdown()),
             img("accuracy_steady_error.png", "error against unknowns"),
+            img("accuracy_steady_runtime.png", "error against runtime"),
             img("accuracy_steady_shaft_profile.png", "shaft sensors per model (paper Fig. 4)"),
         ]
         if self.transient is not None:
@@ -198,6 +199,7 @@ class StudyResult:
                 self._time_html(),
                 markdown_to_html_table(self.transient.markdown()),
                 img("accuracy_transient_error.png", "error against unknowns"),
+                img("accuracy_transient_runtime.png", "error against runtime"),
                 img("accuracy_transient_shaft_profile.png", "shaft sensors at the peak"),
             ]
         return html_page(f"spindle-verify study: {self.spec.name}", parts)
@@ -315,7 +317,7 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
               steady_case: LoadCase | None = None, transient_case: LoadCase | None = None,
               transient: bool = True, dt_s: float = 60.0, threshold: float = 0.01,
               progress: Callable[[str], None] | None = None, workers: int = 1,
-              scheduler: str | None = None) -> StudyResult:
+              scheduler: str | None = None, rom: bool = False) -> StudyResult:
     """Run the whole study (see the module docstring).
 
     The steady FEM levels (grid convergence) run first, here. Then every independent run (the
@@ -329,6 +331,12 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
 
     A run that fails does not stop the study: it is reported through ``progress`` and
     listed in :attr:`StudyResult.failures`, and its model is missing from the tables.
+
+    ``rom``: also a reduced-order model of the reference level (rom.build_rom, trained on
+    the random-loaded:0 cycle, 0.05 K / 0.1 µm) as a row of both tables, integrated in time
+    as the reference was. Off by default: on spl2782 it adds 40-100 s (the build and the
+    training cycle's FEM run) and the build's candidate vectors (about 0.6 GB at level 2;
+    the study's peak was 1.95 GB with it, docs/rom.md).
     """
     from compare.executor import import_dask, run_cases
 
@@ -391,6 +399,13 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
             else:
                 failures.append(_failure(o))
 
+    if rom:
+        ref_res = conv.results[conv.levels.index(ref_level)]
+        rom_rows = _rom_rows(ref_res, ref_level, s_case, t_case if reference is not None else None,
+                             dt_s, T0, reference.time_method if reference else "", progress)
+        got["steady"].append(rom_rows[0])
+        if reference is not None:
+            got["lumped"].append(rom_rows[1])
     eq14 = eq14_entry(spec, s_case)
     steady = AccuracyResult(spec, s_case.name, False, ref_entry, label,
                             ([eq14] if eq14 else []) + got["steady"] + fem)
@@ -412,6 +427,31 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     ref_res = conv.results[conv.levels.index(ref_level)]
     return StudyResult(spec, conv, steady, trans, gt, ref_level, time.perf_counter() - t0,
                        s_case, ref_res, failures, time_integration)
+
+
+def _rom_rows(ref_res, level: int, s_case: LoadCase, t_case: LoadCase | None, dt_s: float,
+              T0: float, time_method: str, progress: Callable[[str], None] | None
+              ) -> list[Entry]:
+    """The ROM of FEM ``level`` (built on the operators of its steady result ``ref_res``):
+    its steady row, and its transient row if ``t_case``."""
+    from compare.verify.accuracy import rom_entry
+    from compare.verify.romstudy import named_case
+    from reference import ReferenceModel
+    from rom import build_rom
+
+    if progress:
+        progress(f"ROM of FEM level {level} (trained on random-loaded:0)")
+    ref = ReferenceModel.from_parts(ref_res.model, ref_res.elastic)
+    spec = ref.spec
+    train = named_case(spec, "random-loaded", 0)
+    if t_case is not None and t_case.extra_times_s:  # read 1 ... 64 s after the steps too:
+        train = train.with_jump_ladder()  # then the ROM is chosen on those times as well
+    model, _ = build_rom(ref, train, 60.0, level=level, keep_basis=False, indicator=False)
+    ref.release()
+    rows = [rom_entry(model, s_case, None, None)]
+    if t_case is not None:
+        rows.append(rom_entry(model, t_case, dt_s, T0, time_method))
+    return rows
 
 
 def _failure(outcome) -> dict[str, str]:
