@@ -53,9 +53,9 @@ int main(int argc, char **argv) {
 def main() -> None:
     from compare.verify.romstudy import named_case
     from reference import ReferenceModel
-    from rom import build_rom
-    from rom.export import export
-    from rom.realtime import ROMPredictor
+    from reference.rom import build_rom
+    from reference.rom.export import export
+    from reference.rom.realtime import ROMPredictor
 
     ap = argparse.ArgumentParser()
     ap.add_argument("--level", type=int, default=2)

@@ -1,4 +1,4 @@
-"""The reduced-order model (rom/, issue 17) against the full FEM computed independently:
+"""The reduced-order model (reference/rom/, issue 17) against the full FEM computed independently:
 ReferenceModel.transient / .steady (the reference's own solvers) and
 ThermalModel.exact_readouts (modal, exact in time), on small meshes."""
 
@@ -13,9 +13,9 @@ import pytest
 
 from compare.verify.romstudy import named_case
 from reference import ReferenceModel
-from rom import build_rom
-from rom.model import fem_transient, full_system
-from rom.realtime import ROMPredictor
+from reference.rom import build_rom
+from reference.rom.model import fem_transient, full_system
+from reference.rom.realtime import ROMPredictor
 
 #: the issue's targets: every sensor within 0.05 K, P1 within 0.1 µm of the ground truth
 TOL_K, TOL_UM = 0.05, 0.1
@@ -114,7 +114,7 @@ def test_predictor_step_run_and_steady(spl0):
 def test_c_export_matches_the_predictor(spl0, tmp_path):
     import ctypes
 
-    from rom.export import export
+    from reference.rom.export import export
 
     ref, rom, _ = spl0
     case = named_case(ref.spec, "spl-16h")

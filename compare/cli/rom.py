@@ -43,8 +43,8 @@ def _check_cycles(texts: list[str]) -> None:
 @with_progress("rom")
 def run(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.romstudy import rom_study
-    from rom.export import export
-    from rom.realtime import ROMPredictor
+    from reference.rom.export import export
+    from reference.rom.realtime import ROMPredictor
     from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 

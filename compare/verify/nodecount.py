@@ -313,7 +313,7 @@ def _rom_for(spec: Spec, level: int, tol_temp_K: float, tol_growth_um: float,
     """The ROM of FEM ``level`` sized for the tolerances (rom.build_rom)."""
     from compare.verify.romstudy import named_case
     from reference import ReferenceModel
-    from rom import build_rom
+    from reference.rom import build_rom
 
     if progress:
         progress(f"reduced-order model of FEM level {level} for {tol_temp_K:g} K / "

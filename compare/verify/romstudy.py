@@ -1,4 +1,4 @@
-"""The ``rom`` command's work: build a ROM (rom/) at a FEM level, check it on held-out cycles.
+"""The ``rom`` command's work: build a ROM (reference/rom/) at a FEM level, check it on held-out cycles.
 
 :func:`rom_study` builds the ROM (rom.build.build_rom) on the training cycle, runs the FEM
 (backward Euler on the same grid, or the steady solve for a steady cycle) and the ROM on
@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rom.build import BuildReport, build_rom, meets, output_errors
-from rom.model import ReducedModel, fem_steady, fem_transient, full_system
+from reference.rom.build import BuildReport, build_rom, meets, output_errors
+from reference.rom.model import ReducedModel, fem_steady, fem_transient, full_system
 from spindle.loads import LoadCase
 
 

@@ -437,7 +437,7 @@ def _rom_rows(ref_res, level: int, s_case: LoadCase, t_case: LoadCase | None, dt
     from compare.verify.accuracy import rom_entry
     from compare.verify.romstudy import named_case
     from reference import ReferenceModel
-    from rom import build_rom
+    from reference.rom import build_rom
 
     if progress:
         progress(f"ROM of FEM level {level} (trained on random-loaded:0)")

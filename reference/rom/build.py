@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rom.model import (
+from reference.rom.model import (
     DEFAULT_SHIFTS,
     SPEED_FRACTIONS,
     FullSystem,
@@ -153,7 +153,7 @@ def _calibrated_indicator(full: FullSystem, V: np.ndarray, rom: ReducedModel,
                           training: LoadCase, dt_s: float, Y_ref: np.ndarray):
     """The residual indicator (rom.indicator) of basis V, its sensor calibration the ratio of
     the true worst sensor error on the training cycle to its bound there."""
-    from rom.indicator import residual_indicator
+    from reference.rom.indicator import residual_indicator
 
     ind = residual_indicator(full, V)
     grid, Z = rom.system.simulate(rom.inputs, training, dt_s, rom.initial(), "be")

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rom.realtime import ROMPredictor
+from reference.rom.realtime import ROMPredictor
 
 
 def discrete_tables(pred: ROMPredictor, speeds_rpm: Sequence[float]) -> dict[str, np.ndarray]:

@@ -1,6 +1,6 @@
 """Reduced-order models of the FEM reference (issue 17): build, simulate, stream, export."""
 
-from rom.build import BuildReport, build_rom
-from rom.model import ReducedModel
+from reference.rom.build import BuildReport, build_rom
+from reference.rom.model import ReducedModel
 
 __all__ = ["BuildReport", "ReducedModel", "build_rom"]

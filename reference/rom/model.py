@@ -390,7 +390,7 @@ class ReducedModel:
         return Z @ self.system.O.T + self.system.offset
 
     def steady(self, case: LoadCase | None = None, t: float = 0.0):
-        from rom.results import ROMSteadyResult
+        from reference.rom.results import ROMSteadyResult
 
         case = case or self.spec.default_load_case()
         n = float(case.speed_rpm(t))
@@ -405,7 +405,7 @@ class ReducedModel:
                   method: str = "be"):
         """Transient on time_grid(case, dt_s): ``method`` "be" (the reference's backward
         Euler) or "exact" (exact for inputs linear between grid points)."""
-        from rom.results import ROMTransientResult
+        from reference.rom.results import ROMTransientResult
 
         if dt_s <= 0 or case.duration_s <= 0:
             raise SolverError("a transient run needs dt_s > 0 and a duration > 0")

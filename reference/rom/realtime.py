@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rom.model import ReducedModel, _phi
+from reference.rom.model import ReducedModel, _phi
 
 _CHUNK = 16384  # samples per block of the batch replay (as lumped.realtime: stays in cache)
 
