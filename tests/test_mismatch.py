@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from compare.fit.greybox import film_groups
-from compare.fit.mismatch import Mismatch, draw_mismatch, random_cycle
+from compare.fit.mismatch import Mismatch, draw_mismatch, ramped_steps, random_cycle
 from spindle.drive import drive_for
 from spindle.faces import exposed_faces, surface_faces
 from spindle.spec import ContactLink, load_spec
@@ -75,6 +75,31 @@ def test_random_cycles():
     a = random_cycle(np.random.default_rng(7), 6000.0)
     b = random_cycle(np.random.default_rng(7), 6000.0)
     assert a.steps == b.steps
+
+
+def test_ramped_load_cycle():
+    """random-ramped-load: every speed step's torque rises then falls in 5 min pieces (a span
+    of at least 10 N m), the speed held; whole minutes, so the pieces keep the 60 s grid; the
+    plain cycle stays unloaded."""
+    pieces = ramped_steps(3000.0, 3725.0, 10.0, 30.0)
+    torques = [p.load_torque_Nm for p in pieces]
+    assert {p.speed_rpm for p in pieces} == {3000.0}
+    assert sum(p.duration_s for p in pieces) == pytest.approx(3725.0)
+    assert all(p.duration_s == 300.0 for p in pieces[:-1])
+    k = int(np.argmax(torques))
+    assert np.all(np.diff(torques[:k + 1]) >= 0) and np.all(np.diff(torques[k:]) <= 0)
+    for seed in range(3):
+        c = random_cycle(np.random.default_rng(seed), 6000.0, ramped=True)
+        assert c.duration_s == pytest.approx(16 * 3600.0) and c.name == "random-ramped-load"
+        assert max(s.speed_rpm for s in c.steps) == 6000.0
+        assert all(s.duration_s % 60.0 == 0.0 for s in c.steps[:-1])
+        level = {}
+        for s in c.steps:
+            if s.speed_rpm > 0:
+                level.setdefault(s.speed_rpm, []).append(s.load_torque_Nm)
+        assert all(max(v) - min(v) >= 5.0 for v in level.values())
+    plain = random_cycle(np.random.default_rng(0), 6000.0)
+    assert all(s.load_torque_Nm == 0.0 for s in plain.steps)
 
 
 def test_synth_with_mismatch_records_it(tmp_path, spl):

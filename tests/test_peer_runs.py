@@ -22,7 +22,10 @@ import pytest
 
 PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"
 #: the runs named wrongly at the last measurement, with what fit names (docs/fit.md)
-KNOWN_WRONG: dict[str, str] = {}
+KNOWN_WRONG = {
+    "dev-08": "coolant_dynamics: nothing named (the jacket film factor absorbs it; the base "
+              "model is inadequate for the loaded runs)",
+}
 #: runs whose validation open-loop RMS after the fit exceeds a tolerance although the effect
 #: is named, with the channel (docs/fit.md: the base model's misfit, not the effect's)
 KNOWN_OVER_TOLERANCE = {

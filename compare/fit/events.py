@@ -344,12 +344,9 @@ def model_onsets(gb, theta: dict[str, float], channels, sub: int = 6) -> ModelOn
 def event_tests(run, gb, theta: dict[str, float], channels, alpha: float = 0.01
                 ) -> dict[str, EventTest]:
     """The centrifugal test on P1, the lag test of every measured channel, and the power
-    tests (compare.fit.power_events; ``alpha`` decides whether the power drifts) and the
-    rings' load response (compare.fit.load_events), on the raw samples of the bench run
-    ``run`` (spindle.bench.BenchRun); keys ``centrifugal_shortening``,
-    ``sensor_lag(<channel>)``, ``bearing_preload``, ``windage_loss`` and
-    ``coolant_dynamics``."""
-    from compare.fit.load_events import coolant_load_test
+    tests (compare.fit.power_events; ``alpha`` decides whether the power drifts), on the raw
+    samples of the bench run ``run`` (spindle.bench.BenchRun); keys ``centrifugal_shortening``,
+    ``sensor_lag(<channel>)``, ``bearing_preload`` and ``windage_loss``."""
     from compare.fit.power_events import power_tests
 
     t, n = run.time_s, run.columns["speed_rpm"]
@@ -370,5 +367,4 @@ def event_tests(run, gb, theta: dict[str, float], channels, alpha: float = 0.01
                                        onsets.lag_for_ratio(c, lo, sc)]}
         out[f"sensor_lag({c})"] = test
     out.update(power_tests(run, alpha, gb, theta))
-    out["coolant_dynamics"] = coolant_load_test(run, gb, theta)
     return out

@@ -68,11 +68,13 @@ class Mismatch:
 
 def ramped_steps(speed_rpm: float, duration_s: float, low_Nm: float, high_Nm: float,
                  step_s: float = 300.0) -> list[Step]:
-    """One speed step of ``duration_s`` [s] cut into ``step_s`` pieces whose process torque
-    [N m] rises linearly from ``low_Nm`` to ``high_Nm`` over the first half and falls back
-    over the second (rounded to 0.1 N m)."""
-    k = max(int(round(duration_s / step_s)), 2)
-    edges = np.linspace(0.0, duration_s, k + 1)
+    """One speed step of ``duration_s`` [s] cut into ``step_s`` pieces (the last takes the
+    remainder, so the pieces keep a time step's grid: a FEM run factorises once per step
+    length) whose process torque [N m] rises linearly from ``low_Nm`` to ``high_Nm`` over the
+    first half and falls back over the second (rounded to 0.1 N m)."""
+    k = max(int(duration_s // step_s), 2)
+    edges = np.concatenate([np.arange(k) * (duration_s / k if duration_s < 2 * step_s
+                                            else step_s), [duration_s]])
     mid = 0.5 * (edges[:-1] + edges[1:]) / duration_s
     shape = 1.0 - np.abs(2.0 * mid - 1.0)
     return [Step(speed_rpm, float(b - a), round(low_Nm + (high_Nm - low_Nm) * float(f), 1))
@@ -115,7 +117,8 @@ def random_cycle(rng: np.random.Generator, max_speed_rpm: float, loaded: bool = 
         n = round(float(rng.uniform(0.15, 1.0)) * max_speed_rpm / 100.0) * 100.0
         speeds.append(n)
         torque = round(float(rng.uniform(0.0, 40.0)), 1) if loaded else 0.0
-        if ramped:
+        if ramped:  # whole minutes, so that the 5 min pieces keep the 60 s grid
+            dur = 60.0 * round(dur / 60.0)
             low = float(rng.uniform(5.0, 20.0))
             pieces = ramped_steps(n, dur, low, low + float(rng.uniform(10.0, 25.0)))
         else:
