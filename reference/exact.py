@@ -84,18 +84,20 @@ class ExactStepper:
     """Exact steps at one speed of M x' = -K x + a + b (t - t0) (see the module docstring).
 
     ``lu_K`` is the (real) LU of K. The eight complex LUs of one step length make a set; at
-    most ``max_sets`` sets are kept (least recently used dropped: 8 complex LUs of spl2782
-    level 2 are about 450 MB). A step whose length is a whole multiple q <= ``max_substeps``
-    of a kept set's is taken as q exact sub-steps instead of a new set (the 1, 2, 4 ... s
-    steps after each jump reuse the 1 s set). ``bound`` accumulates over the
+    most ``max_sets`` sets are kept (least recently used dropped: a set of spl2782 level 2 is
+    about 450 MB). A step whose length is a whole multiple q <= ``max_substeps`` of a kept
+    set's is taken as q exact sub-steps instead of a new set (the 1, 2, 4 ... s steps after
+    each jump reuse the 1 s set), unless its length is one of the ``regular`` ones (the
+    many steps of dt), which always get their own set. ``bound`` accumulates over the
     applications (CRAM16_ERROR ||w||_M each): times sqrt(c M^-1 c) it bounds a read-out's
     approximation error.
     """
 
-    def __init__(self, K: sp.spmatrix, M: sp.spmatrix, lu_K, max_sets: int = 2,
-                 max_substeps: int = 16):
+    def __init__(self, K: sp.spmatrix, M: sp.spmatrix, lu_K, max_sets: int = 1,
+                 max_substeps: int = 32, regular: frozenset[float] = frozenset()):
         self.K, self.M, self.lu_K = K, M, lu_K
         self.max_sets, self.max_substeps = max_sets, max_substeps
+        self.regular = {round(h, 9) for h in regular}
         self._sets: OrderedDict[float, list] = OrderedDict()
         self.bound = 0.0
         self.factorisations = 0
@@ -106,14 +108,14 @@ class ExactStepper:
             self._sets.move_to_end(key)
         else:
             while len(self._sets) >= self.max_sets:
-                self._sets.popitem(last=False)
+                self._sets.popitem(last=False)  # before the new set is made (memory)
             self._sets[key] = [_complex_lu(h * self.K + theta * self.M) for theta in CRAM16_THETA]
             self.factorisations += len(CRAM16_THETA)
         return self._sets[key]
 
     def _plan(self, h: float) -> tuple[float, int]:
         """(sub-step length, count) for a step of length h."""
-        if round(h, 9) in self._sets:
+        if round(h, 9) in self._sets or round(h, 9) in self.regular:
             return h, 1
         for k in reversed(self._sets):
             q = round(h / k)

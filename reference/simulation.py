@@ -75,6 +75,8 @@ class ReferenceModel:
         error [K or m]) on time_grid(case, dt_s), exact in time for inputs linear between
         grid points (ThermalModel.exact_readouts)."""
         gains = self._gains()
+        if self.elastic is not None:  # the gains are kept; its LU is not needed (memory)
+            self.elastic.release()
         t, names, S, F, bound = self.thermal.exact_readouts(
             case, dt_s, T0, {k: g for k, (g, _) in gains.items()}, method)
         return (t, {n: S[:, j] for j, n in enumerate(names)},

@@ -138,6 +138,14 @@ class Operator:
 
 
 
+def _regular_steps(h: np.ndarray, speeds: np.ndarray, more_than: int = 4) -> frozenset[float]:
+    """The step lengths [s] that occur more than ``more_than`` times before the speed first
+    changes (``h`` and ``speeds`` from the current step on): they get their own LUs."""
+    end = int(np.argmax(speeds != speeds[0])) if np.any(speeds != speeds[0]) else len(h)
+    lengths, counts = np.unique(np.round(h[:end], 9), return_counts=True)
+    return frozenset(lengths[counts > more_than].tolist())
+
+
 class ThermalModel:
     """FEM heat conduction on a :class:`~meshes.SpindleMesh` with P1 or P2 elements."""
 
@@ -327,17 +335,19 @@ class ThermalModel:
         op = self.op
         Y = np.empty((len(grid), readout.shape[0]))
         Y[0] = readout @ x
-        stepper, current, total = None, None, 0.0
+        h = np.diff(grid)
+        speeds = np.asarray(case.speed_rpm(0.5 * (grid[1:] + grid[:-1])), dtype=float)
+        stepper, total = None, 0.0
         for k in range(1, len(grid)):
-            t0, t1 = grid[k - 1], grid[k]
-            n = float(case.speed_rpm(0.5 * (t0 + t1)))
-            if n != current:  # a new speed: the last one's complex LUs are dropped
+            n = float(speeds[k - 1])
+            if stepper is None or n != speeds[k - 2]:  # a new speed: drop the last LUs
                 total += stepper.bound if stepper else 0.0
+                stepper = None
                 K = op.K(n)
-                stepper = ExactStepper(K, op.M, self._factor(lambda K=K: K, ("steady", n)))
-                current = n
-            a, b = self._linear_load(case, t0, t1, n)
-            x = stepper.step(x, a, b, t1 - t0)
+                stepper = ExactStepper(K, op.M, factorize(K),
+                                       regular=_regular_steps(h[k - 1:], speeds[k - 1:]))
+            a, b = self._linear_load(case, grid[k - 1], grid[k], n)
+            x = stepper.step(x, a, b, h[k - 1])
             Y[k] = readout @ x
         total += stepper.bound if stepper else 0.0
         return Y, total * readout_norms(op.M, readout, factorize)
