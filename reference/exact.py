@@ -87,8 +87,10 @@ class ExactStepper:
     most ``max_sets`` sets are kept (least recently used dropped: a set of spl2782 level 2 is
     about 450 MB). A step whose length is a whole multiple q <= ``max_substeps`` of a kept
     set's is taken as q exact sub-steps instead of a new set (the 1, 2, 4 ... s steps after
-    each jump reuse the 1 s set), unless its length is one of the ``regular`` ones (the
-    many steps of dt), which always get their own set. ``bound`` accumulates over the
+    each jump reuse the 1 s set). A ``regular`` length (the many steps of dt, and e.g. 60 s
+    steps between them where the inputs have samples) is sub-stepped only on another
+    regular length's set, so that alternating 120 s and 60 s steps share the 60 s set
+    instead of factorising anew at each step. ``bound`` accumulates over the
     applications (CRAM16_ERROR ||w||_M each): times sqrt(c M^-1 c) it bounds a read-out's
     approximation error.
     """
@@ -115,9 +117,12 @@ class ExactStepper:
 
     def _plan(self, h: float) -> tuple[float, int]:
         """(sub-step length, count) for a step of length h."""
-        if round(h, 9) in self._sets or round(h, 9) in self.regular:
+        key = round(h, 9)
+        if key in self._sets:
             return h, 1
         for k in reversed(self._sets):
+            if key in self.regular and k not in self.regular:
+                continue  # a regular step never runs on a rare step's set
             q = round(h / k)
             if 1 < q <= self.max_substeps and abs(q * k - h) <= 1e-9 * h:
                 return k, q
