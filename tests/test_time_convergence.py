@@ -45,9 +45,10 @@ def test_cram16_is_the_published_uniform_approximation():
 def test_cram_steps_match_the_dense_modal_integration(fin, level):
     """fin-shaft levels 0 and 1 (123 and 405 unknowns), spl-16h-like warm-up with the jump
     ladder, dt 60 s: the sparse CRAM path and the dense modal path (eigh of the pencil) agree
-    to 1e-8 K on a 137 K rise (measured 7.7e-11 and 7.0e-10 K). The stated bound on CRAM's
-    error is 4e-11 and 8e-11 K; the rest is the rounding of the two paths (the modal one
-    projects on eigenvectors M-orthonormal to ~1e-13, times a condition number ~1e4)."""
+    to 1e-8 K on a 137 K rise (measured 7.7e-11 and 7.0e-10 K, within the stated bounds on
+    CRAM's error, 4.5e-10 and 9.7e-10 K). The tolerance leaves room for the rounding of the
+    modal path (eigenvectors M-orthonormal to ~1e-13, times a condition number ~1e4: 2.6e-9
+    K on level 2)."""
     model, case, T0, t, S, bound = fin
     if level:
         model = ReferenceModel(model.spec, level)
@@ -55,7 +56,7 @@ def test_cram_steps_match_the_dense_modal_integration(fin, level):
     tm, Sm, _, bm = model.exact_readouts(case, 60.0, T0, method="modal")
     assert np.array_equal(t, tm)
     assert _worst(S, Sm) < 1e-8
-    assert 0.0 < max(bound.values()) < 1e-9 and max(bm.values()) == 0.0
+    assert 0.0 < max(bound.values()) < 1e-8 and max(bm.values()) == 0.0
 
 
 def test_cram_steps_do_not_depend_on_the_time_grid(fin):
@@ -70,8 +71,8 @@ def test_cram_steps_do_not_depend_on_the_time_grid(fin):
 
 def test_a_long_constant_run_reaches_the_steady_state(fin):
     """Constant inputs for 200 h from a uniform start: the last read-outs are the steady
-    state of solve_steady to 1e-8 K (the exponential's part has decayed; what remains is the
-    particular solution K^-1 F)."""
+    state of solve_steady to 1e-8 K (measured 6e-14 K: the exponential's part has decayed;
+    what remains is the particular solution K^-1 F)."""
     model = fin[0]
     case = replace(model.spec.default_load_case(), duration_s=200 * 3600.0)
     _, S, _, _ = model.exact_readouts(case, 3600.0)
