@@ -78,15 +78,19 @@ class ReferenceModel:
         omega2 = (self._step_speeds(case, times_s) * RPM_TO_RAD_S) ** 2
         return omega2 * self.elastic.gain(reading)[1]
 
-    def exact_readouts(self, case: LoadCase, dt_s: float, T0: float | None = None
-                       ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
-        """(times [s], sensors [K], growth readings [m]) on time_grid(case, dt_s), exact in
-        time (ThermalModel.exact_readouts; small meshes only)."""
+    def exact_readouts(self, case: LoadCase, dt_s: float, T0: float | None = None,
+                       method: str = "cram") -> tuple[np.ndarray, dict[str, np.ndarray],
+                                                      dict[str, np.ndarray], dict[str, float]]:
+        """(times [s], sensors [K], growth readings [m], each read-out's bound on its time
+        error [K or m]) on time_grid(case, dt_s), exact in time for inputs linear between
+        grid points (ThermalModel.exact_readouts)."""
         gains = self._gains()
-        t, names, S, F = self.thermal.exact_readouts(case, dt_s, T0,
-                                                     {k: g for k, (g, _) in gains.items()})
+        if self.elastic is not None:  # the gains are kept; its LU is not needed (memory)
+            self.elastic.release()
+        t, names, S, F, bound = self.thermal.exact_readouts(
+            case, dt_s, T0, {k: g for k, (g, _) in gains.items()}, method)
         return (t, {n: S[:, j] for j, n in enumerate(names)},
-                self._growth(gains, F, self._step_speeds(case, t)))
+                self._growth(gains, F, self._step_speeds(case, t)), bound)
 
     def _gains(self) -> dict[str, tuple[np.ndarray, float]]:
         """Each growth reading's thermal gain g [m/K per DOF] and centrifugal c [m s^2]."""

@@ -32,8 +32,9 @@ from spindle.units import ZERO_C_K
 TWO_PI = 2.0 * math.pi
 
 
-#: the largest mesh [unknowns] that ThermalModel.exact_readouts integrates (dense modes:
-#: eigh of a 2500 x 2500 pencil takes about 4 s per speed; spl2782 level 0, 3200, 34 s for 5)
+#: the largest mesh [unknowns] that ThermalModel.exact_readouts integrates by dense modes
+#: (method "modal", the check of the CRAM path: eigh of a 2500 x 2500 pencil takes about
+#: 4 s per speed; spl2782 level 0, 3200, 34 s for 5)
 EXACT_MAX_DOFS = 2500
 
 
@@ -135,6 +136,14 @@ class Operator:
         """Heat stored since T0 [J]: 2 pi 1^T M (T - T0)."""
         return TWO_PI * float(np.asarray(self.M.sum(axis=0)).ravel() @ (T - T0))
 
+
+
+def _regular_steps(h: np.ndarray, speeds: np.ndarray, more_than: int = 4) -> frozenset[float]:
+    """The step lengths [s] that occur more than ``more_than`` times before the speed first
+    changes (``h`` and ``speeds`` from the current step on): they get their own LUs."""
+    end = int(np.argmax(speeds != speeds[0])) if np.any(speeds != speeds[0]) else len(h)
+    lengths, counts = np.unique(np.round(h[:end], 9), return_counts=True)
+    return frozenset(lengths[counts > more_than].tolist())
 
 
 class ThermalModel:
@@ -278,31 +287,81 @@ class ThermalModel:
         return SteadyResult(self, case, t, n, T, q_in, q_out, residual)
 
     def exact_readouts(self, case: LoadCase, dt_s: float, T0: float | None = None,
-                       functionals: dict[str, np.ndarray] | None = None
-                       ) -> tuple[np.ndarray, list[str], np.ndarray, dict[str, np.ndarray]]:
+                       functionals: dict[str, np.ndarray] | None = None, method: str = "cram"
+                       ) -> tuple[np.ndarray, list[str], np.ndarray, dict[str, np.ndarray],
+                                  dict[str, float]]:
         """Sensor temperatures [K] and functionals g . T on time_grid(case, dt_s), integrated
         exactly in time for inputs linear between grid points (issue 15 §1): speed held at
         its mid-step value (as solve_transient), sources, ambient and coolant linear from
-        just after one grid point to just before the next, so steps land exactly. Per speed,
-        the generalised eigenproblem K v = lambda M v (scipy.linalg.eigh, dense) gives the
-        modes; each step is then exact (exponential of the modal rates). Only for small
-        meshes (at most EXACT_MAX_DOFS unknowns): larger ones use solve_transient.
-        Returns (times [s], sensor names, sensors [n_t, n_sensors], functional series)."""
+        just after one grid point to just before the next, so steps land exactly.
+
+        ``method`` "cram" (any mesh): each step's exponential by CRAM-16 on sparse LUs
+        (reference.exact); "modal" (at most EXACT_MAX_DOFS unknowns, an independent check):
+        per speed, the dense generalised eigenproblem K v = lambda M v gives the modes and
+        each step is the exponential of the modal rates.
+        Returns (times [s], sensor names, sensors [n_t, n_sensors], functional series, and
+        per read-out a bound on its approximation error: CRAM's, 0 for "modal"; rounding
+        aside)."""
+        if method not in ("cram", "modal"):
+            raise ValueError(f"method must be 'cram' or 'modal', not {method!r}")
+        grid = time_grid(case, dt_s)
+        names, pts = self.sensor_points()
+        fnames = list(functionals or {})
+        readout = np.vstack([self.probe_matrix(pts).toarray()]
+                            + ([np.array([functionals[k] for k in fnames])] if fnames else []))
+        x0 = np.full(self.op.M.shape[0], self.spec.T_initial_K if T0 is None else float(T0))
+        if method == "modal":
+            Y, bound = self._modal_readouts(case, grid, readout, x0), np.zeros(len(readout))
+        else:
+            Y, bound = self._cram_readouts(case, grid, readout, x0)
+        n_s = len(names)
+        return (grid, names, Y[:, :n_s], {k: Y[:, n_s + j] for j, k in enumerate(fnames)},
+                dict(zip(names + fnames, bound.tolist(), strict=True)))
+
+    def _linear_load(self, case: LoadCase, t0: float, t1: float, n: float
+                     ) -> tuple[np.ndarray, np.ndarray]:
+        """(a, b): the load a + b (t - t0) over the step, from just after t0 to just before
+        t1 (a jump on a grid point belongs to the next step)."""
+        eps = 1e-9 * (t1 - t0)
+        a = self.op.F(case, t0 + eps, n)
+        return a, (self.op.F(case, t1 - eps, n) - a) / (t1 - t0)
+
+    def _cram_readouts(self, case: LoadCase, grid: np.ndarray, readout: np.ndarray,
+                       x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Read-outs on ``grid`` by exact sparse steps (reference.exact.ExactStepper), one
+        speed's LUs at a time, and each read-out's bound on CRAM's error."""
+        from reference.exact import ExactStepper, readout_norms
+
+        op = self.op
+        Y = np.empty((len(grid), readout.shape[0]))
+        Y[0] = readout @ x
+        h = np.diff(grid)
+        speeds = np.asarray(case.speed_rpm(0.5 * (grid[1:] + grid[:-1])), dtype=float)
+        stepper, total = None, 0.0
+        for k in range(1, len(grid)):
+            n = float(speeds[k - 1])
+            if stepper is None or n != speeds[k - 2]:  # a new speed: drop the last LUs
+                total += stepper.bound if stepper else 0.0
+                stepper = None
+                K = op.K(n)
+                stepper = ExactStepper(K, op.M, factorize(K),
+                                       regular=_regular_steps(h[k - 1:], speeds[k - 1:]))
+            a, b = self._linear_load(case, grid[k - 1], grid[k], n)
+            x = stepper.step(x, a, b, h[k - 1])
+            Y[k] = readout @ x
+        total += stepper.bound if stepper else 0.0
+        return Y, total * readout_norms(op.M, readout, factorize)
+
+    def _modal_readouts(self, case: LoadCase, grid: np.ndarray, readout: np.ndarray,
+                        x: np.ndarray) -> np.ndarray:
+        """Read-outs on ``grid`` by dense modes (small meshes only)."""
         from scipy.linalg import eigh
 
         op, N = self.op, self.op.M.shape[0]
         if N > EXACT_MAX_DOFS:
-            raise SolverError(f"exact time integration is for meshes of at most "
+            raise SolverError(f"modal time integration is for meshes of at most "
                               f"{EXACT_MAX_DOFS} unknowns, not {N}")
-        grid = time_grid(case, dt_s)
-        names, pts = self.sensor_points()
-        out_rows = [self.probe_matrix(pts).toarray()]
-        fnames = list(functionals or {})
-        if fnames:
-            out_rows.append(np.array([functionals[k] for k in fnames]))
-        readout = np.vstack(out_rows)
         M = op.M.toarray()
-        x = np.full(N, self.spec.T_initial_K if T0 is None else float(T0))
         Y = np.empty((len(grid), readout.shape[0]))
         Y[0] = readout @ x
         modes: dict[float, tuple] = {}
@@ -318,17 +377,14 @@ class ThermalModel:
             if n != current:  # into this speed's modes
                 z = VtM @ (x if current is None else modes[current][1] @ z)
                 current = n
-            eps = 1e-9 * dt
-            a = V.T @ op.F(case, t0 + eps, n)
-            b = (V.T @ op.F(case, t1 - eps, n) - a) / dt
+            a, b = (V.T @ f for f in self._linear_load(case, t0, t1, n))
             e = np.exp(-lam * dt)
             g1 = np.where(lam * dt > 1e-8, -np.expm1(-lam * dt) / np.maximum(lam, 1e-300), dt)
             g2 = np.where(lam * dt > 1e-4, (dt - g1) / np.maximum(lam, 1e-300),
                           dt * dt / 2 - lam * dt ** 3 / 6)
             z = e * z + g1 * a + g2 * b
             Y[k] = OV @ z
-        n_s = len(names)
-        return grid, names, Y[:, :n_s], {k: Y[:, n_s + j] for j, k in enumerate(fnames)}
+        return Y
 
     def solve_transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
                         T0: np.ndarray | float | None = None, save_every: int = 0,

@@ -51,11 +51,11 @@ def test_serial_and_pool_give_the_same_figures():
     for k in a:
         np.testing.assert_allclose(b[k], a[k], rtol=1e-12, atol=0.0, err_msg=k)
     # progress: one line per pooled run, "[i/n] label done x s"; the reference transient
-    # runs first, on its own, to fix the time step (issue 15 §1)
+    # runs first, on its own, and states its temporal error (issue 15 §1)
     done = [ln for ln in lines if ln.startswith("[")]
     assert len(done) == 6 and all(" done " in ln for ln in done)
-    assert any(ln.startswith("reference transient at dt") for ln in lines)
-    assert any(ln.startswith("time step ") for ln in lines)
+    assert any(ln.startswith("reference transient (exact in time)") for ln in lines)
+    assert any(ln.startswith("temporal error ") for ln in lines)
 
 
 def _fail_for_5_nodes_steady(monkeypatch):

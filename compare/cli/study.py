@@ -92,7 +92,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     st.add_argument("--threshold", type=POSITIVE, default=1.0,
                     help="GCI [%%] a level must meet for every quantity to be the ground truth "
                          "(default 1)")
-    st.add_argument("--dt", type=TIME_STEP_S, default=60.0, help="transient time step [s] (default 60)")
+    st.add_argument("--dt", type=TIME_STEP_S, default=60.0,
+                    help="transient time step [s]: every model is read every dt and 1-64 s after "
+                         "each step; the reference is exact in time (default 60)")
     st.add_argument("--steady-only", action="store_true", help="skip the transient comparison")
     st.add_argument("--rom", action="store_true",
                     help="add a reduced-order model of the reference level (spindle-verify rom, "

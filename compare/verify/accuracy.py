@@ -42,11 +42,9 @@ class Entry:
     preset: str = ""
     nodes: int | None = None
     level: int | None = None
-    #: FEM transients: per sensor [K] and growth reading [m], max over time of |T(dt/2) -
-    #: T(dt)|, a bound on the temporal error of the Richardson-extrapolated read-outs
+    #: FEM transients: per sensor [K] and growth reading [m], the bound on the temporal error
+    #: of the exact integration (CRAM-16's, ThermalModel.exact_readouts)
     time_error: dict[str, float] = field(default_factory=dict)
-    #: FEM transients: "exact" (modal, ThermalModel.exact_readouts) or "richardson"
-    time_method: str = ""
 
 
 def _stats(d: np.ndarray) -> tuple[float, float]:
@@ -363,54 +361,21 @@ def fem_entry(spec: Spec, level: int, case: LoadCase, dt_s: float | None, T0: fl
         sensors, growth = _read_outs(model, case, dt_s, T0)
         return Entry(f"FEM level {level}", "fem", int(model.thermal.basis.N),
                      time.perf_counter() - t, sensors, growth, level=level)
-    from reference.thermal import EXACT_MAX_DOFS
-
-    if model.thermal.basis.N <= EXACT_MAX_DOFS:  # exact in time: no temporal error
-        _, sensors, growth = model.exact_readouts(case, dt_s, T0)
-        err, method = {k: 0.0 for k in [*sensors, *growth]}, "exact"
-    else:
-        sensors, growth, err = richardson_transient(model, case, dt_s, T0)
-        method = "richardson"
+    # exact in time for inputs linear between grid points (CRAM-16 on sparse LUs)
+    _, sensors, growth, err = model.exact_readouts(case, dt_s, T0)
     return Entry(f"FEM level {level}", "fem", int(model.thermal.basis.N),
-                 time.perf_counter() - t, sensors, growth, level=level, time_error=err,
-                 time_method=method)
+                 time.perf_counter() - t, sensors, growth, level=level, time_error=err)
 
 
-def rom_entry(rom, case: LoadCase, dt_s: float | None, T0: float | None,
-              time_method: str = "richardson") -> Entry:
-    """A reduced-order model (rom.ReducedModel) as a row: steady (dt_s None) or transient,
-    integrated as the reference was (``time_method`` "exact", or "richardson": backward
-    Euler at dt and dt/2 extrapolated), so that its error is the projection error."""
+def rom_entry(rom, case: LoadCase, dt_s: float | None, T0: float | None) -> Entry:
+    """A reduced-order model (reference.rom.ReducedModel) as a row: steady (dt_s None) or
+    transient, integrated exactly in time as the reference is (inputs linear between grid
+    points), so that its error is the projection error."""
     t = time.perf_counter()
     if dt_s is None:
         sensors, growth = _read_outs(rom, case, None, T0)
-    elif time_method == "exact":
+    else:
         res = rom.transient(case, dt_s, T0=T0, method="exact")
         sensors, growth = {k: res.sensor(k) for k in res.names}, res.growth_m
-    else:
-        sensors, growth, _ = richardson_transient(rom, case, dt_s, T0)
     return Entry(f"ROM {rom.n_states} states", "rom", rom.n_states, time.perf_counter() - t,
                  sensors, growth, level=rom.level)
-
-
-def richardson_transient(model, case: LoadCase, dt_s: float, T0: float | None
-                         ) -> tuple[dict, dict, dict]:
-    """Backward Euler at ``dt_s`` and ``dt_s``/2, extrapolated to second order on the
-    ``dt_s`` grid (issue 15 §1): R = 2 T(dt/2) - T(dt). Returns sensors [K] and growth [m]
-    over time_grid(case, dt_s), and per read-out max_t |T(dt/2) - T(dt)|: the error estimate
-    of the finer first-order run, a bound on R's (whose error is O(dt^2))."""
-    from spindle.loads import time_grid
-
-    s1, g1 = _read_outs(model, case, dt_s, T0)
-    s2, g2 = _read_outs(model, case, 0.5 * dt_s, T0)
-    coarse, fine = time_grid(case, dt_s), time_grid(case, 0.5 * dt_s)
-    idx = np.clip(np.searchsorted(fine, coarse - 1e-6 * dt_s), 0, len(fine) - 1)
-    if not np.allclose(fine[idx], coarse, rtol=0.0, atol=1e-6 * dt_s):
-        raise RuntimeError("the dt/2 grid does not hold the dt grid")  # time_grid's contract
-    sensors, growth, err = {}, {}, {}
-    for src, fine_src, dst in ((s1, s2, sensors), (g1, g2, growth)):
-        for k, a in src.items():
-            b = np.asarray(fine_src[k])[idx]
-            dst[k] = 2.0 * b - np.asarray(a)
-            err[k] = float(np.max(np.abs(b - np.asarray(a))))
-    return sensors, growth, err

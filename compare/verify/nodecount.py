@@ -291,7 +291,7 @@ def choose_nodes(spec: Spec, cases: Sequence[LoadCase] | None = None,
             temps = [v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)]
             worst.append(max(temps) if temps else math.nan)
         if rom_model is not None:
-            row = acc.errors(rom_entry(rom_model, case, dt, T0, ref.time_method or "richardson"))
+            row = acc.errors(rom_entry(rom_model, case, dt, T0))
             rom_cases.append({"case": case.name, "worst_err_K": max(
                 v for k, v in row.items() if k.endswith("_max_K") and not math.isnan(v)),
                 "err_P1_um": row.get("P1_max_um", math.nan)})

@@ -62,7 +62,7 @@ class StudyResult:
     #: runs that failed: {"label", "error", "type"} each; their models are missing from the
     #: tables (a failed FEM transient on the reference level leaves ``transient`` None)
     failures: list[dict[str, str]] = field(default_factory=list)
-    #: how the reference transient was converged in time (_converged_reference); None
+    #: how the reference transient was integrated in time (_exact_reference); None
     #: without a transient
     time_integration: dict | None = None
 
@@ -230,14 +230,13 @@ class StudyResult:
         ti = self.time_integration
         if not ti:
             return ""
-        halved = (f"halved {ti['halvings']} times from the requested {ti['dt_requested_s']:g} s"
-                  if ti["halvings"] else "as requested")
         limit = f"the {100 * ti['threshold']:g} % threshold of the spatial GCI"
-        verdict = (f"below {limit}" if ti["converged"] else f"STILL ABOVE {limit} after the "
-                   "last halving: the transient verdicts carry that much time error")
-        return (f"<p><b>Time.</b> {html.escape(ti['method'])}; dt {ti['dt_s']:g} s "
-                f"({halved}). Bound on the temporal error: {ti['time_error_K']:.3g} K and "
-                f"{ti['time_error_um']:.3g} µm, {100 * ti['relative']:.2g} % of the peak rise "
+        verdict = (f"below {limit}" if ti["converged"] else f"ABOVE {limit}: the transient "
+                   "verdicts carry that much time error")
+        return (f"<p><b>Time.</b> The reference is {html.escape(ti['method'])}. Read every "
+                f"{ti['dt_s']:g} s and 1, 2, 4 ... 64 s after each step of speed or heat. "
+                f"Bound on its temporal error: {ti['time_error_K']:.2g} K and "
+                f"{ti['time_error_um']:.2g} µm, {100 * ti['relative']:.2g} % of the peak rise "
                 f"({ti['peak_rise_K']:.3g} K): {verdict}. The lumped models integrate exactly "
                 "for inputs held over each step and are read at the same instants.</p>")
 
@@ -361,18 +360,13 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     T0 = float(t_case.T_ambient_K(0.0))
     failures: list[dict[str, str]] = []
     reference, time_integration = None, None
-    from reference.thermal import EXACT_MAX_DOFS
-
-    if transient and conv.dofs[conv.levels.index(ref_level)] <= EXACT_MAX_DOFS:
-        # a reference exact in time: read every model 1, 2, 4 ... 64 s after every step
-        # too, whatever dt (the peak errors are there). With the Richardson path each ladder
-        # step is another factorisation of a large matrix: too slow, read every dt only
+    if transient:  # the reference exact in time (issue 15 §1), on the reference level
+        # every model is read 1, 2, 4 ... 64 s after every step too, whatever dt: the peak
+        # errors are there
         t_case = t_case.with_jump_ladder()
-    if transient:  # first the time step, on the reference level (issue 15 §1)
-        reference, time_integration, failed = _converged_reference(
+        reference, time_integration, failed = _exact_reference(
             spec, t_case, ref_level, dt_s, T0, threshold, progress)
         failures += failed
-        dt_s = time_integration["dt_s"] if time_integration else dt_s
     # the independent runs, longest first (the FEM transients) so that a pool stays busy
     coarse_levels = [lv for lv in conv.levels if lv < ref_level]
     groups: dict[str, list[StudyRun]] = {"steady": [StudyRun(spec, s_case, "lumped", n)
@@ -402,7 +396,7 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     if rom:
         ref_res = conv.results[conv.levels.index(ref_level)]
         rom_rows = _rom_rows(ref_res, ref_level, s_case, t_case if reference is not None else None,
-                             dt_s, T0, reference.time_method if reference else "", progress)
+                             dt_s, T0, progress)
         got["steady"].append(rom_rows[0])
         if reference is not None:
             got["lumped"].append(rom_rows[1])
@@ -415,10 +409,8 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
 
         coarse = sorted(got["coarse"], key=lambda e: e.level)  # the table goes coarse first
         ti = time_integration
-        how = ("exact in time" if reference.time_method == "exact" else
-               f"backward Euler at {dt_s:g} s and {dt_s / 2:g} s, Richardson-extrapolated "
-               f"(temporal error <= {ti['time_error_K']:.3g} K, {ti['time_error_um']:.3g} µm: "
-               f"{100 * ti['relative']:.2g} % of the peak)")
+        how = (f"exact in time (CRAM-16; temporal error <= {ti['time_error_K']:.2g} K, "
+               f"{ti['time_error_um']:.2g} µm)")
         trans = AccuracyResult(spec, t_case.name, True, reference,
                                f"FEM level {ref_level}, {how}; read every {dt_s:g} s"
                                + (" and 1, 2, 4 ... 64 s after each step"
@@ -430,7 +422,7 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
 
 
 def _rom_rows(ref_res, level: int, s_case: LoadCase, t_case: LoadCase | None, dt_s: float,
-              T0: float, time_method: str, progress: Callable[[str], None] | None
+              T0: float, progress: Callable[[str], None] | None
               ) -> list[Entry]:
     """The ROM of FEM ``level`` (built on the operators of its steady result ``ref_res``):
     its steady row, and its transient row if ``t_case``."""
@@ -450,7 +442,7 @@ def _rom_rows(ref_res, level: int, s_case: LoadCase, t_case: LoadCase | None, dt
     ref.release()
     rows = [rom_entry(model, s_case, None, None)]
     if t_case is not None:
-        rows.append(rom_entry(model, t_case, dt_s, T0, time_method))
+        rows.append(rom_entry(model, t_case, dt_s, T0))
     return rows
 
 
@@ -460,43 +452,29 @@ def _failure(outcome) -> dict[str, str]:
             "type": outcome.error_type or ""}
 
 
-#: at most this many halvings of the requested time step for a Richardson-extrapolated
-#: reference (each one doubles the cost of the largest runs of the study: on spl2782 level 2
-#: the bound falls only like dt^0.5 near the speed steps, so more would take many minutes);
-#: beyond it the bound is reported as above the threshold
-MAX_TIME_HALVINGS = 1
-
-
-def _converged_reference(spec: Spec, case: LoadCase, level: int, dt_s: float, T0: float,
-                         threshold: float, progress: Callable[[str], None] | None
-                         ) -> tuple[Entry | None, dict | None, list[dict[str, str]]]:
-    """The reference transient converged in time: Richardson-extrapolated backward Euler
-    (compare.verify.accuracy.richardson_transient) at ``dt_s`` [s], halved until its
-    temporal error bound is at most ``threshold`` of the peak (the sensors' largest rise
-    above ``T0`` [K], P1's largest magnitude), at most MAX_TIME_HALVINGS times. Returns the
-    entry, the ``time_integration`` record for study.json and the failures."""
+def _exact_reference(spec: Spec, case: LoadCase, level: int, dt_s: float, T0: float,
+                     threshold: float, progress: Callable[[str], None] | None
+                     ) -> tuple[Entry | None, dict | None, list[dict[str, str]]]:
+    """The reference transient on ``level``, exact in time for inputs linear between the
+    grid points (ThermalModel.exact_readouts, CRAM-16), with its temporal error bound
+    against ``threshold`` of the peak (the sensors' largest rise above ``T0`` [K], P1's
+    largest magnitude). Returns the entry, the ``time_integration`` record for study.json
+    and the failures."""
     from compare.executor import run_cases
 
-    dt, requested = float(dt_s), float(dt_s)
-    for halvings in range(MAX_TIME_HALVINGS + 1):
-        if progress:
-            progress(f"reference transient at dt {dt:g} s and {dt / 2:g} s")
-        (o,) = run_cases(run_study_case, [StudyRun(spec, case, "fem", level, dt, T0)])
-        if not o.ok:
-            return None, None, [_failure(o)]
-        ref: Entry = o.value
-        record = _time_error_record(ref, T0, requested, dt, halvings, threshold)
-        if record["converged"] or halvings == MAX_TIME_HALVINGS:
-            break
-        dt /= 2.0
     if progress:
-        progress(f"time step {dt:g} s: temporal error {100 * record['relative']:.2g} % of the "
-                 f"peak (threshold {100 * threshold:g} %)")
-    return ref, record, []
+        progress(f"reference transient (exact in time) on level {level}, read every {dt_s:g} s")
+    (o,) = run_cases(run_study_case, [StudyRun(spec, case, "fem", level, dt_s, T0)])
+    if not o.ok:
+        return None, None, [_failure(o)]
+    record = _time_error_record(o.value, T0, dt_s, threshold)
+    if progress:
+        progress(f"temporal error {record['time_error_K']:.2g} K, "
+                 f"{100 * record['relative']:.2g} % of the peak (threshold {100 * threshold:g} %)")
+    return o.value, record, []
 
 
-def _time_error_record(ref: Entry, T0: float, requested: float, dt: float, halvings: int,
-                       threshold: float) -> dict:
+def _time_error_record(ref: Entry, T0: float, dt: float, threshold: float) -> dict:
     temps = [k for k in ref.sensors if k in ref.time_error]
     rise = max(float(np.max(np.abs(np.asarray(ref.sensors[k]) - T0))) for k in temps)
     err_K = max(ref.time_error[k] for k in temps)
@@ -505,11 +483,10 @@ def _time_error_record(ref: Entry, T0: float, requested: float, dt: float, halvi
     err_m = ref.time_error.get("P1", 0.0) if p1 is not None else 0.0
     if p1 is not None:
         rel = max(rel, err_m / max(float(np.max(np.abs(p1))), 1e-12))
-    method = ("exact for inputs linear over each step (modal, the mesh is small)"
-              if ref.time_method == "exact" else
-              "backward Euler at dt and dt/2, Richardson-extrapolated (second order)")
-    return {"method": method,
-            "dt_requested_s": requested, "dt_s": dt, "halvings": halvings,
-            "time_error_K": err_K, "time_error_um": err_m * 1e6, "peak_rise_K": rise,
-            "relative": rel, "threshold": threshold, "converged": rel <= threshold}
-
+    return {"method": "exact for inputs linear between the read-out instants: each step's "
+                      "matrix exponential by Chebyshev rational approximation of order 16 "
+                      "(CRAM-16) on sparse LUs; the bound is CRAM's uniform error, rounding "
+                      "included, carried to each read-out",
+            "dt_s": dt, "time_error_K": err_K, "time_error_um": err_m * 1e6,
+            "peak_rise_K": rise, "relative": rel, "threshold": threshold,
+            "converged": rel <= threshold}
