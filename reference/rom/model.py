@@ -97,13 +97,19 @@ class FullSystem:
 
     def inputs(self, case: LoadCase, t: np.ndarray) -> np.ndarray:
         """u at times t (n_t, n_sources + 2): source powers [W], ambient, coolant [K]."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        cols = [np.broadcast_to(np.asarray(case.sources.get(n, d.power_W)(t), dtype=float),
-                                t.shape) for n, d in zip(self.source_names, self.source_defaults,
-                                                          strict=True)]
-        cols.append(np.broadcast_to(np.asarray(case.T_ambient_K(t), dtype=float), t.shape))
-        cols.append(np.broadcast_to(np.asarray(case.T_coolant_K(t), dtype=float), t.shape))
-        return np.stack(cols, axis=-1)
+        return case_inputs(case, t, self.source_names, self.source_defaults)
+
+
+def case_inputs(case: LoadCase, t, source_names: Sequence[str], source_defaults: Sequence
+                ) -> np.ndarray:
+    """u at times t [s] (n_t, n_sources + 2): each source's power [W] (the case's, else the
+    spec's default), then ambient and coolant [K]; the full and the reduced model share it."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    cols = [np.broadcast_to(np.asarray(case.sources.get(n, d.power_W)(t), dtype=float), t.shape)
+            for n, d in zip(source_names, source_defaults, strict=True)]
+    cols.append(np.broadcast_to(np.asarray(case.T_ambient_K(t), dtype=float), t.shape))
+    cols.append(np.broadcast_to(np.asarray(case.T_coolant_K(t), dtype=float), t.shape))
+    return np.stack(cols, axis=-1)
 
 
 def _coefficient(obj, kind: str) -> Callable[[float], float]:
@@ -375,13 +381,7 @@ class ReducedModel:
         return [*self.source_names, "T_ambient_K", "T_coolant_K"]
 
     def inputs(self, case: LoadCase, t) -> np.ndarray:
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        cols = [np.broadcast_to(np.asarray(case.sources.get(n, d.power_W)(t), dtype=float),
-                                t.shape) for n, d in zip(self.source_names, self.source_defaults,
-                                                          strict=True)]
-        cols.append(np.broadcast_to(np.asarray(case.T_ambient_K(t), dtype=float), t.shape))
-        cols.append(np.broadcast_to(np.asarray(case.T_coolant_K(t), dtype=float), t.shape))
-        return np.stack(cols, axis=-1)
+        return case_inputs(case, t, self.source_names, self.source_defaults)
 
     def initial(self, T0: float | None = None) -> np.ndarray:
         return self.system.z_one * (self.spec.T_initial_K if T0 is None else float(T0))
