@@ -3,7 +3,7 @@
 the shipped spec), against the truth.
 
     python benchmarks/bench_devruns.py [--runs DIR] [--spec spl2782] [--only dev-01 dev-06]
-                                       [--workers 2] [--json OUT.json]
+                                       [--workers 2] [--json OUT.json] [--fit-fraction 0.6]
                                        [--base-extra heat_capacity friction_exponent]
 
 Prints, per run: the true effect, what ``fit`` named (and how), whether the verdict is right
@@ -35,6 +35,7 @@ class DevRun:
     base_extra: tuple[str, ...] = ()
     blocks: int = 1
     cv_blocks: int = 5
+    fit_fraction: float = 0.6
 
     @property
     def label(self) -> str:
@@ -48,7 +49,7 @@ def fit_one(case: DevRun) -> dict:
 
     t = time.perf_counter()
     rep = run_fit(case.path, load_spec(case.spec), base_extra=case.base_extra,
-                  blocks=case.blocks, cv_blocks=case.cv_blocks)
+                  blocks=case.blocks, cv_blocks=case.cv_blocks, fit_fraction=case.fit_fraction)
     doc = rep.to_dict()
     named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
                           and e["parameters"].get("channel") else "") for e in doc["effects"]]
@@ -69,6 +70,10 @@ def fit_one(case: DevRun) -> dict:
             "events": {k: {f: v.get(f) for f in ("estimate", "se", "z", "p_value",
                                                  "model_reference", "scale", "scales")}
                        for k, v in doc.get("events", {}).items()},
+            "tried": [{k: c.get(k) for k in ("effect", "channel", "round", "gain", "excess_before",
+                                              "excess_after", "cv_before", "cv_after",
+                                              "needed_by", "qualifies", "accepted")}
+                      for c in doc["candidates_tried"] if "qualifies" in c],
             "seconds": time.perf_counter() - t}
 
 
@@ -83,6 +88,9 @@ def main(argv: list[str] | None = None) -> None:
                     help="as fit --base-extra (heat_capacity, friction_exponent)")
     ap.add_argument("--blocks", type=int, default=1, help="as fit --blocks (default 1)")
     ap.add_argument("--cv-blocks", type=int, default=5, help="as fit --cv-blocks (default 5)")
+    ap.add_argument("--fit-fraction", type=float, default=0.6,
+                    help="as fit --fit-fraction (default 0.6): how stable the verdicts are when "
+                    "the split moves")
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
 
@@ -91,7 +99,7 @@ def main(argv: list[str] | None = None) -> None:
     truth = json.loads((args.runs / "truth.json").read_text(encoding="utf-8"))
     labels = args.only or sorted(truth)
     cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"], tuple(args.base_extra),
-                    args.blocks, args.cv_blocks) for k in labels]
+                    args.blocks, args.cv_blocks, args.fit_fraction) for k in labels]
     t = time.perf_counter()
     outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
     rows = []

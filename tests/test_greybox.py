@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from compare.cli import main
-from compare.fit.calibrate import Calibrator, Measured, forward_selection, resample
+from compare.fit.calibrate import Calibrator, Measured, choose_refit, forward_selection, resample
 from compare.fit.greybox import EFFECTS, GreyBox, inputs_from_cycle
 from lumped import build
 from spindle.cycles import load_cycle
@@ -81,6 +81,21 @@ def test_forward_selection_finds_a_known_effect(setup):
     lo, hi = fit.ci95["k_fix_um_K"]
     assert hi - lo < 0.25
     assert fit.validation_score() < 0.5 * sel.base.validation_score()
+
+
+@pytest.mark.parametrize("refits, expected", [
+    # (qualifies, log-posterior gain, label): the best-likelihood refit must qualify itself;
+    # a weaker qualifying one is not a fallback (Bacher and Madsen 2011, issue 13: the
+    # fallback named a mount sink on a fixture-expansion run when the split moved)
+    ([(False, 30.0, "fixture"), (True, 17.0, "mount")], None),
+    ([(True, 30.0, "fixture"), (True, 17.0, "mount")], "fixture"),
+    ([(True, 17.0, "mount"), (True, 30.0, "fixture")], "fixture"),
+    ([(False, 5.0, "a"), (False, 9.0, "b")], None),
+    ([], None),
+])
+def test_a_round_accepts_the_best_refit_only_when_it_qualifies(refits, expected):
+    chosen = choose_refit(refits)
+    assert (chosen and chosen[2]) == expected
 
 
 def test_resample_leaves_gaps_empty():

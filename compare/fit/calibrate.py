@@ -559,6 +559,19 @@ class _Judge:
         return ok, x1, why, bound, cv
 
 
+def choose_refit(refits: Sequence[tuple]) -> tuple | None:
+    """The refit a forward-selection round accepts, or None to stop. ``refits`` are tuples
+    whose first two items are (qualifies, log-posterior gain). Bacher and Madsen (2011)
+    extend the model by the candidate that raises the likelihood most and stop when that one
+    fails its tests; falling back to the next-best qualifying candidate instead lets a
+    candidate that only soaks up base misfit (a mount sink on a fixture-expansion run, issue
+    13) be named when the effect that fits best narrowly misses a threshold."""
+    if not refits:
+        return None
+    best = max(refits, key=lambda r: r[1])
+    return best if best[0] else None
+
+
 def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                       alpha: float = 0.01, base: Fit | None = None,
                       min_gain: float = 0.25, refit_top: int = 3,
@@ -616,8 +629,8 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
         if not screens:
             break
         # the screen is short: refit the best few jointly; an effect qualifies when its
-        # likelihood-ratio test is significant and it is needed (below); the qualifying one
-        # with the best likelihood wins
+        # likelihood-ratio test is significant and it is needed (below); the refit with the
+        # best likelihood must itself qualify (choose_refit)
         def gain(f: Fit, cur: Fit = current) -> float:
             return log_posterior_gain(cur, f)
 
@@ -633,8 +646,7 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
             lr, pv = lr_test(current, full)
             ok, x1, why, bound, cv = judge(name, full, pv)
             refits.append((ok, gain(full), name, full, lag_ch, lr, pv, x1, why, bound, cv))
-        qualifying = [r for r in refits if r[0]]
-        chosen = max(qualifying or refits, key=lambda r: r[1])
+        chosen = choose_refit(refits)
         for ok, _g, name, full, lag_ch, _lr, pv, x1, why, bound, cv in refits:
             tried.append({"effect": name, "channel": lag_ch, "round": len(steps) + 1,
                           "p_value": pv, "validation_before": v0,
@@ -643,11 +655,11 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                           "implausible_after": cal.implausible(full, alpha),
                           "prior_z_before": cal.prior_z(current),
                           "prior_z_after": cal.prior_z(full),
-                          "needed_by": why, "at_bound": bound,
+                          "needed_by": why, "at_bound": bound, "gain": _g,
                           "cv_before": None if cv is None else cv[0],
                           "cv_after": None if cv is None else cv[1], "qualifies": ok,
-                          "accepted": ok and full is chosen[3]})
-        if not qualifying:
+                          "accepted": chosen is not None and full is chosen[3]})
+        if chosen is None:
             break
         _ok, _g, name, full, lag_ch, lr, pv, _x1, why, _b, _cv = chosen
         steps.append(Step(name, full, lr, pv, full.bic() - current.bic(), v0,
