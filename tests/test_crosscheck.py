@@ -193,3 +193,45 @@ def test_missing_ccx_names_the_fix(monkeypatch, tmp_path):
     with pytest.raises(SolverError) as exc:
         crosscheck("fin-shaft", 0)
     assert str(exc.value) == CCX_MISSING
+
+
+@pytest.mark.parametrize("field", ["uniform", "r_linear", "r_quadratic"])
+def test_spl2782_growth_of_radial_fields_agrees(field):
+    """Issue 15 §2: a separately built model differed from the reference by 0.4-0.7 % in P1
+    for temperature fields that vary with r alone. On the same mesh and constraints, ccx's
+    P1 for such fields equals the reference's up to the quadrature difference (the twin),
+    ccx's print rounding and its 2-degree expansion bound, as for the nominal field above;
+    measured 1e-6 to 4e-6 relative (benchmarks/p1_fields.py). A 1 % error in the field
+    handed to ccx fails every case."""
+    import tempfile
+    from pathlib import Path
+
+    from compare.crosscheck.ccx_mesh import ccx_mesh
+    from compare.crosscheck.check import EXPANSION_REL
+    from compare.crosscheck.deck import write_elastic
+    from compare.crosscheck.elastic_data import elastic_constraints
+    from compare.crosscheck.frd import half_ulp
+    from compare.crosscheck.twin import reading_rows, twin_gains
+    from reference.simulation import ReferenceModel
+    from spindle.spec import load_spec
+
+    spec = load_spec("spl2782")
+    model = ReferenceModel(spec, 0, 2)
+    z, r = model.thermal.basis.doflocs
+    rise = {"uniform": 10.0 + 0.0 * r, "r_linear": 10.0 * r / r.max(),
+            "r_quadratic": 10.0 * (r / r.max()) ** 2}[field]
+    T = spec.T_initial_K + rise
+    skfem = model.elastic.growth(model.elastic.displacement(T))["P1"]
+    cm = ccx_mesh(model)
+    con = elastic_constraints(model, cm)
+    with tempfile.TemporaryDirectory() as tmp:
+        deck = write_elastic(model, cm, con, Path(tmp) / "radial.inp", T, spec.T_ambient_K)
+        U = read_frd(run_ccx(deck, 600))["U"][:model.thermal.basis.N, 1]
+    row = reading_rows(model)["P1"]
+    ccx = float(row @ U)
+    twin = float(twin_gains(model, cm, con)["P1"] @ rise)
+    allow = float(np.abs(row) @ half_ulp(U)) + EXPANSION_REL * float(np.abs(row) @ np.abs(U))
+    assert abs(ccx - twin) <= allow, (ccx, twin, allow)
+    assert abs(ccx - skfem) <= abs(skfem - twin) + allow, (ccx, skfem, twin)
+    # and far inside the issue's gap: 0.1 % is its target for the P1 agreement
+    assert abs(ccx - skfem) < 1e-3 * abs(skfem)
