@@ -4,7 +4,7 @@ the shipped spec), against the truth.
 
     python benchmarks/bench_devruns.py [--runs DIR] [--spec spl2782] [--only dev-01 dev-06]
                                        [--workers 2] [--json OUT.json] [--fit-fraction 0.6]
-                                       [--base-extra heat_capacity friction_exponent]
+                                       [--base-extra none | G_seat_W_K heat_capacity ...]
 
 Prints, per run: the true effect, what ``fit`` named (and how), whether the verdict is right
 (the true effect named alone; no effect named on a control run), the validation open-loop RMS
@@ -32,7 +32,7 @@ class DevRun:
     path: Path
     spec: str
     truth: str | None
-    base_extra: tuple[str, ...] = ()
+    base_extra: tuple[str, ...] | None = None
     blocks: int = 1
     cv_blocks: int = 5
     fit_fraction: float = 0.6
@@ -74,6 +74,7 @@ def fit_one(case: DevRun) -> dict:
                                               "excess_after", "cv_before", "cv_after",
                                               "needed_by", "qualifies", "accepted")}
                       for c in doc["candidates_tried"] if "qualifies" in c],
+            "parameters": {p["name"]: p["value"] for p in doc.get("parameters", [])},
             "seconds": time.perf_counter() - t}
 
 
@@ -84,8 +85,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--spec", default="spl2782", help="spec the runs are fitted with")
     ap.add_argument("--only", nargs="*", help="run labels to fit (default: all in truth.json)")
     ap.add_argument("--workers", type=int, default=2, help="parallel fits (default 2)")
-    ap.add_argument("--base-extra", nargs="+", default=[], metavar="PARAM",
-                    help="as fit --base-extra (heat_capacity, friction_exponent)")
+    ap.add_argument("--base-extra", nargs="+", default=None, metavar="PARAM",
+                    help="as fit --base-extra (G_seat_W_K, heat_capacity, friction_exponent, "
+                    "none; default: fit's default)")
     ap.add_argument("--blocks", type=int, default=1, help="as fit --blocks (default 1)")
     ap.add_argument("--cv-blocks", type=int, default=5, help="as fit --cv-blocks (default 5)")
     ap.add_argument("--fit-fraction", type=float, default=0.6,
@@ -98,7 +100,9 @@ def main(argv: list[str] | None = None) -> None:
 
     truth = json.loads((args.runs / "truth.json").read_text(encoding="utf-8"))
     labels = args.only or sorted(truth)
-    cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"], tuple(args.base_extra),
+    extra = (None if args.base_extra is None
+             else tuple(n for n in args.base_extra if n != "none"))
+    cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"], extra,
                     args.blocks, args.cv_blocks, args.fit_fraction) for k in labels]
     t = time.perf_counter()
     outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())

@@ -37,6 +37,18 @@ def test_inadequate_names_the_channel_the_factor_and_where_to_look():
     assert {m["name"]: m["calibrated"] for m in ad["moved"]} == {"h_coolant": 6.0, "f0": 0.3}
 
 
+@pytest.mark.parametrize("G, named", [(0.3, False), (15.0, True)])
+def test_a_path_the_spec_lacks_is_named_when_the_run_needs_it(G, named):
+    """G_seat_W_K (spec 0, no prior) above MISSING_PATH_W_K is said in the statement with
+    where to look, and does not by itself make the calibrated base inadequate."""
+    ad = base_adequacy(_errors({"T1": (0.2, 0.3)}), {"h_coolant": 1.1, "f0": 0.3,
+                                                     "G_seat_W_K": G},
+                       {**SPEC, "G_seat_W_K": 0.0}, {"h_coolant": 0.4, "f0": 0.0})
+    assert ad["adequate"]
+    assert (ad["missing_paths"] == ["G_seat_W_K"]) is named
+    assert ("bearing seats" in ad["statement"]) is named
+
+
 def test_no_priors_judges_the_channels_only():
     ad = base_adequacy(_errors({"T1": (0.3, 0.2)}), {"h_coolant": 50.0}, SPEC, None)
     assert ad["adequate"] and ad["moved"][0]["z"] is None

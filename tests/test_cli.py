@@ -99,6 +99,17 @@ def test_bad_option_exits_2(tmp_path):
     assert r.returncode == 2 and "--level" in r.stderr
 
 
+@pytest.mark.parametrize("extra, words", [
+    (["none", "G_seat_W_K"], "none with other parameters"),
+    (["seat"], "invalid choice"),
+])
+def test_fit_bad_base_extra_exits_2(tmp_path, extra, words):
+    r = run("fit", str(tmp_path / "run.csv"), "--base-extra", *extra, "--out",
+            str(tmp_path / "o"))
+    assert r.returncode == 2 and "--base-extra" in r.stderr and words in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "o").exists()
+
+
 def test_output_never_overwrites_input(tmp_path):
     spec = tmp_path / "sensors.csv"  # an input named like an output
     from spindle.spec import load_spec

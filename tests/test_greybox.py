@@ -62,6 +62,30 @@ def test_every_effect_is_nested_and_acts(setup, name):
         assert moved == ["P1"]  # output effects touch their channel only
 
 
+def test_seat_conductance_is_nested_and_cools_the_rings(setup):
+    """The default base extra G_seat_W_K: at 0 W/K the model is the spec's (a zero
+    conductance), and a seat conductance pulls both bearing rings toward the coolant, T1 and
+    T2 most, the stator least (it is cooled by the sleeve already)."""
+    spec, _, inp = setup
+    plain = GreyBox(spec, DRIVES["spl2782"], inp).simulate({})
+    gb = GreyBox(spec, DRIVES["spl2782"], inp, base_extra=("G_seat_W_K",))
+    model = gb._structure()[0]
+    seats = [(i, j, name) for i, j, _, name in model.system.edges if name.startswith("seat:")]
+    assert sorted(s[2] for s in seats) == ["seat:front_bearing", "seat:rear_bearing"]
+    labels = [lab[0] for lab in model.system.labels]
+    assert {labels[i] for i, _, _ in seats} == {"front_bearing.outer", "rear_bearing.outer"}
+    assert {labels[j] for _, j, _ in seats} == {"coolant"}
+    zero = gb.simulate({"G_seat_W_K": 0.0})
+    for c in CHANNELS:  # the same network but for two zero conductances: round-off
+        np.testing.assert_allclose(zero[c], plain[c], atol=1e-9 * (1e-6 if c == "P1" else 1))
+    on = gb.simulate({"G_seat_W_K": 20.0})
+    T_cool = np.concatenate([[inp.T_coolant_K[0]], inp.T_coolant_K])
+    rise = {c: np.max(plain[c] - T_cool) for c in ("T1", "T2", "T_stator")}
+    cooled = {c: np.max(on[c] - T_cool) for c in rise}
+    assert cooled["T1"] < 0.7 * rise["T1"] and cooled["T2"] < 0.7 * rise["T2"], (rise, cooled)
+    assert (rise["T_stator"] - cooled["T_stator"]) < (rise["T1"] - cooled["T1"])
+
+
 def test_forward_selection_finds_a_known_effect(setup):
     """Data from the grey box itself with fixture_expansion (k = 1.5 µm/K) and noise: the
     selection names it, not the other candidate, and recovers k within its interval."""

@@ -31,12 +31,23 @@ def cv_blocks(text: str) -> int:
     return value
 
 
+def _base_extra(names: list[str] | None) -> tuple[str, ...] | None:
+    """--base-extra as run_fit takes it: None (not given) for the default, () for none."""
+    if names is None:
+        return None
+    if "none" in names and len(names) > 1:
+        raise InputError("command line", "--base-extra", "none with other parameters",
+                         "give either none or the parameters")
+    return tuple(n for n in names if n != "none")
+
+
 @with_progress("fit")
 def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
     from compare.fit.run import report_summary_text, run_fit, save_report
     from spindle.outputs import output_dir, safe_name
     from spindle.spec import load_spec
 
+    base_extra = _base_extra(args.base_extra)
     if args.model == "fem" and args.lumped_only:
         raise InputError("command line", "--model", "--model fem calibrates on the FEM "
                          "reference, --lumped-only switches the FEM off",
@@ -48,7 +59,7 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
                   progress=progress.say,
                   fem_level=None if args.lumped_only else args.fem_level, model=args.model,
-                  base_extra=tuple(args.base_extra or ()), blocks=args.blocks,
+                  base_extra=base_extra, blocks=args.blocks,
                   cv_blocks=args.cv_blocks)
     with output_dir(out, inputs=[spec.path, args.run]) as tmp, progress.pictures():
         save_report(rep, tmp, pictures=not args.no_pictures)
@@ -59,6 +70,8 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    from compare.fit.greybox import DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS
+
     """Add the command's sub-parser."""
     fp = subparsers.add_parser("fit", help="fit a bench run: calibrate, diagnose the residual, add the "
                         "effects it supports, report the error before and after")
@@ -93,11 +106,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "calibrate the base parameters on the FEM reference itself (minutes), "
                     "then select effects on the lumped model anchored there")
     fp.add_argument("--base-extra", nargs="+", metavar="PARAM",
-                    choices=("heat_capacity", "friction_exponent"),
-                    help="calibrate these too, for a spindle its spec describes only "
-                    "approximately: heat_capacity (a factor on every heat capacity), "
-                    "friction_exponent (bearing friction times (n / 3000 rpm)^e) (default: "
-                    "neither; docs/fit.md)")
+                    choices=(*EXTRA_BASE_PARAMS, "none"),
+                    help="the extra base parameters to calibrate, for a spindle its spec "
+                    "describes only approximately: G_seat_W_K (a conductance from the bearing "
+                    "rings to the coolant), heat_capacity (a factor on every heat capacity), "
+                    "friction_exponent (bearing friction times (n / 3000 rpm)^e), or none "
+                    f"(default: {' '.join(DEFAULT_BASE_EXTRA)} with --model lumped; "
+                    "docs/fit.md)")
     fp.add_argument("--nodes", type=NODE_COUNT, default=11, help="lumped model nodes (default 11)")
     fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
     add_no_pictures(fp)

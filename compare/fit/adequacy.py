@@ -17,6 +17,11 @@ import numpy as np
 #: |z| beyond which a base parameter is outside its prior range (two-sided 1 %)
 IMPLAUSIBLE_Z = 2.576
 
+#: conductances [W/K] the spec does not have (base extras whose spec value is 0) and the
+#: value above which the run is said to need them: 1 W/K moves a bearing ring carrying 30-60 W
+#: of friction by several kelvin, far above the sensors' resolution
+MISSING_PATH_W_K = {"G_seat_W_K": 1.0}
+
 #: where in the spec (or drive file) each base parameter lives: what to look at when the
 #: calibration drives it out of its prior range
 WHERE_IN_SPEC = {
@@ -37,6 +42,10 @@ WHERE_IN_SPEC = {
                       "(the stator's k_W_mK)",
     "alpha_eff": "the expansion coefficients of the growth chain's materials (alpha_1_K) and "
                  "the P1 sensor's position",
+    "G_seat_W_K": "the cooling of the bearing seats: the spec's coolant films end at the "
+                  "cooling sleeve, and this run's bearing rings follow the coolant more "
+                  "closely than conduction through the housing allows (a coolant channel or "
+                  "film at the bearing bores: surfaces with T_ref = \"coolant\" there)",
     "heat_capacity": "the parts' volumes and materials (rho_kg_m3, c_J_kgK): the thermal mass "
                      "that takes part on the run's time scales",
 }
@@ -72,6 +81,9 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
              for k in spec_values if k in theta]
     implausible = sorted((k for k, v in z.items() if abs(v) > IMPLAUSIBLE_Z),
                          key=lambda k: -abs(z[k]))
+    # paths the spec lacks (no prior: the spec's value is 0) that the run needed
+    missing = [k for k, floor in MISSING_PATH_W_K.items()
+               if k in theta and float(theta[k]) > floor]
     worst: dict[str, tuple[str, float]] = {}
     for c, window, r in bad:
         if r > worst.get(c, ("", 0.0))[1]:
@@ -88,9 +100,13 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     adequate = not worst and not implausible
     statement = ("explains the run within the tolerances with every base parameter inside its "
                  "prior range" if adequate else "; ".join(parts))
+    if missing:  # the calibrated base has it; the spec does not: say so either way
+        statement += ("; it needed a path the spec lacks: " + "; ".join(
+            f"{k} = {theta[k]:.3g} (spec 0): look at {WHERE_IN_SPEC.get(k, 'the spec')}"
+            for k in missing))
     return {"adequate": adequate, "channels": channels,
             "inadequate_channels": sorted(worst), "moved": moved,
-            "implausible": implausible, "statement": statement}
+            "implausible": implausible, "missing_paths": missing, "statement": statement}
 
 
 def extrapolation_warnings(grid_s: np.ndarray, speed_rpm: np.ndarray,

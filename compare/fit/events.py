@@ -361,10 +361,14 @@ def event_tests(run, gb, theta: dict[str, float], channels, alpha: float = 0.01
         if np.isfinite(test.z):
             sc = by_name[test.scale]
             lo, hi = test.estimate - 1.96 * test.se, test.estimate + 1.96 * test.se
-            test.parameter = {"name": "tau_s",
-                              "value": onsets.lag_for_ratio(c, test.estimate, sc),
-                              "ci95": [onsets.lag_for_ratio(c, hi, sc),
-                                       onsets.lag_for_ratio(c, lo, sc)]}
+            tau = onsets.lag_for_ratio(c, test.estimate, sc)
+            # below the lagged model's floor (a long lag turns the onset into a ramp whose
+            # ratio stops falling) the ratio says "lagged" but not by how much: no prior on
+            # tau then, the fit over the whole run estimates it
+            if tau < LAG_GRID_S[-1]:
+                test.parameter = {"name": "tau_s", "value": tau,
+                                  "ci95": [onsets.lag_for_ratio(c, hi, sc),
+                                           onsets.lag_for_ratio(c, lo, sc)]}
         out[f"sensor_lag({c})"] = test
     out.update(power_tests(run, alpha, gb, theta))
     return out

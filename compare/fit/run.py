@@ -34,6 +34,7 @@ from compare.fit.calibrate import (
     Fit,
     Measured,
     Selection,
+    at_bound,
     cross_validate,
     forward_selection,
     parameters_table,
@@ -42,6 +43,7 @@ from compare.fit.calibrate import (
 from compare.fit.events import event_tests
 from compare.fit.greybox import (
     BASE_PARAMS,
+    DEFAULT_BASE_EXTRA,
     EFFECTS,
     EXTRA_BASE_PARAMS,
     GreyBox,
@@ -142,7 +144,9 @@ class FitReport:
                             "explanation": e.explanation,
                             "validation_error_before": st.validation_before,
                             "validation_error_after": st.validation_after,
-                            "needed_by": st.needed_by})
+                            "needed_by": st.needed_by,
+                            # on its range's bound: a limit of the effect, not an estimate
+                            "at_bound": at_bound(final, st.effect)})
         return jsonable({
             "format": REPORT_FORMAT, "run": str(self.run.path), "spec": self.spec.name,
             "channels": self.channels, "run_summary": self.run.summary(),
@@ -231,7 +235,8 @@ class BaseCalibration:
 def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, nodes: int = 11,
                    grid_s: float = 60.0, progress: Callable[[str], None] | None = None,
                    fem_level: int | None = 0, model: str = "lumped",
-                   base_extra: tuple[str, ...] = (), blocks: int = 1) -> BaseCalibration:
+                   base_extra: tuple[str, ...] | None = None, blocks: int = 1
+                   ) -> BaseCalibration:
     """The first half of :func:`run_fit`: read the run, check it against the spec, anchor the
     grey box to the FEM reference and calibrate the base parameters (arguments as there)."""
     from compare.fit.discrepancy import fem_discrepancy
@@ -244,6 +249,9 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         raise InputError("command line", "--model", "--model fem calibrates on the FEM "
                          "reference, --lumped-only switches the FEM off",
                          "drop one of the two options")
+    if base_extra is None:  # the default extras, with the lumped calibration only
+        base_extra = DEFAULT_BASE_EXTRA if model == "lumped" else ()
+    base_extra = tuple(base_extra)
     _check_base_extra(base_extra, model)
     if not 0.2 <= fit_fraction <= 0.9:
         raise InputError("command line", "--fit-fraction", f"{fit_fraction} is outside 0.2..0.9",
@@ -264,9 +272,14 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
     anchor = None
     fem_cal_info = None
+    # an extra whose spec value is its range's bound (a conductance the spec lacks) starts
+    # inside its range: a start on the bound can stall there
+    params = cal.gb.parameters()
+    start = {k: params[k].lo + 0.05 * (params[k].hi - params[k].lo) for k in base_extra
+             if params[k].default <= params[k].lo}
     if fem_level is None:  # the lumped model alone, factors of 1, no priors (older behaviour)
         say("calibrating the base model")
-        base = cal.fit()
+        base = cal.fit(start=start)
     elif model == "fem":
         base, anchor, fem_cal_info = _calibrate_on_fem(cal, fem_level, say)
     else:
@@ -274,7 +287,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         anchor = fem_discrepancy(cal.gb, channels, fem_level)
         cal.gb.discrepancy = anchor.offsets
         say("calibrating the base model")
-        _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref})
+        _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref}, start=start)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
                            fem_cal_info)
 
@@ -283,7 +296,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
             nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
             min_gain: float = 0.25, progress: Callable[[str], None] | None = None,
             fem_level: int | None = 0, model: str = "lumped",
-            base_extra: tuple[str, ...] = (), blocks: int = 1,
+            base_extra: tuple[str, ...] | None = None, blocks: int = 1,
             cv_blocks: int = 5) -> FitReport:
     """The whole loop (module docstring). ``model``: "lumped" calibrates the base parameters
     on the lumped grey box anchored to the FEM at the spec's values; "fem" calibrates them on
@@ -762,7 +775,9 @@ def report_summary_text(rep: FitReport) -> str:
         pars = ", ".join(f"{k} = {v:.4g}" if isinstance(v, int | float) else f"{k} = {v}"
                          for k, v in e["parameters"].items())
         lines.append(f"  effect {e['name']}: {pars} (p = {p_text(e['p_value'])}, "
-                     f"delta BIC {e['delta_bic']:.1f}, needed by {e['needed_by']})")
+                     f"delta BIC {e['delta_bic']:.1f}, needed by {e['needed_by']})"
+                     + (f"; {', '.join(e['at_bound'])} on its range's bound: the effect is "
+                        "at least this large in magnitude" if e.get("at_bound") else ""))
     if not doc["effects"]:
         lines.append("  no effect accepted")
     lines.append(f"  unexplained: {doc['unexplained']['unexplained']}"
