@@ -153,6 +153,11 @@ def test_synth_then_fit_end_to_end(tmp_path, capsys):
     assert isinstance(rep["warnings"], list)
     ad = rep["base_adequacy"]
     assert isinstance(ad["adequate"], bool) and set(ad["channels"]) == set(rep["channels"])
+    # the spec's own spindle has no cooled bearing seats: the default extra stays near 0
+    # (0.016 W/K measured on a clean run) and no missing path is said; 1 W/K is the
+    # adequacy's own threshold (compare.fit.adequacy.MISSING_PATH_W_K)
+    seat = {p["name"]: p["value"] for p in rep["parameters"]}["G_seat_W_K"]
+    assert seat < 1.0 and ad["missing_paths"] == [], seat
     assert "Base model:" in (out / "report.html").read_text()
     assert (out / "report.html").exists() and (out / "fit_channels.png").exists()
 
