@@ -86,6 +86,28 @@ def test_seat_conductance_is_nested_and_cools_the_rings(setup):
     assert (rise["T_stator"] - cooled["T_stator"]) < (rise["T1"] - cooled["T1"])
 
 
+def test_seats_see_the_warmed_coolant(setup):
+    """With coolant_dynamics the bearing seats' conductance ends at the coolant's mean
+    temperature (behind the advection conductance), as the sleeve's films do, not at the
+    supply: the water that warms along the jacket is the water at the seats. So the same
+    coolant warming raises T1 and T2 more with the seats than without."""
+    spec, _, inp = setup
+    gb = GreyBox(spec, DRIVES["spl2782"], inp, effects=("coolant_dynamics",),
+                 base_extra=("G_seat_W_K",))
+    edges = gb._structure()[0].system.edges
+    mean = next(i for i, _, _, name in edges if name == "coolant_advection")
+    assert {j for _, j, _, name in edges if name.startswith("seat:")} == {mean}
+
+    def warming(G: float) -> dict[str, float]:
+        off = gb.simulate({"G_seat_W_K": G, "R_adv_K_W": 0.0})
+        on = gb.simulate({"G_seat_W_K": G, "R_adv_K_W": 0.004})
+        return {c: float(np.max(on[c] - off[c])) for c in ("T1", "T2")}
+
+    # measured: T1 2.93 K without seats, 3.88 K with 20 W/K; T2 3.64 / 4.09 K
+    without, with_seats = warming(0.0), warming(20.0)
+    assert all(with_seats[c] > without[c] + 0.2 for c in without), (without, with_seats)
+
+
 def test_forward_selection_finds_a_known_effect(setup):
     """Data from the grey box itself with fixture_expansion (k = 1.5 µm/K) and noise: the
     selection names it, not the other candidate, and recovers k within its interval."""

@@ -23,10 +23,7 @@ import pytest
 
 PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"
 #: the runs named wrongly at the last measurement, with what fit names (docs/fit.md)
-KNOWN_WRONG = {
-    "dev-08": "coolant_dynamics: nothing named, unexplained (the jacket film factor absorbs "
-              "it: h_coolant 2.8 here against 3.8 on the loaded control dev-09)",
-}
+KNOWN_WRONG: dict[str, str] = {}
 #: runs whose validation open-loop RMS after the fit exceeds a tolerance although the effect
 #: is named, with the channel (docs/fit.md: the base model's misfit, not the effect's)
 KNOWN_OVER_TOLERANCE: dict[str, str] = {}

@@ -458,7 +458,8 @@ def lr_test(before: Fit, after: Fit) -> tuple[float, float]:
 
 #: effects with an instantaneous signature, judged on the run's events where a test applies
 #: (compare.fit.events) rather than on the open-loop fit, whose slow misfit they cannot mimic
-EVENT_EFFECTS = ("centrifugal_shortening", "sensor_lag", "bearing_preload", "windage_loss")
+EVENT_EFFECTS = ("centrifugal_shortening", "sensor_lag", "bearing_preload", "windage_loss",
+                 "coolant_dynamics")
 
 
 def event_supported(events: Mapping[str, EventTest], alpha: float

@@ -109,15 +109,22 @@ class EventTest:
     #: lag tests: the onset scale reported, and the test at every scale
     scale: str | None = None
     scales: list[dict] = field(default_factory=list)
+    #: tests with a materiality floor: the effect at its estimate moves a measured channel by
+    #: at least that channel's tolerance (None where the test has no such floor)
+    material: bool | None = None
+    #: the largest change the effect at its estimate makes per channel (K, m)
+    peak_effect: dict | None = None
 
     def significant(self, alpha: float) -> bool:
-        return bool(np.isfinite(self.p_value) and self.p_value < alpha)
+        return bool(np.isfinite(self.p_value) and self.p_value < alpha
+                    and self.material is not False)
 
     def to_dict(self) -> dict:
         return {"effect": self.effect, "channel": self.channel, "estimate": self.estimate,
                 "se": self.se, "z": self.z, "p_value": self.p_value, "n_steps": self.n_steps,
                 "unit": self.unit, "meaning": self.meaning, "model_reference": self.reference,
-                "parameter": self.parameter, "scale": self.scale, "scales": self.scales}
+                "parameter": self.parameter, "scale": self.scale, "scales": self.scales,
+                "material": self.material, "peak_effect": self.peak_effect}
 
 
 def speed_steps(t_s: np.ndarray, speed_rpm: np.ndarray, min_step_rpm: float = STEP_RPM,
@@ -371,4 +378,6 @@ def event_tests(run, gb, theta: dict[str, float], channels, alpha: float = 0.01
                                            onsets.lag_for_ratio(c, lo, sc)]}
         out[f"sensor_lag({c})"] = test
     out.update(power_tests(run, alpha, gb, theta))
+    from compare.fit.load_events import coolant_load_test
+    out["coolant_dynamics"] = coolant_load_test(run, gb, theta)
     return out

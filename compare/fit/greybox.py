@@ -321,14 +321,17 @@ class GreyBox:
             net.network.connect(hous.masses[-1].block.port, c.port_a)
             net.network.connect(c.port_b, amb.port)
         if self._seats:
-            cool = next(b for b in net.network.blocks if isinstance(b, FixedTemperature)
-                        and b.source == "coolant")
+            adv_block = next((b for b in net.network.blocks
+                              if getattr(b, "name", "") == "coolant_advection"), None)
+            cool_port = (adv_block.port_a if adv_block is not None else
+                         next(b for b in net.network.blocks if isinstance(b, FixedTemperature)
+                              and b.source == "coolant").port)
             for p in net.parts.values():
                 if p.part.role in ("front_bearing", "rear_bearing"):
                     outer = [m for m in p.masses if m.name.endswith("outer")] or p.masses[-1:]
                     c = net.network.add(Convection(f"seat:{p.part.name}", Gc_W_K=1.0))
                     net.network.connect(outer[0].block.port, c.port_a)
-                    net.network.connect(c.port_b, cool.port)
+                    net.network.connect(c.port_b, cool_port)
         drag = (_preload_drag_flows(net) if "bearing_preload" in self.effects
                 and self.power_measured else [])
         model = LumpedModel(self.spec, network=net)

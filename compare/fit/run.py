@@ -726,10 +726,16 @@ def _events_html(doc: dict) -> str:
     rows = []
     for label, t in events.items():
         applies = t["p_value"] is not None and math.isfinite(t["p_value"])
+        meaning = t["meaning"]
+        if t.get("material") is False and t.get("peak_effect"):
+            ch, v = max(t["peak_effect"].items(), key=lambda kv: kv[1] / TOLERANCE[kv[0]])
+            size = f"{v * 1e6:.2f} µm" if ch == "P1" else f"{v:.2f} K"
+            meaning += (f"; at its estimate it moves {ch} by at most {size}, less than the "
+                        "tolerance: not material, not named")
         rows.append([label, t["channel"],
                      f"{t['estimate']:.4g} ± {t['se']:.2g}" if applies else "",
                      t["unit"], f"{t['z']:.1f}" if applies else "", p_text(t["p_value"]),
-                     t["meaning"]])
+                     meaning])
     return ("<h2>Event tests (raw samples)</h2><p>Effects with a signature the thermal "
             "model's slow misfit cannot produce are judged on these alone where they apply "
             "(docs/fit.md).</p>"
