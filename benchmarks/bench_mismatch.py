@@ -5,6 +5,7 @@ seed) over a cycle that is not the spec's own, then fitted with the spec.
 
     python benchmarks/bench_mismatch.py [--seeds 1 2 3] [--cycle random] [--workers 2]
                                         [--only windage_loss clean] [--json OUT.json]
+                                        [--keep RUNS_DIR]
 
 Prints, per case: the truth, what ``fit`` named (and how), whether the verdict is right (the
 effect named alone; nothing on clean data; ``unexplained`` with nothing named for the
@@ -30,6 +31,7 @@ class Case:
     seed: int
     cycle: str
     spec: str
+    keep: str | None = None
 
     @property
     def label(self) -> str:
@@ -45,8 +47,12 @@ def run_one(case: Case) -> dict:
     t = time.perf_counter()
     spec = load_spec(case.spec)
     with tempfile.TemporaryDirectory() as tmp:
-        run = Path(tmp) / "run.csv"
-        truth = synth(spec, case.cycle, case.effect, case.seed, run, mismatch=True)
+        run = Path(case.keep or tmp) / f"{case.cycle}-{case.label}.csv"
+        if case.keep and run.exists() and run.with_suffix(".truth.json").exists():
+            # a kept run is fitted again as it is (to compare fit changes on the same data)
+            truth = json.loads(run.with_suffix(".truth.json").read_text(encoding="utf-8"))
+        else:
+            truth = synth(spec, case.cycle, case.effect, case.seed, run, mismatch=True)
         t_synth = time.perf_counter() - t
         doc = run_fit(run, spec).to_dict()
     named = [e["name"] for e in doc["effects"]]
@@ -61,7 +67,15 @@ def run_one(case: Case) -> dict:
     return {"case": case.label, "effect": case.effect, "seed": case.seed, "named": named,
             "how": [e.get("needed_by") for e in doc["effects"]], "unexplained": unexplained,
             "right": right, "validation_rmse": {c: v["rmse"] for c, v in val.items()},
-            "truth": truth, "synth_s": t_synth, "seconds": time.perf_counter() - t}
+            "truth": truth, "synth_s": t_synth,
+            "events": {k: {f: v.get(f) for f in ("estimate", "se", "z", "p_value", "material")}
+                       for k, v in doc.get("events", {}).items()},
+            "tried": [{k: c.get(k) for k in ("effect", "channel", "round", "gain", "excess_before",
+                                              "excess_after", "cv_before", "cv_after",
+                                              "needed_by", "qualifies", "accepted")}
+                      for c in doc["candidates_tried"] if "qualifies" in c],
+            "parameters": {p["name"]: p["value"] for p in doc.get("parameters", [])},
+            "seconds": time.perf_counter() - t}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -76,12 +90,17 @@ def main(argv: list[str] | None = None) -> None:
                     "electronics_drift)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
+    ap.add_argument("--keep", type=Path, help="keep the synthetic runs in this folder; runs "
+                    "already there are fitted again without synthesising them anew")
     args = ap.parse_args(argv)
+    if args.keep:
+        args.keep.mkdir(parents=True, exist_ok=True)
 
     from compare.executor import run_cases, stderr_progress
 
     effects = args.only or [*sorted(EFFECTS), "clean", "electronics_drift"]
-    cases = [Case(e, s, args.cycle, args.spec) for e in effects for s in args.seeds]
+    cases = [Case(e, s, args.cycle, args.spec, str(args.keep) if args.keep else None)
+             for e in effects for s in args.seeds]
     t = time.perf_counter()
     outcomes = run_cases(run_one, cases, workers=args.workers, progress=stderr_progress())
     rows = []

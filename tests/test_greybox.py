@@ -144,6 +144,21 @@ def test_a_round_accepts_the_best_refit_only_when_it_qualifies(refits, expected)
     assert (chosen and chosen[2]) == expected
 
 
+@pytest.mark.parametrize("refits, expected", [
+    # (qualifies, gain, label, channels): a better refit that fails blocks only candidates
+    # acting on a channel it acts on (the peer's dev-06 with a lag injected on T_stator: a
+    # P1 fixture term fitting better and failing its tests blocked the lag)
+    ([(False, 37.4, "fixture", {"P1"}), (True, 21.5, "lag", {"T_stator"})], "lag"),
+    ([(False, 30.0, "fixture", {"P1"}), (True, 17.0, "mount", set(CHANNELS))], None),
+    ([(False, 30.0, "fixture", {"P1"}), (True, 20.0, "mount", set(CHANNELS)),
+      (True, 10.0, "lag", {"T2"})], None),  # mount, blocked, still blocks what it covers
+    ([(True, 30.0, "lag", {"T1"}), (True, 40.0, "fixture", {"P1"})], "fixture"),
+])
+def test_a_failing_refit_blocks_only_candidates_on_its_channels(refits, expected):
+    chosen = choose_refit(refits, lambda r: r[3])
+    assert (chosen and chosen[2]) == expected
+
+
 def test_resample_leaves_gaps_empty():
     t = np.concatenate([np.arange(0, 600, 1.0), np.arange(1800, 2400, 1.0)])
     y = t * 0.01
@@ -394,3 +409,38 @@ def test_cross_validation_of_the_true_model_is_at_the_noise(setup):
     wrong = cal.fit(free=["h_air"], start={"f0": 0.2})
     cv_wrong = cross_validate(cal, wrong, blocks=4)
     assert cv_wrong["pooled"]["T1"]["rmse"] > 3 * sd["T1"]
+
+
+def _event(effect: str, channel: str, z: float, p: float):
+    from compare.fit.events import EventTest
+
+    return EventTest(effect, channel, 1.0, 0.1, z, p, 8, "-", "constructed", reference=1.5)
+
+
+def test_a_lag_on_p1_and_a_centrifugal_jump_are_rivals():
+    """Both are read from P1's shape at the speed steps: when both events are significant
+    the weaker goes to the loop; either alone is taken from its event."""
+    from compare.fit.calibrate import _event_judged
+
+    both = {"centrifugal_shortening": _event("centrifugal_shortening", "P1", 2.5, 0.006),
+            "sensor_lag(P1)": _event("sensor_lag", "P1", 4.7, 1e-6),
+            "sensor_lag(T1)": _event("sensor_lag", "T1", -3.0, 1.0)}
+    judged, cands = _event_judged(both, list(EFFECTS), 0.01)
+    assert "centrifugal_shortening" not in judged and "centrifugal_shortening" not in cands
+    assert {"sensor_lag(P1)", "sensor_lag(T1)"} <= judged
+    alone = {k: v for k, v in both.items() if k != "sensor_lag(P1)"}
+    judged, cands = _event_judged(alone, list(EFFECTS), 0.01)
+    assert "centrifugal_shortening" in cands
+    # a lag on another channel is no rival of the jump
+    other = dict(alone, **{"sensor_lag(T2)": _event("sensor_lag", "T2", 6.0, 1e-9)})
+    judged, cands = _event_judged(other, list(EFFECTS), 0.01)
+    assert {"centrifugal_shortening", "sensor_lag(T2)"} <= set(cands)
+
+
+def test_gains_are_judged_on_the_effects_own_channels():
+    from compare.fit.calibrate import own_channels
+
+    assert own_channels("fixture_expansion") == ("P1",)
+    assert own_channels("centrifugal_shortening") == ("P1",)
+    assert own_channels("sensor_lag", "T_stator") == ("T_stator",)
+    assert set(own_channels("mount_conduction")) == set(CHANNELS)

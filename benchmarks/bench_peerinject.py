@@ -1,0 +1,140 @@
+"""Effects injected into a peer's control runs (compare/fit/inject.py): held-out-like cases
+whose base misfit is a real one this project did not make, with magnitudes and channels other
+than the peer's own effect runs.
+
+    python benchmarks/bench_peerinject.py [--runs DIR] [--controls dev-06 dev-09]
+                                          [--only sensor_lag] [--workers 2] [--json OUT.json]
+
+Each case: one control run (truth ``none`` in truth.json) with one measurement-side effect
+injected (centrifugal shortening, fixture expansion, a sensor lag on one channel), then
+``fit --spec spl2782``. Right: that effect (and for a lag, that channel) named alone. Prints
+the table and the share right; the controls themselves are fitted as they are (right: nothing
+named).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT_RUNS = ROOT.parent / "shared" / "bench-runs"
+
+#: (effect, parameters, lag channel): magnitudes around and away from the peer's own effect
+#: runs (dev-01 c 0.055 um/krpm^2, dev-04 k -0.72 um/K, dev-03 lag on T1, 400 s fitted)
+INJECTIONS = (
+    ("none", {}, None),
+    ("centrifugal_shortening", {"c_cf_um_krpm2": 0.03}, None),
+    ("centrifugal_shortening", {"c_cf_um_krpm2": 0.1}, None),
+    ("fixture_expansion", {"k_fix_um_K": -0.5}, None),
+    ("fixture_expansion", {"k_fix_um_K": 1.5}, None),
+    ("sensor_lag", {"tau_s": 600.0}, "T1"),
+    ("sensor_lag", {"tau_s": 600.0}, "T2"),
+    ("sensor_lag", {"tau_s": 900.0}, "P1"),
+    ("sensor_lag", {"tau_s": 1200.0}, "T_stator"),
+)
+
+
+@dataclass(frozen=True)
+class Injected:
+    control: Path
+    effect: str
+    params: dict = field(hash=False)
+    channel: str | None
+    spec: str = "spl2782"
+
+    @property
+    def label(self) -> str:
+        what = "+".join(f"{v:g}" for v in self.params.values())
+        return f"{self.control.stem}:{self.effect}" + (f"({self.channel})" if self.channel
+                                                      else "") + (f"={what}" if what else "")
+
+
+def fit_one(case: Injected) -> dict:
+    """Inject, then ``fit``; the figures the table prints."""
+    from compare.fit.inject import inject
+    from compare.fit.run import run_fit
+    from spindle.spec import load_spec
+
+    t = time.perf_counter()
+    text = case.control.read_text(encoding="utf-8")
+    with tempfile.TemporaryDirectory() as tmp:
+        run = Path(tmp) / f"{case.control.stem}.csv"
+        if case.effect != "none":
+            text = inject(text, case.effect, case.params, case.channel)
+        run.write_text(text, encoding="utf-8")
+        doc = run_fit(run, load_spec(case.spec)).to_dict()
+    named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
+                          and e["parameters"].get("channel") else "") for e in doc["effects"]]
+    want = [] if case.effect == "none" else [case.effect + (f"({case.channel})"
+                                                           if case.channel else "")]
+    val = doc["error_after"]["validation"]
+    estimate = {k: v for e in doc["effects"] for k, v in e["parameters"].items()
+                if k != "channel"}
+    return {"case": case.label, "truth": want, "named": named, "right": named == want,
+            "unexplained": bool(doc["unexplained"]["unexplained"]), "injected": case.params,
+            "estimate": estimate,
+            "validation_rmse": {c: v["rmse"] for c, v in val.items()},
+            "events": {k: {f: v.get(f) for f in ("estimate", "se", "z", "p_value", "material")}
+                       for k, v in doc.get("events", {}).items()},
+            "tried": [{k: c.get(k) for k in ("effect", "channel", "round", "gain", "excess_before",
+                                              "excess_after", "cv_before", "cv_after",
+                                              "needed_by", "qualifies", "accepted")}
+                      for c in doc["candidates_tried"] if "qualifies" in c],
+            "seconds": time.perf_counter() - t}
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=Path, default=DEFAULT_RUNS,
+                    help="folder with RUN.csv files and truth.json (default: %(default)s)")
+    ap.add_argument("--controls", nargs="*",
+                    help="control runs to inject into (default: every run whose truth is none)")
+    ap.add_argument("--only", nargs="*", help="effects to inject (default: all; 'none' fits "
+                    "the controls as they are)")
+    ap.add_argument("--spec", default="spl2782")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
+    args = ap.parse_args(argv)
+
+    from compare.executor import run_cases, stderr_progress
+
+    truth_file = args.runs / "truth.json"
+    if not truth_file.is_file():
+        raise SystemExit(f"error: {truth_file} not found; --runs must name a folder with the "
+                         "runs' truth.json (../shared/bench-runs)")
+    truth = json.loads(truth_file.read_text(encoding="utf-8"))
+    controls = args.controls or sorted(k for k, v in truth.items()
+                                       if v.get("truth") in (None, "none"))
+    cases = [Injected(args.runs / f"{c}.csv", e, p, ch, args.spec) for c in controls
+             for e, p, ch in INJECTIONS if not args.only or e in args.only]
+    t = time.perf_counter()
+    outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
+    rows = []
+    print(f"{'case':46} {'named':26} ok  estimate      validation RMS after (T1 T2 Tst K, P1 µm)")
+    for o in outcomes:
+        if o.error:
+            print(f"{o.label:46} failed: {o.error}")
+            continue
+        r = o.value
+        rows.append(r)
+        v = r["validation_rmse"]
+        named = ", ".join(r["named"]) or ("unexplained" if r["unexplained"] else "nothing")
+        est = " ".join(f"{x:.3g}" for x in r["estimate"].values())
+        print(f"{r['case']:46} {named:26} {'yes' if r['right'] else 'NO ':3} {est:13} "
+              + " ".join(f"{v.get(c, float('nan')):5.2f}" for c in ("T1", "T2", "T_stator", "P1")))
+    n_right = sum(r["right"] for r in rows)
+    print(f"right verdicts: {n_right} of {len(cases)}; wall time {time.perf_counter() - t:.0f} s "
+          f"on {args.workers} workers")
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main()
