@@ -44,7 +44,7 @@ class DevRun:
 
 def fit_one(case: DevRun) -> dict:
     """``fit`` on one run; the figures the table prints."""
-    from compare.fit.run import run_fit
+    from compare.fit.run import run_fit, selection_trace
     from spindle.spec import load_spec
 
     t = time.perf_counter()
@@ -67,14 +67,7 @@ def fit_one(case: DevRun) -> dict:
                                  for c, v in val.items()},
             "implausible": {k: round(v, 2) for k, v in (doc.get("parameters_prior_z") or {})
                             .items() if abs(v) > 2.58},
-            "events": {k: {f: v.get(f) for f in ("estimate", "se", "z", "p_value",
-                                                 "model_reference", "scale", "scales")}
-                       for k, v in doc.get("events", {}).items()},
-            "tried": [{k: c.get(k) for k in ("effect", "channel", "round", "gain", "excess_before",
-                                              "excess_after", "cv_before", "cv_after",
-                                              "needed_by", "qualifies", "accepted")}
-                      for c in doc["candidates_tried"] if "qualifies" in c],
-            "parameters": {p["name"]: p["value"] for p in doc.get("parameters", [])},
+            **selection_trace(doc, ("estimate", "se", "z", "p_value", "model_reference", "scale", "scales")),
             "seconds": time.perf_counter() - t}
 
 

@@ -40,7 +40,7 @@ class Case:
 
 def run_one(case: Case) -> dict:
     """``synth --mismatch`` then ``fit`` on one case; the figures the table prints."""
-    from compare.fit.run import run_fit
+    from compare.fit.run import run_fit, selection_trace
     from compare.fit.synth import synth
     from spindle.spec import load_spec
 
@@ -68,13 +68,7 @@ def run_one(case: Case) -> dict:
             "how": [e.get("needed_by") for e in doc["effects"]], "unexplained": unexplained,
             "right": right, "validation_rmse": {c: v["rmse"] for c, v in val.items()},
             "truth": truth, "synth_s": t_synth,
-            "events": {k: {f: v.get(f) for f in ("estimate", "se", "z", "p_value", "material")}
-                       for k, v in doc.get("events", {}).items()},
-            "tried": [{k: c.get(k) for k in ("effect", "channel", "round", "gain", "excess_before",
-                                              "excess_after", "cv_before", "cv_after",
-                                              "needed_by", "qualifies", "accepted")}
-                      for c in doc["candidates_tried"] if "qualifies" in c],
-            "parameters": {p["name"]: p["value"] for p in doc.get("parameters", [])},
+            **selection_trace(doc),
             "seconds": time.perf_counter() - t}
 
 

@@ -59,7 +59,7 @@ class Injected:
 def fit_one(case: Injected) -> dict:
     """Inject, then ``fit``; the figures the table prints."""
     from compare.fit.inject import inject
-    from compare.fit.run import run_fit
+    from compare.fit.run import run_fit, selection_trace
     from spindle.spec import load_spec
 
     t = time.perf_counter()
@@ -81,12 +81,7 @@ def fit_one(case: Injected) -> dict:
             "unexplained": bool(doc["unexplained"]["unexplained"]), "injected": case.params,
             "estimate": estimate,
             "validation_rmse": {c: v["rmse"] for c, v in val.items()},
-            "events": {k: {f: v.get(f) for f in ("estimate", "se", "z", "p_value", "material")}
-                       for k, v in doc.get("events", {}).items()},
-            "tried": [{k: c.get(k) for k in ("effect", "channel", "round", "gain", "excess_before",
-                                              "excess_after", "cv_before", "cv_after",
-                                              "needed_by", "qualifies", "accepted")}
-                      for c in doc["candidates_tried"] if "qualifies" in c],
+            **selection_trace(doc),
             "seconds": time.perf_counter() - t}
 
 

@@ -21,7 +21,7 @@ import html
 import math
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -808,3 +808,18 @@ def report_summary_text(rep: FitReport) -> str:
     if bad:
         lines.append(f"  not identifiable from this run: {', '.join(bad)}")
     return "\n".join(lines)
+
+
+def selection_trace(doc: dict, event_fields: Sequence[str] = ("estimate", "se", "z",
+                                                              "p_value", "material")) -> dict:
+    """What a benchmark keeps of a report's ``to_dict()`` to see why an effect was named or
+    not: the event tests (``event_fields`` of each), the refitted candidates of the loop
+    (gains, validation and cross-validated excess before/after, need, verdict) and the
+    calibrated parameters."""
+    keys = ("effect", "channel", "round", "gain", "excess_before", "excess_after",
+            "cv_before", "cv_after", "judged_on", "needed_by", "qualifies", "accepted")
+    return {"events": {k: {f: v.get(f) for f in event_fields}
+                       for k, v in doc.get("events", {}).items()},
+            "tried": [{k: c.get(k) for k in keys}
+                      for c in doc["candidates_tried"] if "qualifies" in c],
+            "parameters": {p["name"]: p["value"] for p in doc.get("parameters", [])}}
