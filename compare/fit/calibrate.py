@@ -542,18 +542,17 @@ class _Judge:
     def __call__(self, name: str, full: Fit, pv: float, lag_channel: str | None = None
                  ) -> tuple:
         cal = self.cal
-        # needed: judged on the whole misfit (an effect that explains a small part of it is
-        # not worth naming); the cross-validated gain below on the channels it acts on
         own = own_channels(name, lag_channel)
-        # a lag, though, is a defect of one sensor: it cannot explain another channel's
-        # misfit, and that misfit (the stator's, on the peer's loaded runs) would hide it
-        # (a lag of 1200 s injected on T_stator of the peer's control dev-06: 0.97 of
-        # that channel's excess explained)
-        on = own if name == "sensor_lag" else None
-        x0 = cal.validation_excess(self.current, on)
-        x1 = cal.validation_excess(full, on)
-        # needed: it predicts the validation window better, or without it the base
-        # parameters sit outside their prior range and with it they do not
+        # needed: it predicts the validation window better (over the whole misfit: an
+        # effect that explains a small part of it is not worth naming), or without it the
+        # base parameters sit outside their prior range and with it they do not. A lag,
+        # though, is a defect of one sensor: it cannot explain another channel's misfit,
+        # which would hide it (a lag of 1200 s injected on T_stator of the peer's control
+        # dev-06: 0.97 of that channel's excess explained), so it is judged on its channel
+        if name == "sensor_lag":
+            x0, x1 = cal.validation_excess(self.current, own), cal.validation_excess(full, own)
+        else:
+            x0, x1 = self.x0, cal.validation_excess(full)
         why = ("validation" if x1 < (1.0 - self.min_gain) * x0 else
                "plausibility" if self.odd0 and cal.comfortable(full) else None)
         # an estimate on its range's bound is reported (at_bound) but no longer refuses the
