@@ -36,6 +36,9 @@ class DevRun:
     blocks: int = 1
     cv_blocks: int = 5
     fit_fraction: float = 0.6
+    #: fit with the spec's geometry, films and contacts perturbed as this seed's mismatch
+    #: (compare.fit.mismatch.draw_mismatch): the runs as if from yet another variant
+    spec_seed: int | None = None
 
     @property
     def label(self) -> str:
@@ -48,7 +51,12 @@ def fit_one(case: DevRun) -> dict:
     from spindle.spec import load_spec
 
     t = time.perf_counter()
-    rep = run_fit(case.path, load_spec(case.spec), base_extra=case.base_extra,
+    spec = load_spec(case.spec)
+    if case.spec_seed is not None:
+        from compare.fit.mismatch import perturbed_spec
+
+        spec = perturbed_spec(spec, case.spec_seed)
+    rep = run_fit(case.path, spec, base_extra=case.base_extra,
                   blocks=case.blocks, cv_blocks=case.cv_blocks, fit_fraction=case.fit_fraction)
     doc = rep.to_dict()
     named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
@@ -86,6 +94,10 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--fit-fraction", type=float, default=0.6,
                     help="as fit --fit-fraction (default 0.6): how stable the verdicts are when "
                     "the split moves")
+    ap.add_argument("--spec-mismatch", type=int, default=None, metavar="SEED",
+                    help="fit with the spec's geometry (axial stretch 10-15 %%), film groups "
+                    "and contacts (x 0.5-2) perturbed as synth's mismatch of this seed: how the "
+                    "verdicts hold when the spec is further off (default: the spec as is)")
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
 
@@ -96,7 +108,8 @@ def main(argv: list[str] | None = None) -> None:
     extra = (None if args.base_extra is None
              else tuple(n for n in args.base_extra if n != "none"))
     cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"], extra,
-                    args.blocks, args.cv_blocks, args.fit_fraction) for k in labels]
+                    args.blocks, args.cv_blocks, args.fit_fraction, args.spec_mismatch)
+             for k in labels]
     t = time.perf_counter()
     outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
     rows = []

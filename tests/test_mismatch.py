@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from compare.fit.greybox import film_groups
-from compare.fit.mismatch import Mismatch, draw_mismatch, ramped_steps, random_cycle
+from compare.fit.mismatch import Mismatch, draw_mismatch, perturbed_spec, ramped_steps, random_cycle
 from spindle.drive import drive_for
 from spindle.faces import exposed_faces, surface_faces
 from spindle.spec import ContactLink, load_spec
@@ -57,6 +57,21 @@ def test_apply_changes_what_it_declares(spl):
     f0 = drive.bearings["front_bearing"].f0
     assert d.bearings["front_bearing"].f0 == pytest.approx(1.2 * f0, rel=1e-12)
     assert d.friction_exponent == 0.2 and d.motor.rotor_loss_share == 0.1
+
+
+def test_perturbed_spec_is_the_seeds_mismatch_without_the_drive(spl):
+    """What fit reads from a perturbed spec: the seed's films, contacts and stretch; the spec
+    itself is left as it was (specs are frozen values)."""
+    spec, drive = spl
+    mm = draw_mismatch(np.random.default_rng([2, 1]))
+    out = perturbed_spec(spec, 2)
+    for group, factor in mm.films.items():
+        ratio = _film_conductance(out, group) / _film_conductance(spec, group)
+        assert factor * (1 - 1e-9) <= ratio <= factor * mm.axial_scale * (1 + 1e-9)
+    z = max(s.z_end for p in out.parts for s in p.sections)
+    assert z == pytest.approx(mm.axial_scale * max(s.z_end for p in spec.parts
+                                                   for s in p.sections), rel=1e-12)
+    assert drive_for(out).bearings["front_bearing"].f0 == drive.bearings["front_bearing"].f0
 
 
 def test_random_cycles():

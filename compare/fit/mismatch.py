@@ -97,6 +97,17 @@ def draw_mismatch(rng: np.random.Generator) -> Mismatch:
         fem_level=int(rng.choice([1, 2])))
 
 
+def perturbed_spec(spec: Spec, seed: int) -> Spec:
+    """``spec`` with the geometry, film groups and contacts of seed ``seed``'s mismatch
+    (:func:`draw_mismatch`; the drive's parameters stay the spec's): a spec that is yet
+    further off a bench's spindle, to check that ``fit``'s verdicts do not hang on the spec
+    being close (benchmarks/bench_devruns.py --spec-mismatch)."""
+    from spindle.drive import drive_for
+
+    out, _drive = draw_mismatch(np.random.default_rng([seed, 1])).apply(spec, drive_for(spec))
+    return out
+
+
 def random_cycle(rng: np.random.Generator, max_speed_rpm: float, loaded: bool = False,
                  duration_h: float = 16.0, ramped: bool = False) -> Cycle:
     """A 16 h cycle the spec does not have: a standstill start, speed steps of 45-120 min in a
