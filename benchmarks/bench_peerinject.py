@@ -48,6 +48,7 @@ class Injected:
     params: dict = field(hash=False)
     channel: str | None
     spec: str = "spl2782"
+    spec_seed: int | None = None  # as bench_devruns --spec-mismatch
 
     @property
     def label(self) -> str:
@@ -69,7 +70,12 @@ def fit_one(case: Injected) -> dict:
         if case.effect != "none":
             text = inject(text, case.effect, case.params, case.channel)
         run.write_text(text, encoding="utf-8")
-        doc = run_fit(run, load_spec(case.spec)).to_dict()
+        spec = load_spec(case.spec)
+        if case.spec_seed is not None:
+            from compare.fit.mismatch import perturbed_spec
+
+            spec = perturbed_spec(spec, case.spec_seed)
+        doc = run_fit(run, spec).to_dict()
     named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
                           and e["parameters"].get("channel") else "") for e in doc["effects"]]
     want = [] if case.effect == "none" else [case.effect + (f"({case.channel})"
@@ -94,6 +100,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--only", nargs="*", help="effects to inject (default: all; 'none' fits "
                     "the controls as they are)")
     ap.add_argument("--spec", default="spl2782")
+    ap.add_argument("--spec-mismatch", type=int, default=None, metavar="SEED",
+                    help="fit with the spec perturbed as synth's mismatch of this seed "
+                    "(compare.fit.mismatch.perturbed_spec; as bench_devruns.py)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
@@ -107,7 +116,8 @@ def main(argv: list[str] | None = None) -> None:
     truth = json.loads(truth_file.read_text(encoding="utf-8"))
     controls = args.controls or sorted(k for k, v in truth.items()
                                        if v.get("truth") in (None, "none"))
-    cases = [Injected(args.runs / f"{c}.csv", e, p, ch, args.spec) for c in controls
+    cases = [Injected(args.runs / f"{c}.csv", e, p, ch, args.spec, args.spec_mismatch)
+             for c in controls
              for e, p, ch in INJECTIONS if not args.only or e in args.only]
     t = time.perf_counter()
     outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
