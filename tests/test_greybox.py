@@ -437,6 +437,21 @@ def test_a_lag_on_p1_and_a_centrifugal_jump_are_rivals():
     assert {"centrifugal_shortening", "sensor_lag(T2)"} <= set(cands)
 
 
+def test_restoring_plausibility_lowers_the_cross_validated_gain_asked():
+    from compare.fit.calibrate import cv_gain_asked
+
+    # the synthetic mount of docs/fit.md: three parameters out before, one after
+    assert cv_gain_asked(0.25, ["rotor_share", "h_air", "h_rotating"], ["rotor_share"]) == 0.0
+    assert cv_gain_asked(0.25, ["h_air"], []) == 0.0
+    # leaving the set as it was, or trading one implausible parameter for another, restores
+    # nothing (windage on the mount runs left h_air where it was)
+    assert cv_gain_asked(0.25, ["h_air"], ["h_air"]) == 0.25
+    assert cv_gain_asked(0.25, ["h_air"], ["contact"]) == 0.25
+    assert cv_gain_asked(0.25, ["h_air"], ["h_air", "contact"]) == 0.25
+    # a plausible base has nothing to restore
+    assert cv_gain_asked(0.25, [], []) == 0.25
+
+
 def test_gains_are_judged_on_the_effects_own_channels():
     from compare.fit.calibrate import own_channels
 
