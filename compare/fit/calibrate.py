@@ -33,6 +33,7 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -526,6 +527,24 @@ def at_bound(fit: Fit, effect: str, rel: float = 1e-3) -> list[str]:
     return out
 
 
+class Refit(NamedTuple):
+    """One candidate refitted jointly in a round of :func:`forward_selection`, with its
+    tests (the first two items are what :func:`choose_refit` reads)."""
+
+    qualifies: bool
+    gain: float  # log-posterior gain over the current model
+    name: str
+    fit: Fit
+    lag_channel: str | None
+    lr: float
+    p_value: float
+    excess_before: float
+    excess_after: float
+    needed_by: str | None
+    at_bound: list[str]
+    cv: tuple[float, float] | None
+
+
 class _Judge:
     """Whether a refitted candidate qualifies in the open-loop loop of
     :func:`forward_selection`: (ok, validation excess after, needed by, parameters on a
@@ -719,8 +738,9 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                 full = screen
             lr, pv = lr_test(current, full)
             ok, x0, x1, why, bound, cv = judge(name, full, pv, lag_ch)
-            refits.append((ok, gain(full), name, full, lag_ch, lr, pv, x0, x1, why, bound, cv))
-        chosen = choose_refit(refits, lambda r: set(own_channels(r[2], r[4])))
+            refits.append(Refit(ok, gain(full), name, full, lag_ch, lr, pv, x0, x1, why, bound,
+                                cv))
+        chosen = choose_refit(refits, lambda r: set(own_channels(r.name, r.lag_channel)))
         for ok, _g, name, full, lag_ch, _lr, pv, x0, x1, why, bound, cv in refits:
             tried.append({"effect": name, "channel": lag_ch, "round": len(steps) + 1,
                           "p_value": pv, "validation_before": v0,
@@ -733,12 +753,13 @@ def forward_selection(cal: Calibrator, candidates: Sequence[str] | None = None,
                           "needed_by": why, "at_bound": bound, "gain": _g,
                           "cv_before": None if cv is None else cv[0],
                           "cv_after": None if cv is None else cv[1], "qualifies": ok,
-                          "accepted": chosen is not None and full is chosen[3]})
+                          "accepted": chosen is not None and full is chosen.fit})
         if chosen is None:
             break
-        _ok, _g, name, full, lag_ch, lr, pv, _x0, _x1, why, _b, _cv = chosen
-        steps.append(Step(name, full, lr, pv, full.bic() - current.bic(), v0,
-                          full.validation_score(), why))
+        full = chosen.fit
+        steps.append(Step(chosen.name, full, chosen.lr, chosen.p_value,
+                          full.bic() - current.bic(), v0, full.validation_score(),
+                          chosen.needed_by))
         current = full
     return Selection(base, steps, tried)
 
