@@ -95,11 +95,13 @@ def main(argv: list[str] | None = None) -> None:
                     help="as fit --fit-fraction (default 0.6): how stable the verdicts are when "
                     "the split moves")
     ap.add_argument("--spec-mismatch", type=int, default=None, metavar="SEED",
-                    help="fit with the spec's geometry (axial stretch 10-15 %%), film groups "
+                    help="fit with the spec's geometry (axis stretched or shrunk by 10-15 %%), film groups "
                     "and contacts (x 0.5-2) perturbed as synth's mismatch of this seed: how the "
                     "verdicts hold when the spec is further off (default: the spec as is)")
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
+    if args.spec_mismatch is not None and args.spec_mismatch < 0:
+        ap.error("--spec-mismatch: a seed >= 0")
 
     from compare.executor import run_cases, stderr_progress
 

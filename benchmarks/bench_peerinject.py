@@ -106,6 +106,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
+    if args.spec_mismatch is not None and args.spec_mismatch < 0:
+        ap.error("--spec-mismatch: a seed >= 0")
 
     from compare.executor import run_cases, stderr_progress
 

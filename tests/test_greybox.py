@@ -440,16 +440,22 @@ def test_a_lag_on_p1_and_a_centrifugal_jump_are_rivals():
 def test_restoring_plausibility_lowers_the_cross_validated_gain_asked():
     from compare.fit.calibrate import cv_gain_asked
 
-    # the synthetic mount of docs/fit.md: three parameters out before, one after
-    assert cv_gain_asked(0.25, ["rotor_share", "h_air", "h_rotating"], ["rotor_share"]) == 0.0
-    assert cv_gain_asked(0.25, ["h_air"], []) == 0.0
-    # leaving the set as it was, or trading one implausible parameter for another, restores
-    # nothing (windage on the mount runs left h_air where it was)
-    assert cv_gain_asked(0.25, ["h_air"], ["h_air"]) == 0.25
-    assert cv_gain_asked(0.25, ["h_air"], ["contact"]) == 0.25
-    assert cv_gain_asked(0.25, ["h_air"], ["h_air", "contact"]) == 0.25
+    crit = 2.576  # two-sided 1 %
+    # the synthetic mount of docs/fit.md: h_air +4.2 -> +0.3 sd, h_rotating 2.7 -> 1.6,
+    # rotor_share stays out
+    before = {"rotor_share": 2.9, "h_air": 4.2, "h_rotating": 2.7, "f0": -1.4}
+    after = {"rotor_share": 2.8, "h_air": 0.3, "h_rotating": 1.6, "f0": -1.1}
+    assert cv_gain_asked(0.25, before, after, crit) == 0.125
+    # nudged just across the 1 % line, not back within 1.96: nothing restored
+    assert cv_gain_asked(0.25, {"h_air": 2.60}, {"h_air": 2.55}, crit) == 0.25
+    # left where it was, or traded for another implausible parameter (windage on the mount
+    # runs left h_air where it was)
+    assert cv_gain_asked(0.25, {"h_air": 2.6, "contact": 0.0}, {"h_air": 2.6, "contact": 0.0},
+                         crit) == 0.25
+    assert cv_gain_asked(0.25, {"h_air": 2.6, "contact": 0.0}, {"h_air": 0.0, "contact": 3.0},
+                         crit) == 0.25
     # a plausible base has nothing to restore
-    assert cv_gain_asked(0.25, [], []) == 0.25
+    assert cv_gain_asked(0.25, {"h_air": 1.0}, {"h_air": 0.0}, crit) == 0.25
 
 
 def test_gains_are_judged_on_the_effects_own_channels():

@@ -60,18 +60,29 @@ def test_apply_changes_what_it_declares(spl):
 
 
 def test_perturbed_spec_is_the_seeds_mismatch_without_the_drive(spl):
-    """What fit reads from a perturbed spec: the seed's films, contacts and stretch; the spec
-    itself is left as it was (specs are frozen values)."""
-    spec, drive = spl
+    """What fit reads from a perturbed spec: the seed's films, contacts and stretch (seed 2
+    stretches the axis, so a film group's conductance grows by its factor times up to the
+    stretch, as in test_apply_changes_what_it_declares); the spec passed in is unchanged; a
+    spec without a drive (fin-shaft) is perturbed too; a negative seed is refused."""
+    spec, _drive = spl
     mm = draw_mismatch(np.random.default_rng([2, 1]))
+    assert mm.axial_scale > 1.0
     out = perturbed_spec(spec, 2)
     for group, factor in mm.films.items():
         ratio = _film_conductance(out, group) / _film_conductance(spec, group)
         assert factor * (1 - 1e-9) <= ratio <= factor * mm.axial_scale * (1 + 1e-9)
+    before = [lk.h_W_m2K for lk in spec.links if isinstance(lk, ContactLink)]
+    after = [lk.h_W_m2K for lk in out.links if isinstance(lk, ContactLink)]
+    assert after == pytest.approx([mm.contact * h for h in before], rel=1e-12)
     z = max(s.z_end for p in out.parts for s in p.sections)
     assert z == pytest.approx(mm.axial_scale * max(s.z_end for p in spec.parts
                                                    for s in p.sections), rel=1e-12)
-    assert drive_for(out).bearings["front_bearing"].f0 == drive.bearings["front_bearing"].f0
+    assert spec == load_spec("spl2782")
+    fin = load_spec("fin-shaft")
+    assert drive_for(fin) is None
+    assert perturbed_spec(fin, 2) != fin
+    with pytest.raises(ValueError, match="seed"):
+        perturbed_spec(spec, -1)
 
 
 def test_random_cycles():

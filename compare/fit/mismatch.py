@@ -46,6 +46,13 @@ class Mismatch:
 
     def apply(self, spec: Spec, drive: Drive) -> tuple[Spec, Drive]:
         """The mismatched spindle: its spec and its drive."""
+        d = (drive.with_f0(drive.bearings[next(iter(drive.bearings))].f0 * self.f0_factor)
+             .with_friction_exponent(self.friction_exponent)
+             .with_rotor_share(self.rotor_share))
+        return self.apply_to_spec(spec), d
+
+    def apply_to_spec(self, spec: Spec) -> Spec:
+        """The spec part of the mismatch: film groups, contacts, axial stretch."""
         groups = film_groups(spec)
         surfaces = tuple(
             s if s.h_W_m2K is None or groups.get(s.name) not in self.films else
@@ -53,11 +60,7 @@ class Mismatch:
             for s in spec.surfaces)
         links = tuple(replace(lk, h_W_m2K=lk.h_W_m2K * self.contact)
                       if isinstance(lk, ContactLink) else lk for lk in spec.links)
-        out = stretch_axially(replace(spec, surfaces=surfaces, links=links), self.axial_scale)
-        d = (drive.with_f0(drive.bearings[next(iter(drive.bearings))].f0 * self.f0_factor)
-             .with_friction_exponent(self.friction_exponent)
-             .with_rotor_share(self.rotor_share))
-        return out, d
+        return stretch_axially(replace(spec, surfaces=surfaces, links=links), self.axial_scale)
 
     def to_dict(self) -> dict:
         return {"films": dict(self.films), "contact": self.contact,
@@ -101,11 +104,10 @@ def perturbed_spec(spec: Spec, seed: int) -> Spec:
     """``spec`` with the geometry, film groups and contacts of seed ``seed``'s mismatch
     (:func:`draw_mismatch`; the drive's parameters stay the spec's): a spec that is yet
     further off a bench's spindle, to check that ``fit``'s verdicts do not hang on the spec
-    being close (benchmarks/bench_devruns.py --spec-mismatch)."""
-    from spindle.drive import drive_for
-
-    out, _drive = draw_mismatch(np.random.default_rng([seed, 1])).apply(spec, drive_for(spec))
-    return out
+    being close (benchmarks/bench_devruns.py --spec-mismatch). ``seed`` >= 0."""
+    if seed < 0:
+        raise ValueError(f"the seed of a spec's perturbation is >= 0, not {seed}")
+    return draw_mismatch(np.random.default_rng([seed, 1])).apply_to_spec(spec)
 
 
 def random_cycle(rng: np.random.Generator, max_speed_rpm: float, loaded: bool = False,
