@@ -26,6 +26,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from lumped.elastic import first_order_lag as lumped_lag
 from spindle.commented_csv import split_commented_csv
 
 #: the effects this module injects, with their parameter names
@@ -64,26 +65,13 @@ def _decimals(rows: list[list[str]], j: int) -> int:
 
 
 def first_order_lag(t_s: np.ndarray, x: np.ndarray, tau_s: float) -> np.ndarray:
-    """``x`` read through a first-order lag of ``tau_s`` [s] at the sample times ``t_s`` [s],
-    the input taken linear between samples (exact for a piecewise-linear input); NaN samples
-    are held over."""
-    y = np.empty_like(x)
+    """``x`` read through a first-order lag of ``tau_s`` [s] at the sample times ``t_s`` [s]
+    (strictly increasing, as a bench run's), the input taken linear between the measured
+    samples (lumped.elastic.first_order_lag over them: exact for a piecewise-linear input);
+    an empty (NaN) sample stays empty."""
     ok = np.isfinite(x)
-    first = int(np.argmax(ok))
-    y[:first] = np.nan
-    y[first] = x[first]
-    last_t, last_x, last_y = t_s[first], x[first], x[first]
-    for i in range(first + 1, len(x)):
-        if not ok[i]:
-            y[i] = np.nan
-            continue
-        h = t_s[i] - last_t
-        a = math.exp(-h / tau_s)
-        slope = (x[i] - last_x) / h if h > 0 else 0.0
-        # y' = (x - y) / tau with x linear over the interval
-        last_y = x[i] - slope * tau_s + (last_y - last_x + slope * tau_s) * a
-        y[i] = last_y
-        last_t, last_x = t_s[i], x[i]
+    y = np.full_like(x, np.nan)
+    y[ok] = lumped_lag(t_s[ok], x[ok], tau_s)
     return y
 
 
