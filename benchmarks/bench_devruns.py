@@ -47,7 +47,7 @@ class DevRun:
 
 def fit_one(case: DevRun) -> dict:
     """``fit`` on one run; the figures the table prints."""
-    from compare.fit.run import run_fit, selection_trace
+    from compare.fit.run import named_effects, run_fit, selection_trace
     from spindle.spec import load_spec
 
     t = time.perf_counter()
@@ -59,8 +59,7 @@ def fit_one(case: DevRun) -> dict:
     rep = run_fit(case.path, spec, base_extra=case.base_extra,
                   blocks=case.blocks, cv_blocks=case.cv_blocks, fit_fraction=case.fit_fraction)
     doc = rep.to_dict()
-    named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
-                          and e["parameters"].get("channel") else "") for e in doc["effects"]]
+    named = named_effects(doc)
     plain = [e["name"] for e in doc["effects"]]
     unexplained = bool(doc["unexplained"]["unexplained"])
     # the issue's verdict: the true effect named alone; nothing named on a control run

@@ -60,7 +60,7 @@ class Injected:
 def fit_one(case: Injected) -> dict:
     """Inject, then ``fit``; the figures the table prints."""
     from compare.fit.inject import inject
-    from compare.fit.run import run_fit, selection_trace
+    from compare.fit.run import named_effects, run_fit, selection_trace
     from spindle.spec import load_spec
 
     t = time.perf_counter()
@@ -76,8 +76,7 @@ def fit_one(case: Injected) -> dict:
 
             spec = perturbed_spec(spec, case.spec_seed)
         doc = run_fit(run, spec).to_dict()
-    named = [e["name"] + (f"({e['parameters'].get('channel')})" if e["name"] == "sensor_lag"
-                          and e["parameters"].get("channel") else "") for e in doc["effects"]]
+    named = named_effects(doc)
     want = [] if case.effect == "none" else [case.effect + (f"({case.channel})"
                                                            if case.channel else "")]
     val = doc["error_after"]["validation"]

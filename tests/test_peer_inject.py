@@ -42,7 +42,7 @@ def _fit(control: str, effect: str, params: tuple, channel: str | None) -> list[
     import tempfile
 
     from compare.fit.inject import inject
-    from compare.fit.run import run_fit
+    from compare.fit.run import named_effects, run_fit
     from spindle.spec import load_spec
 
     text = inject((PEER_RUNS / f"{control}.csv").read_text(encoding="utf-8"), effect,
@@ -51,8 +51,7 @@ def _fit(control: str, effect: str, params: tuple, channel: str | None) -> list[
         run = Path(tmp) / f"{control}.csv"
         run.write_text(text, encoding="utf-8")
         doc = run_fit(run, load_spec("spl2782")).to_dict()
-    return [e["name"] + (f"({e['parameters']['channel']})" if e["name"] == "sensor_lag"
-                         else "") for e in doc["effects"]]
+    return named_effects(doc)
 
 
 def _params() -> list:

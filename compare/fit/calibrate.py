@@ -45,6 +45,13 @@ RESTORED_Z = 1.96
 TOLERANCE = {"T1": 1.0, "T2": 1.0, "T_stator": 1.0, "P1": 1.5e-6}  # K, K, K, m (paper)
 
 
+def implausible_z(alpha: float) -> float:
+    """The prior |z| beyond which a base parameter is implausible: two-sided at ``alpha``."""
+    from scipy.stats import norm
+
+    return float(norm.isf(alpha / 2))
+
+
 @dataclass
 class Measured:
     """Measured channels on the model grid (NaN where not measured), and the windows.
@@ -238,9 +245,7 @@ class Calibrator:
 
     def implausible(self, fit: Fit, alpha: float) -> list[str]:
         """The base parameters outside their two-sided (1 - alpha) prior range."""
-        from scipy.stats import norm
-
-        z_crit = float(norm.isf(alpha / 2))
+        z_crit = implausible_z(alpha)
         return [k for k, z in self.prior_z(fit).items() if abs(z) > z_crit]
 
     def comfortable(self, fit: Fit) -> bool:
@@ -559,6 +564,7 @@ class _Judge:
         self.min_gain, self.cv_blocks, self.cv_gain = min_gain, cv_blocks, cv_gain
         self.x0, self.v0 = cal.validation_excess(current), current.validation_score()
         self.odd0 = cal.implausible(current, alpha)
+        self.z0 = cal.prior_z(current)
         self._cv_now: dict | None = None
 
     def __call__(self, name: str, full: Fit, pv: float, lag_channel: str | None = None
@@ -598,10 +604,8 @@ class _Judge:
                 self._cv_now = cross_validate(cal, self.current, self.cv_blocks)
             cv = (cv_score(self._cv_now, cal.floor, own),
                   cv_score(cross_validate(cal, full, self.cv_blocks), cal.floor, own))
-            from scipy.stats import norm
-
-            asked = cv_gain_asked(self.cv_gain, cal.prior_z(self.current), cal.prior_z(full),
-                                  float(norm.isf(self.alpha / 2)))
+            asked = cv_gain_asked(self.cv_gain, self.z0, cal.prior_z(full),
+                                  implausible_z(self.alpha))
             ok = cv[1] <= (1.0 - asked) * cv[0]
         return ok, x0, x1, why, bound, cv
 

@@ -810,6 +810,12 @@ def report_summary_text(rep: FitReport) -> str:
     return "\n".join(lines)
 
 
+def named_effects(doc: dict) -> list[str]:
+    """The effects a report's ``to_dict()`` names, a lag with its channel (``sensor_lag(T1)``)."""
+    return [e["name"] + (f"({e['parameters']['channel']})" if e["name"] == "sensor_lag"
+                         and e["parameters"].get("channel") else "") for e in doc["effects"]]
+
+
 def selection_trace(doc: dict, event_fields: Sequence[str] = ("estimate", "se", "z",
                                                               "p_value", "material")) -> dict:
     """What a benchmark keeps of a report's ``to_dict()`` to see why an effect was named or
