@@ -440,13 +440,21 @@ class ThermalModel:
             if n1 not in K_cache:
                 K_cache[n1] = op.K(n1)
             K1 = K_cache[n1]
-            F1 = op.F(case, t1, n1)
+            # the inputs held over the step (a 'previous' series, a bench's interval means)
+            # are read as the step's own values: at t1 from the left, at t0 from the right.
+            # Read at t1 itself, a held input switching there would already act over this
+            # step, a lead of one step (60 s on a bench grid: 4 K at the stator at a speed
+            # step, docs/fit.md); a continuous input is the same either way
+            t1_in, t0_in = t1 - 1e-9 * dt, t0 + 1e-9 * dt
+            F1 = op.F(case, t1_in, n1)
+            if theta < 1.0:
+                F0, q_in0 = op.F(case, t0_in, n0), op.heat_in_W(case, t0_in)
             lu = self._factor(lambda dt=dt, K1=K1: op.M / dt + theta * K1,
                               ("step", round(dt, 9), n1, theta))
             rhs = op.M @ T / dt + theta * F1 + (1 - theta) * (F0 - K0 @ T)
             T_new = lu.solve(rhs)
-            q_in1 = op.heat_in_W(case, t1)
-            q_out1 = sum(op.heat_out_W(T_new, case, t1, n1).values())
+            q_in1 = op.heat_in_W(case, t1_in)
+            q_out1 = sum(op.heat_out_W(T_new, case, t1_in, n1).values())
             # heat flows of the same theta-weighting as the scheme: the balance is exact
             E_in += dt * (theta * q_in1 + (1 - theta) * q_in0)
             # the explicit part acts with the previous step's operator, hence q_out0

@@ -237,12 +237,18 @@ def test_fit_model_fem_end_to_end(setup, tmp_path):
     assert doc["fem_anchor"]["prior_centre"] == {k: p.default
                                                  for k, p in base_params(DRIVE).items()}
     # the priors around 1 pull back (h_air: 1 sd = 0.35 in ln, the truth 2.0 sd away; 6 h on
-    # a 600 s grid): seeds 1 and 2 gave h_air 1.89 and 1.68, f0 0.398 and 0.395; since the
-    # stator contact became a base parameter (issue 13) seed 1 gives h_air 1.59 (part of the
-    # air side's heat now goes by the stator path's freedom), so 25 % and 5 %. The lumped
+    # a 600 s grid, 36 points). Measured since the FEM reads a held input over its own step
+    # (it acted one step, here 600 s, early before; docs/fit.md, *Input timing*): seeds 1
+    # and 2 give h_air 1.39 and 1.03, f0 0.371 and 0.361 (before: 1.59-1.89, 0.395-0.398).
+    # On seed 1 the estimate's log-likelihood is above the truth's own (315.3 against
+    # 312.1): it is what these points say, not a fit stopped early. Asserted: h_air moved
+    # from the prior's centre towards the truth by at least half a prior sd (0.17 in ln),
+    # the truth lies inside the run's own 95 % interval, and f0 is within 10 %. The lumped
     # path is further from the truth on the same data (asserted below)
-    assert before["h_air"] == pytest.approx(2.0, rel=0.25)
-    assert before["f0"] == pytest.approx(0.4, rel=0.05)
+    ci = {p["name"]: p["ci95"] for p in doc["parameters_before"]}
+    assert np.log(before["h_air"]) > 0.5 * 0.35
+    assert ci["h_air"][0] <= 2.0 <= ci["h_air"][1], ci["h_air"]
+    assert before["f0"] == pytest.approx(0.4, rel=0.10)
     # the anchored lumped model at the calibrated point is the FEM there
     gb = GreyBox(spec, DRIVE, rep.inputs, discrepancy=rep.anchor.offsets)
     _close(gb.simulate(before), FemGreyBox(spec, DRIVE, rep.inputs).simulate(before),

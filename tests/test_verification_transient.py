@@ -117,3 +117,40 @@ def test_spl2782_steady_energy_balance_and_residual():
     assert res.energy["heat_in_W"] == pytest.approx(sum(h.power_W(0) for h in spec.heat_sources),
                                                     rel=1e-12)
     assert res.energy["heat_in_W"] == pytest.approx(5146.0, abs=0.7)
+
+
+@pytest.mark.parametrize("theta", [1.0, 0.5])
+def test_a_held_input_switching_at_a_step_end_acts_from_there_on(spec_from, theta):
+    """A held ('previous') source that switches on at a grid time t acts from t on, never over
+    the step that ends there (a zero-order hold of the step's own value, as the lumped model
+    integrates it). Read at the step's end instead, every switch acted one step early: on a
+    bench's 60 s grid that put the stator 4 K ahead of the data at a speed step
+    (docs/fit.md). Up to t the run equals the one without the source (to round-off); the
+    step after t warms by about q dt / C."""
+    dt, t_on, q = 10.0, 50.0, 1.0  # s, s, W (TAU is 333 s)
+
+    def run(source: TimeSeries):
+        case = LoadCase("switch", TimeSeries.constant(0.0), TimeSeries.constant(300.0),
+                        TimeSeries.constant(300.0), {"heat": source}, duration_s=10 * dt)
+        return model.solve_transient(case, dt, theta=theta, T0=300.0)
+
+    heat_spec = spec_from(LUMP + HEAT_SOURCE, "lump")
+    model = ThermalModel(build_mesh(heat_spec, 0), 1)
+    on = run(TimeSeries((0.0, t_on), (0.0, q), "previous"))
+    off = run(TimeSeries.constant(0.0))
+    k = int(np.argmin(np.abs(on.times_s - t_on)))
+    assert on.times_s[k] == pytest.approx(t_on)
+    np.testing.assert_allclose(on.sensor("centre")[:k + 1], off.sensor("centre")[:k + 1],
+                               atol=1e-9)
+    C = RHOC * math.pi * R**2 * L
+    rise = on.sensor("centre")[k + 1] - off.sensor("centre")[k + 1]
+    # the first step after t: q dt / C less what the film and (CN) the scheme take, < 10 %
+    assert 0.9 * q * dt / C < rise < q * dt / C * (1.0 if theta == 1.0 else 1.01), rise
+
+
+HEAT_SOURCE = """
+[[heat_sources]]
+name = "heat"
+part = "body"
+power_W = 0.0
+"""

@@ -86,7 +86,7 @@ def greybox_inputs(run: BenchRun, grid_s: float = 60.0) -> Inputs:
         ok = ~np.isnan(y)
         return run.time_s[ok], y[ok]
 
-    speed = settled_speed(held(*valid("speed_rpm"), grid[:-1]))
+    speed = settled_speed(held(*valid("speed_rpm"), mids))
     power = cell_means(*valid("power_kW"), grid, mids)
     torque = cell_means(*valid("load_torque_Nm"), grid, mids) if run.load_torque_measured \
         else np.zeros(len(mids))
@@ -230,6 +230,8 @@ class BaseCalibration:
     spec_values: dict[str, float]
     anchor: object | None = None
     fem_calibration: dict | None = None
+    #: compare.fit.gaps.GapSwitch per logging gap with an operating change inside
+    gap_switches: list = field(default_factory=list)
 
 
 def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, nodes: int = 11,
@@ -267,6 +269,8 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                          "add [power_balance] preset to the spec")
     inputs = greybox_inputs(run, grid_s)
     measured = _measured(run, channels, inputs.grid_s, fit_fraction, blocks)
+    inputs, switches = _place_gap_switches(run, spec, drive, inputs, measured, channels, nodes,
+                                           tuple(base_extra), say)
     cal = Calibrator(GreyBox(spec, drive, inputs, nodes, base_extra=tuple(base_extra)),
                      measured, channels, progress=say)
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
@@ -289,7 +293,40 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         say("calibrating the base model")
         _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref}, start=start)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
-                           fem_cal_info)
+                           fem_cal_info, switches)
+
+
+def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measured: Measured,
+                        channels: list[str], nodes: int, base_extra: tuple[str, ...],
+                        say: Callable[[str], None]) -> tuple[Inputs, list]:
+    """compare.fit.gaps.place_switches with the spec model's misfit over the hour after each
+    gap (the lumped grey box at the spec's values, no anchor: it runs before the FEM)."""
+    from compare.fit.gaps import JUDGE_S, gaps_with_change, place_switches
+
+    def valid(col: str) -> tuple[np.ndarray, np.ndarray]:
+        y = run.columns[col]
+        ok = ~np.isnan(y)
+        return run.time_s[ok], y[ok]
+
+    t_n, n = valid("speed_rpm")
+    if not gaps_with_change(t_n, n, inputs.grid_s):
+        return inputs, []
+    say("placing the operating change inside a logging gap")
+    cache: dict = {}
+
+    def misfit(trial: Inputs, end_s: float) -> float:
+        for k in [k for k in cache if isinstance(k, tuple) and k[:1] == ("src",)]:
+            del cache[k]  # the heat sources depend on the inputs, the network does not
+        gb = GreyBox(spec, drive, trial, nodes, base_extra=base_extra, _cache=cache)
+        y = gb.simulate(default_theta(gb.parameters()))
+        window = (trial.grid_s >= end_s) & (trial.grid_s <= end_s + JUDGE_S)
+        total = 0.0
+        for c in channels:
+            r = (measured.values[c][window] - y[c][window]) / TOLERANCE[c]
+            total += float(np.nansum(r * r))
+        return total
+
+    return place_switches(inputs, t_n, n, *valid("power_kW"), misfit)
 
 
 def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
@@ -376,6 +413,10 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     adequacy["verdict"] = verdict_text(adequacy, adequacy_final, list(final.effects))
     warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
                                    measured.fit_points())
+    warns += [f"the speed changed from {g.speed_before_rpm:.0f} to {g.speed_after_rpm:.0f} rpm "
+              f"inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} h); the change "
+              f"is placed at {g.switch_s / 3600:.2f} h, where the spec's model fits the hour "
+              "after the gap best (compare.fit.gaps)" for g in prep.gap_switches]
     cv = {}
     if cv_blocks:
         say(f"cross-validating over {cv_blocks} blocks")

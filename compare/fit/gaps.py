@@ -1,0 +1,101 @@
+"""Logging gaps with an operating change inside: when did the spindle switch?
+
+A bench that stops logging for a while (a 20 min gap in ``synth``'s runs, 9 min in a peer's)
+may come back at another speed. The inputs then say nothing about when it changed, and a
+zero-order hold of the last speed puts the change at the gap's end: up to the whole gap late.
+On a 6000 -> 1600 rpm change in a 20 min gap that left the stator 10 K, the rings 1.5 K off
+the data right after the gap and pulled the calibrated jacket film to its bound (docs/fit.md).
+
+The switch time is a nuisance parameter of the inputs, so it is estimated like one: for each
+such gap, every grid point inside it is tried as the switch (the old speed and power before,
+the new after), the lumped grey box is simulated at the spec's values, and the time that fits
+the measured channels best over the hour after the gap (sum of squares in tolerance units)
+is taken. The fast channels (the stator, the rings) pin it to about a grid step. This runs
+before the FEM anchor is solved, so the anchor and the fit see the same inputs. Units: s, rpm,
+kW.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from compare.fit.greybox import Inputs
+
+#: a gap is a stretch without a speed sample longer than this many grid steps
+MIN_GAP_STEPS = 2.0
+#: the window after a gap [s] whose fit decides the switch time
+JUDGE_S = 3600.0
+#: the window [s] over which the power before and after a gap is averaged
+LEVEL_S = 300.0
+
+
+@dataclass(frozen=True)
+class GapSwitch:
+    """A gap with an operating change and the switch time chosen inside it [s, rpm]."""
+
+    start_s: float
+    end_s: float
+    speed_before_rpm: float
+    speed_after_rpm: float
+    switch_s: float
+
+    def to_dict(self) -> dict:
+        return {"gap_start_s": self.start_s, "gap_end_s": self.end_s,
+                "speed_before_rpm": self.speed_before_rpm,
+                "speed_after_rpm": self.speed_after_rpm, "switch_s": self.switch_s}
+
+
+def gaps_with_change(t_speed_s: np.ndarray, speed_rpm: np.ndarray, grid_s: np.ndarray,
+                     band_rpm: float = 20.0, band_rel: float = 0.01
+                     ) -> list[tuple[float, float, float, float]]:
+    """(start, end, speed before, speed after) of each stretch without a speed sample longer
+    than MIN_GAP_STEPS grid steps across which the speed changed beyond the drive's scatter
+    band (max(``band_rpm``, ``band_rel`` x speed))."""
+    step = float(np.median(np.diff(grid_s)))
+    out = []
+    for i in np.where(np.diff(t_speed_s) > MIN_GAP_STEPS * step)[0]:
+        a, b = float(speed_rpm[i]), float(speed_rpm[i + 1])
+        if abs(b - a) > max(band_rpm, band_rel * max(abs(a), abs(b))):
+            out.append((float(t_speed_s[i]), float(t_speed_s[i + 1]), a, b))
+    return out
+
+
+def _level(t_s: np.ndarray, y: np.ndarray, t0: float, t1: float) -> float:
+    m = (t_s >= t0) & (t_s <= t1) & np.isfinite(y)
+    return float(np.mean(y[m])) if m.any() else float("nan")
+
+
+def place_switches(inputs: Inputs, t_speed_s: np.ndarray, speed_rpm: np.ndarray,
+                   t_power_s: np.ndarray, power_kW: np.ndarray,
+                   misfit: Callable[[Inputs, float], float]
+                   ) -> tuple[Inputs, list[GapSwitch]]:
+    """``inputs`` with the speed and power inside each gap with a change set to the old
+    operating point up to the best switch time and the new one after it, and the switches.
+    ``misfit(inputs, gap_end_s)``: the spec model's misfit to the measured channels over
+    the window after the gap for these inputs (compare.fit.run builds it)."""
+    grid = inputs.grid_s
+    switches = []
+    for start, end, before, after in gaps_with_change(t_speed_s, speed_rpm, grid):
+        # the grid intervals the gap touches; the switch falls on one of their edges
+        inside = np.where((grid[1:] > start) & (grid[:-1] < end))[0]
+        if len(inside) == 0:
+            continue
+        p_before = _level(t_power_s, power_kW, start - LEVEL_S, start)
+        p_after = _level(t_power_s, power_kW, end, end + LEVEL_S)
+        best = None
+        for s in range(int(inside[0]), int(inside[-1]) + 2):
+            speed, power = inputs.speed_rpm.copy(), inputs.power_kW.copy()
+            old, new = inside[inside < s], inside[inside >= s]
+            speed[old], speed[new] = before, after
+            if np.isfinite(p_before) and np.isfinite(p_after):
+                power[old], power[new] = p_before, p_after
+            trial = replace(inputs, speed_rpm=speed, power_kW=power)
+            cost = misfit(trial, end)
+            if best is None or cost < best[0]:
+                best = (cost, trial, float(grid[s]) if s < len(grid) else float(grid[-1]))
+        inputs = best[1]
+        switches.append(GapSwitch(start, end, before, after, best[2]))
+    return inputs, switches

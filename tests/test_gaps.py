@@ -1,0 +1,58 @@
+"""Operating changes inside logging gaps (compare/fit/gaps.py): found, and the switch time
+recovered from the channels after the gap."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from compare.fit.gaps import gaps_with_change, place_switches
+from compare.fit.greybox import GreyBox, inputs_from_cycle
+from spindle.cycles import load_cycle
+from spindle.drive import DRIVES
+from spindle.spec import load_spec
+
+
+def test_only_gaps_with_a_change_beyond_the_drive_scatter_count():
+    grid = np.arange(0.0, 4000.0, 60.0)
+    t = np.array([0.0, 10.0, 20.0, 1220.0, 1230.0, 2000.0, 3300.0])
+    n = np.array([2000.0, 2000.0, 2000.0, 2005.0, 2005.0, 2005.0, 4000.0])
+    # 20 -> 1220 s: no change beyond 20 rpm; 1230 -> 2000 s: no change; 2000 -> 3300 s: one
+    assert gaps_with_change(t, n, grid) == [(2000.0, 3300.0, 2005.0, 4000.0)]
+    # a change between samples closer than two grid steps is a logged change, not a gap
+    assert gaps_with_change(np.array([0.0, 100.0]), np.array([1000.0, 3000.0]), grid) == []
+
+
+@pytest.mark.parametrize("true_switch_s", [5400.0 + 300.0, 5400.0 + 900.0])
+def test_the_switch_time_is_recovered_from_the_hour_after_the_gap(true_switch_s):
+    """The lumped model's own run of spl-16h's first two steps (1000 -> 2000 rpm) with the
+    change moved to ``true_switch_s`` inside a 20 min gap (5400-6600 s), read back as a bench
+    export would give it (the old speed held to the gap's end): the switch that fits the
+    hour after the gap best is the true one, to the grid step (60 s)."""
+    spec = load_spec("spl2782")
+    cycle = load_cycle("spl-16h")
+    grid = np.arange(0.0, 4 * 3600.0 + 1.0, 60.0)
+    truth = inputs_from_cycle(cycle, grid)
+    starts = grid[:-1]
+    speed = np.where(starts < true_switch_s, 1000.0, 2000.0)
+    truth = replace(truth, speed_rpm=speed[: len(truth.speed_rpm)])
+    gb = GreyBox(spec, DRIVES["spl2782"], truth)
+    measured = gb.simulate({})
+    gap = (5400.0, 6600.0)
+    logged = replace(truth, speed_rpm=np.where(starts < gap[1], 1000.0, 2000.0))
+    t_speed = np.concatenate([np.arange(0.0, gap[0] + 1, 10.0),
+                              np.arange(gap[1], grid[-1] + 1, 10.0)])
+    n_speed = np.where(t_speed < true_switch_s, 1000.0, 2000.0)
+    tried = []
+
+    def misfit(trial, end_s):
+        y = GreyBox(spec, DRIVES["spl2782"], trial).simulate({})
+        w = (grid >= end_s) & (grid <= end_s + 3600.0)
+        tried.append(float(np.sum((y["T_stator"][w] - measured["T_stator"][w]) ** 2)))
+        return tried[-1]
+
+    placed, switches = place_switches(logged, t_speed, n_speed, t_speed,
+                                      np.full(len(t_speed), np.nan), misfit)
+    assert len(switches) == 1 and len(tried) == 21  # 20 intervals in the gap, and none
+    assert switches[0].switch_s == pytest.approx(true_switch_s, abs=60.0)
+    np.testing.assert_array_equal(placed.speed_rpm, truth.speed_rpm)
