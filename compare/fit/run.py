@@ -864,7 +864,8 @@ def selection_trace(doc: dict, event_fields: Sequence[str] = ("estimate", "se", 
     (gains, validation and cross-validated excess before/after, need, verdict) and the
     calibrated parameters."""
     keys = ("effect", "channel", "round", "gain", "excess_before", "excess_after",
-            "cv_before", "cv_after", "judged_on", "needed_by", "qualifies", "accepted")
+            "cv_before", "cv_after", "peak_effect", "judged_on", "needed_by", "qualifies",
+            "accepted")
     return {"events": {k: {f: v.get(f) for f in event_fields}
                        for k, v in doc.get("events", {}).items()},
             "tried": [{k: c.get(k) for k in keys}
