@@ -18,9 +18,19 @@ def test_only_gaps_with_a_change_beyond_the_drive_scatter_count():
     t = np.array([0.0, 10.0, 20.0, 1220.0, 1230.0, 2000.0, 3300.0])
     n = np.array([2000.0, 2000.0, 2000.0, 2005.0, 2005.0, 2005.0, 4000.0])
     # 20 -> 1220 s: no change beyond 20 rpm; 1230 -> 2000 s: no change; 2000 -> 3300 s: one
-    assert gaps_with_change(t, n, grid) == [(2000.0, 3300.0, 2005.0, 4000.0)]
-    # a change between samples closer than two grid steps is a logged change, not a gap
-    assert gaps_with_change(np.array([0.0, 100.0]), np.array([1000.0, 3000.0]), grid) == []
+    assert gaps_with_change(t, t, n, grid) == [(2000.0, 3300.0, 2005.0, 4000.0)]
+    # a change between rows closer than two grid steps is a logged change, not a gap
+    assert gaps_with_change(np.array([0.0, 100.0]), np.array([0.0, 100.0]),
+                            np.array([1000.0, 3000.0]), grid) == []
+
+
+def test_a_speed_logged_on_change_has_no_gap():
+    """Rows every 10 s, the speed only where it changes (empty cells between): the change is
+    at the row that logs it, not somewhere inside a gap."""
+    grid = np.arange(0.0, 4000.0, 60.0)
+    rows = np.arange(0.0, 4000.0, 10.0)
+    assert gaps_with_change(rows, np.array([0.0, 1800.0]), np.array([1000.0, 3000.0]),
+                            grid) == []
 
 
 @pytest.mark.parametrize("true_switch_s", [5400.0 + 300.0, 5400.0 + 900.0])
@@ -51,7 +61,7 @@ def test_the_switch_time_is_recovered_from_the_hour_after_the_gap(true_switch_s)
         tried.append(float(np.sum((y["T_stator"][w] - measured["T_stator"][w]) ** 2)))
         return tried[-1]
 
-    placed, switches = place_switches(logged, t_speed, n_speed, t_speed,
+    placed, switches = place_switches(logged, t_speed, t_speed, n_speed, t_speed,
                                       np.full(len(t_speed), np.nan), misfit)
     assert len(switches) == 1 and len(tried) == 21  # 20 intervals in the gap, and none
     assert switches[0].switch_s == pytest.approx(true_switch_s, abs=60.0)

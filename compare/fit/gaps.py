@@ -48,18 +48,27 @@ class GapSwitch:
                 "speed_after_rpm": self.speed_after_rpm, "switch_s": self.switch_s}
 
 
-def gaps_with_change(t_speed_s: np.ndarray, speed_rpm: np.ndarray, grid_s: np.ndarray,
-                     band_rpm: float = 20.0, band_rel: float = 0.01
+def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.ndarray,
+                     grid_s: np.ndarray, band_rpm: float = 20.0, band_rel: float = 0.01
                      ) -> list[tuple[float, float, float, float]]:
-    """(start, end, speed before, speed after) of each stretch without a speed sample longer
-    than MIN_GAP_STEPS grid steps across which the speed changed beyond the drive's scatter
-    band (max(``band_rpm``, ``band_rel`` x speed))."""
+    """(start, end, speed before, speed after) of each stretch without any row (``t_rows_s``,
+    every row's time) longer than MIN_GAP_STEPS grid steps across which the speed changed
+    beyond the drive's scatter band (max(``band_rpm``, ``band_rel`` x speed)). The speed
+    before is the last valid sample at or before the gap, after it the first one at or after
+    its end (``t_speed_s``, ``speed_rpm``: the valid speed samples). A speed logged only on
+    change (empty cells between changes, rows going on) has no gap: its change is at the
+    sample that logs it."""
     step = float(np.median(np.diff(grid_s)))
     out = []
-    for i in np.where(np.diff(t_speed_s) > MIN_GAP_STEPS * step)[0]:
-        a, b = float(speed_rpm[i]), float(speed_rpm[i + 1])
+    for i in np.where(np.diff(t_rows_s) > MIN_GAP_STEPS * step)[0]:
+        start, end = float(t_rows_s[i]), float(t_rows_s[i + 1])
+        k = int(np.searchsorted(t_speed_s, start, side="right")) - 1
+        j = int(np.searchsorted(t_speed_s, end, side="left"))
+        if k < 0 or j >= len(t_speed_s):
+            continue
+        a, b = float(speed_rpm[k]), float(speed_rpm[j])
         if abs(b - a) > max(band_rpm, band_rel * max(abs(a), abs(b))):
-            out.append((float(t_speed_s[i]), float(t_speed_s[i + 1]), a, b))
+            out.append((start, end, a, b))
     return out
 
 
@@ -68,8 +77,8 @@ def _level(t_s: np.ndarray, y: np.ndarray, t0: float, t1: float) -> float:
     return float(np.mean(y[m])) if m.any() else float("nan")
 
 
-def place_switches(inputs: Inputs, t_speed_s: np.ndarray, speed_rpm: np.ndarray,
-                   t_power_s: np.ndarray, power_kW: np.ndarray,
+def place_switches(inputs: Inputs, t_rows_s: np.ndarray, t_speed_s: np.ndarray,
+                   speed_rpm: np.ndarray, t_power_s: np.ndarray, power_kW: np.ndarray,
                    misfit: Callable[[Inputs, float], float]
                    ) -> tuple[Inputs, list[GapSwitch]]:
     """``inputs`` with the speed and power inside each gap with a change set to the old
@@ -78,7 +87,7 @@ def place_switches(inputs: Inputs, t_speed_s: np.ndarray, speed_rpm: np.ndarray,
     the window after the gap for these inputs (compare.fit.run builds it)."""
     grid = inputs.grid_s
     switches = []
-    for start, end, before, after in gaps_with_change(t_speed_s, speed_rpm, grid):
+    for start, end, before, after in gaps_with_change(t_rows_s, t_speed_s, speed_rpm, grid):
         # the grid intervals the gap touches; the switch falls on one of their edges
         inside = np.where((grid[1:] > start) & (grid[:-1] < end))[0]
         if len(inside) == 0:

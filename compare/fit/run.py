@@ -309,7 +309,7 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
         return run.time_s[ok], y[ok]
 
     t_n, n = valid("speed_rpm")
-    if not gaps_with_change(t_n, n, inputs.grid_s):
+    if not gaps_with_change(run.time_s, t_n, n, inputs.grid_s):
         return inputs, []
     say("placing the operating change inside a logging gap")
     cache: dict = {}
@@ -326,7 +326,7 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
             total += float(np.nansum(r * r))
         return total
 
-    return place_switches(inputs, t_n, n, *valid("power_kW"), misfit)
+    return place_switches(inputs, run.time_s, t_n, n, *valid("power_kW"), misfit)
 
 
 def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,

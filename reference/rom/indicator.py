@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reference.rom.model import step_end_inputs
 from spindle.loads import LoadCase
 
 
@@ -40,7 +41,7 @@ class ResidualIndicator:
         sysr = rom.system
         mid = 0.5 * (grid[1:] + grid[:-1])
         speeds = np.asarray(case.speed_rpm(mid), dtype=float)
-        U = rom.inputs(case, grid[1:])
+        U = step_end_inputs(rom.inputs, case, grid)  # as the scheme reads them
         th = np.array([sysr.theta(float(n)) for n in speeds])  # (steps, terms)
         dz = (Z[1:] - Z[:-1]) / np.diff(grid)[:, None]
         ms = sysr.F_src.shape[1]

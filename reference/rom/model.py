@@ -100,6 +100,14 @@ class FullSystem:
         return case_inputs(case, t, self.source_names, self.source_defaults)
 
 
+def step_end_inputs(inputs: Callable, case: LoadCase, grid: np.ndarray) -> np.ndarray:
+    """u at the end of each step of ``grid`` read from the left (n_steps, n_u): a held input
+    switching at a step's end acts from there on, not over the step (as
+    :meth:`reference.thermal.ThermalModel.solve_transient` reads it); ``inputs(case, t)``."""
+    grid = np.asarray(grid, dtype=float)
+    return inputs(case, grid[1:] - 1e-9 * np.diff(grid))
+
+
 def case_inputs(case: LoadCase, t, source_names: Sequence[str], source_defaults: Sequence
                 ) -> np.ndarray:
     """u at times t [s] (n_t, n_sources + 2): each source's power [W] (the case's, else the
@@ -153,7 +161,8 @@ def fem_transient(full: FullSystem, case: LoadCase, dt_s: float, T0: float | Non
                   progress: Callable[[float], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Backward Euler of the full model on time_grid(case, dt_s), exactly the scheme of
     :meth:`reference.thermal.ThermalModel.solve_transient` (theta = 1, speed at mid-step,
-    load at the step's end), keeping only the outputs. Returns (times [s], Y (n_t, n_out))."""
+    load at the step's end read from the left: :func:`step_end_inputs`), keeping only the
+    outputs. Returns (times [s], Y (n_t, n_out))."""
     from reference.thermal import factorize
 
     grid = time_grid(case, dt_s)
@@ -162,7 +171,7 @@ def fem_transient(full: FullSystem, case: LoadCase, dt_s: float, T0: float | Non
     Y[0] = full.O @ T
     lus: dict[tuple, object] = {}
     Bs: dict[float, np.ndarray] = {}
-    U = full.inputs(case, grid)
+    U = step_end_inputs(full.inputs, case, grid)
     mid = 0.5 * (grid[1:] + grid[:-1])
     speeds = np.asarray(case.speed_rpm(mid), dtype=float)
     for k in range(1, len(grid)):
@@ -173,7 +182,7 @@ def fem_transient(full: FullSystem, case: LoadCase, dt_s: float, T0: float | Non
             lus[key] = factorize(full.M / dt + full.K(n))
         if n not in Bs:
             Bs[n] = full.B(n)
-        T = lus[key].solve(full.M @ T / dt + Bs[n] @ U[k])
+        T = lus[key].solve(full.M @ T / dt + Bs[n] @ U[k - 1])
         Y[k] = full.O @ T
         if progress is not None:
             progress(grid[k] / case.duration_s)
@@ -294,7 +303,7 @@ class ReducedSystem:
         Z = np.empty((len(grid), self.r))
         Z[0] = z0
         if method == "be":
-            U = full_inputs(case, grid)
+            U = step_end_inputs(full_inputs, case, grid)
             for k in range(1, len(grid)):
                 dt, n = grid[k] - grid[k - 1], float(speeds[k - 1])
                 key = ("be", round(dt, 9), n)
@@ -302,7 +311,7 @@ class ReducedSystem:
                     A = np.eye(self.r) / dt + self.K(n)
                     self._cache[key] = (sla.cho_factor(A), self.B(n))
                 cf, B = self._cache[key]
-                Z[k] = sla.cho_solve(cf, Z[k - 1] / dt + B @ U[k])
+                Z[k] = sla.cho_solve(cf, Z[k - 1] / dt + B @ U[k - 1])
             return grid, Z
         if method != "exact":
             raise ValueError(f"method must be 'be' or 'exact', not {method!r}")
