@@ -459,7 +459,8 @@ class ThermalModel:
             E_in += dt * (theta * q_in1 + (1 - theta) * q_in0)
             # the explicit part acts with the previous step's operator, hence q_out0
             E_out += dt * (theta * q_out1 + (1 - theta) * q_out0)
-            T, K0, F0, q_in0, q_out0, n0 = T_new, K1, op.F(case, t1, n1), q_in1, q_out1, n1
+            # F0 and q_in0 of the next step are read at its start when theta < 1
+            T, K0, q_in0, q_out0, n0 = T_new, K1, q_in1, q_out1, n1
             sensors[k] = P @ T
             fvals[k] = G @ T
             heat_in[k], heat_out[k] = q_in1, q_out1

@@ -23,8 +23,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from compare.fit.greybox import Inputs
+from spindle.bench import SPEED_BAND_REL, SPEED_BAND_RPM
 
-#: a gap is a stretch without a speed sample longer than this many grid steps
+#: a gap is a stretch without any row longer than this many grid steps
 MIN_GAP_STEPS = 2.0
 #: the window after a gap [s] whose fit decides the switch time
 JUDGE_S = 3600.0
@@ -42,14 +43,10 @@ class GapSwitch:
     speed_after_rpm: float
     switch_s: float
 
-    def to_dict(self) -> dict:
-        return {"gap_start_s": self.start_s, "gap_end_s": self.end_s,
-                "speed_before_rpm": self.speed_before_rpm,
-                "speed_after_rpm": self.speed_after_rpm, "switch_s": self.switch_s}
-
 
 def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.ndarray,
-                     grid_s: np.ndarray, band_rpm: float = 20.0, band_rel: float = 0.01
+                     grid_s: np.ndarray, band_rpm: float = SPEED_BAND_RPM,
+                     band_rel: float = SPEED_BAND_REL
                      ) -> list[tuple[float, float, float, float]]:
     """(start, end, speed before, speed after) of each stretch without any row (``t_rows_s``,
     every row's time) longer than MIN_GAP_STEPS grid steps across which the speed changed

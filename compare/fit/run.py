@@ -75,24 +75,26 @@ REPORT_FORMAT = "spindle-verify-fit/1"
 MATERIAL_RMS = 0.25
 
 
+def _valid_samples(run: BenchRun, col: str) -> tuple[np.ndarray, np.ndarray]:
+    """(times [s], values) of column ``col``'s non-empty cells."""
+    y = run.columns[col]
+    ok = ~np.isnan(y)
+    return run.time_s[ok], y[ok]
+
+
 def greybox_inputs(run: BenchRun, grid_s: float = 60.0) -> Inputs:
-    """Per-interval inputs of the grey box: speed held at the interval start, power, torque,
-    ambient and coolant averaged over the interval (spindle.bench's helpers)."""
+    """Per-interval inputs of the grey box: the speed logged at the interval's middle (a step
+    inside an interval is at most half an interval off), power, torque, ambient and coolant
+    averaged over the interval (spindle.bench's helpers)."""
     grid = bench_grid(run, grid_s)
     mids = 0.5 * (grid[:-1] + grid[1:])
-
-    def valid(col: str) -> tuple[np.ndarray, np.ndarray]:
-        y = run.columns[col]
-        ok = ~np.isnan(y)
-        return run.time_s[ok], y[ok]
-
-    speed = settled_speed(held(*valid("speed_rpm"), mids))
-    power = cell_means(*valid("power_kW"), grid, mids)
-    torque = cell_means(*valid("load_torque_Nm"), grid, mids) if run.load_torque_measured \
-        else np.zeros(len(mids))
-    T_env = cell_means(*valid("T_env_C"), grid, mids) + ZERO_C_K
-    T_cool = cell_means(*valid("T_coolant_C"), grid, mids) + ZERO_C_K
-    _, y_env = valid("T_env_C")
+    speed = settled_speed(held(*_valid_samples(run, "speed_rpm"), mids))
+    power = cell_means(*_valid_samples(run, "power_kW"), grid, mids)
+    torque = (cell_means(*_valid_samples(run, "load_torque_Nm"), grid, mids)
+              if run.load_torque_measured else np.zeros(len(mids)))
+    t_env, y_env = _valid_samples(run, "T_env_C")
+    T_env = cell_means(t_env, y_env, grid, mids) + ZERO_C_K
+    T_cool = cell_means(*_valid_samples(run, "T_coolant_C"), grid, mids) + ZERO_C_K
     return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + ZERO_C_K)
 
 
@@ -303,12 +305,7 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
     gap (the lumped grey box at the spec's values, no anchor: it runs before the FEM)."""
     from compare.fit.gaps import JUDGE_S, gaps_with_change, place_switches
 
-    def valid(col: str) -> tuple[np.ndarray, np.ndarray]:
-        y = run.columns[col]
-        ok = ~np.isnan(y)
-        return run.time_s[ok], y[ok]
-
-    t_n, n = valid("speed_rpm")
+    t_n, n = _valid_samples(run, "speed_rpm")
     if not gaps_with_change(run.time_s, t_n, n, inputs.grid_s):
         return inputs, []
     say("placing the operating change inside a logging gap")
@@ -326,7 +323,8 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
             total += float(np.nansum(r * r))
         return total
 
-    return place_switches(inputs, run.time_s, t_n, n, *valid("power_kW"), misfit)
+    return place_switches(inputs, run.time_s, t_n, n, *_valid_samples(run, "power_kW"),
+                          misfit)
 
 
 def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
