@@ -49,6 +49,25 @@ def test_a_path_the_spec_lacks_is_named_when_the_run_needs_it(G, named):
     assert ("bearing seats" in ad["statement"]) is named
 
 
+def test_a_parameter_on_its_bound_is_said_not_judged():
+    """axial_scale's range (0.8-1.25, +-1.5 prior sd) lies inside the prior's 1 % tails, so on
+    its bound it is not implausible; the statement still says it ran there and where to look,
+    and the verdict stays adequate. A parameter inside its range is not listed; one both
+    implausible and on its bound is said once, as implausible."""
+    spec = {**SPEC, "axial_scale": 1.0}
+    bounds = {"h_coolant": (0.2, 5.0), "f0": (0.05, 3.0), "axial_scale": (0.8, 1.25)}
+    ad = base_adequacy(_errors({"T1": (0.2, 0.3)}), {"h_coolant": 0.2, "f0": 0.3,
+                                                     "axial_scale": 0.8},
+                       spec, {"h_coolant": -6.4, "f0": 0.0, "axial_scale": -1.5}, bounds)
+    assert ad["at_bound"] == ["axial_scale"] and ad["implausible"] == ["h_coolant"]
+    assert "axial_scale ran to the bound of its range (0.8" in ad["statement"]
+    assert "axial dimensions" in ad["statement"] and ad["statement"].count("h_coolant") == 1
+    inside = base_adequacy(_errors({"T1": (0.2, 0.3)}), {"h_coolant": 1.0, "f0": 0.3,
+                                                         "axial_scale": 1.1},
+                           spec, {"h_coolant": 0.0, "f0": 0.0, "axial_scale": 0.6}, bounds)
+    assert inside["at_bound"] == [] and inside["adequate"]
+
+
 def test_no_priors_judges_the_channels_only():
     ad = base_adequacy(_errors({"T1": (0.3, 0.2)}), {"h_coolant": 50.0}, SPEC, None)
     assert ad["adequate"] and ad["moved"][0]["z"] is None

@@ -2,9 +2,12 @@
 matrix is benchmarks/bench_mismatch.py, 27 runs, docs/fit.md "The mismatch matrix"). Slow:
 each case synthesises a 16 h run on FEM level 1 or 2 (15-30 s) and fits it (10-25 s).
 
-Two cases of seed 1 on the random no-load cycle: the mount the plausibility rule of the
+Cases on the random no-load cycle: seed 1's mount, which the plausibility rule of the
 cross-validation guard was changed for (compare.fit.calibrate.cv_gain_asked; before it the
-run was left unnamed) and the clean run of the same spindle, where nothing may be named.
+run was left unnamed), and the clean run of the same spindle, where nothing may be named;
+seed 3's mount and seed 2's coolant warming, named only since the base calibrates the axial
+scale (compare.fit.greybox, axial_scale: these spindles are 12-15 % longer than the spec,
+and without it the jacket film went to its bound and took the effects up).
 The fast path (synth with mismatch, the rule itself) is in tests/test_mismatch.py and
 tests/test_greybox.py."""
 
@@ -14,16 +17,17 @@ import pytest
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("effect", "named"), [("mount_conduction", ["mount_conduction"]),
-                                                ("clean", [])])
-def test_fit_on_a_mismatched_run(tmp_path, effect, named):
+@pytest.mark.parametrize(("effect", "seed", "named"), [
+    ("mount_conduction", 1, ["mount_conduction"]), ("clean", 1, []),
+    ("mount_conduction", 3, ["mount_conduction"]), ("coolant_dynamics", 2, ["coolant_dynamics"])])
+def test_fit_on_a_mismatched_run(tmp_path, effect, seed, named):
     from compare.fit.run import run_fit
     from compare.fit.synth import synth
     from spindle.spec import load_spec
 
     spec = load_spec("spl2782")
     run = tmp_path / f"{effect}.csv"
-    synth(spec, "random", effect, 1, run, mismatch=True)
+    synth(spec, "random", effect, seed, run, mismatch=True)
     doc = run_fit(run, spec).to_dict()
     assert [e["name"] for e in doc["effects"]] == named
     for e in doc["effects"]:

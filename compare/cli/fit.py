@@ -109,7 +109,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     choices=(*EXTRA_BASE_PARAMS, "none"),
                     help="the extra base parameters to calibrate, for a spindle its spec "
                     "describes only approximately: G_seat_W_K (a conductance from the bearing "
-                    "rings to the coolant), heat_capacity (a factor on every heat capacity), "
+                    "rings to the coolant), axial_scale (every axial length times s), "
+                    "heat_capacity (a factor on every heat capacity), "
                     "friction_exponent (bearing friction times (n / 3000 rpm)^e), or none "
                     f"(default: {' '.join(DEFAULT_BASE_EXTRA)} with --model lumped; "
                     "docs/fit.md)")

@@ -48,21 +48,33 @@ WHERE_IN_SPEC = {
                   "film at the bearing bores: surfaces with T_ref = \"coolant\" there)",
     "heat_capacity": "the parts' volumes and materials (rho_kg_m3, c_J_kgK): the thermal mass "
                      "that takes part on the run's time scales",
+    "axial_scale": "the axial dimensions (the parts' sections z_start_m / z_end_m, the "
+                   "surfaces' z limits, the sensors' z): bearing spacing, motor and housing "
+                   "lengths",
 }
+
+#: a calibrated value within this fraction of its range's width from a bound is "at" it
+AT_BOUND_REL = 1e-3
 
 
 def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
                   theta: Mapping[str, float], spec_values: Mapping[str, float],
-                  prior_z: Mapping[str, float] | None) -> dict:
+                  prior_z: Mapping[str, float] | None,
+                  bounds: Mapping[str, tuple[float, float]] | None = None) -> dict:
     """The base-adequacy verdict of a calibrated base model.
 
     ``errors``: :meth:`compare.fit.calibrate.Calibrator.errors` of the base fit (per window
     and channel, with ``rmse_w``, the RMS in units of the channel's tolerance); ``theta`` its
     parameters; ``spec_values`` the spec's values (prior centres); ``prior_z`` the parameters'
-    distances from them in prior standard deviations (empty without priors).
+    distances from them in prior standard deviations (empty without priors); ``bounds`` the
+    parameters' ranges (lo, hi), to say which ran to a bound.
 
     Returns ``{"adequate": bool, "channels": {c: {window: rmse_w}}, "inadequate_channels":
-    [...], "moved": [{name, spec, calibrated, z}], "implausible": [...], "statement": str}``.
+    [...], "moved": [{name, spec, calibrated, z}], "implausible": [...], "at_bound": [...],
+    "missing_paths": [...], "statement": str}``. A parameter on a bound of its range that is
+    not implausible (a range inside the prior's 1 % tails, as axial_scale's) is said, not
+    judged: the run asked for more than the range allows, or the freedom took up another
+    misfit.
     A channel is inadequate when its open-loop RMS exceeds its tolerance on either window.
     The statement is a clause to follow a subject ("the base model ...").
     """
@@ -84,6 +96,12 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     # paths the spec lacks (no prior: the spec's value is 0) that the run needed
     missing = [k for k, floor in MISSING_PATH_W_K.items()
                if k in theta and float(theta[k]) > floor]
+    at_bound = []
+    for k, (lo, hi) in (bounds or {}).items():
+        if k in theta and k not in implausible and k in spec_values:
+            tol = AT_BOUND_REL * (hi - lo)
+            if float(theta[k]) <= lo + tol or float(theta[k]) >= hi - tol:
+                at_bound.append(k)
     worst: dict[str, tuple[str, float]] = {}
     for c, window, r in bad:
         if r > worst.get(c, ("", 0.0))[1]:
@@ -100,13 +118,18 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     adequate = not worst and not implausible
     statement = ("explains the run within the tolerances with every base parameter inside its "
                  "prior range" if adequate else "; ".join(parts))
+    if at_bound:
+        statement += ("; " + "; ".join(
+            f"{k} ran to the bound of its range ({theta[k]:.3g}, spec {spec_values[k]:.3g}): "
+            f"look at {WHERE_IN_SPEC.get(k, 'its value in the spec')}" for k in at_bound))
     if missing:  # the calibrated base has it; the spec does not: say so either way
         statement += ("; it needed a path the spec lacks: " + "; ".join(
             f"{k} = {theta[k]:.3g} (spec 0): look at {WHERE_IN_SPEC.get(k, 'the spec')}"
             for k in missing))
     return {"adequate": adequate, "channels": channels,
             "inadequate_channels": sorted(worst), "moved": moved,
-            "implausible": implausible, "missing_paths": missing, "statement": statement}
+            "implausible": implausible, "at_bound": at_bound, "missing_paths": missing,
+            "statement": statement}
 
 
 def extrapolation_warnings(grid_s: np.ndarray, speed_rpm: np.ndarray,

@@ -404,9 +404,11 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                 + " but within the tolerances on the validation window (model-form error "
                 "below the tolerances: the lumped model's sensitivities and the FEM level); no "
                 "effect is named for it")
+    ranges = {k: (p.lo, p.hi) for k, p in cal.gb.parameters().items()}
     adequacy = base_adequacy(sel.base.errors, sel.base.theta, spec_values,
-                             cal.prior_z(sel.base))
-    adequacy_final = base_adequacy(final.errors, final.theta, spec_values, cal.prior_z(final))
+                             cal.prior_z(sel.base), ranges)
+    adequacy_final = base_adequacy(final.errors, final.theta, spec_values, cal.prior_z(final),
+                                   ranges)
     adequacy["with_effects"] = adequacy_final
     adequacy["verdict"] = verdict_text(adequacy, adequacy_final, list(final.effects))
     warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
