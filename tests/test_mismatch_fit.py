@@ -29,6 +29,11 @@ def test_fit_on_a_mismatched_run(tmp_path, effect, seed, named):
     run = tmp_path / f"{effect}.csv"
     synth(spec, "random", effect, seed, run, mismatch=True)
     doc = run_fit(run, spec).to_dict()
+    if seed == 2:  # its 20 min logging gap holds the 3600 -> 2800 rpm change of 21 543 s:
+        # placed by the calibrated model within 3 grid steps (the spec's model alone: 243 s
+        # early on this cycle; docs/fit.md, *Input timing*)
+        assert [round(g["speed_after_rpm"]) for g in doc["gap_switches"]] == [2800]
+        assert abs(doc["gap_switches"][0]["switch_s"] - 21543.0) <= 180.0
     assert [e["name"] for e in doc["effects"]] == named
     for e in doc["effects"]:
         assert e["p_value"] < doc["alpha"] and e["needed_by"]
