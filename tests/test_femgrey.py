@@ -258,7 +258,12 @@ def test_fit_model_fem_end_to_end(setup, tmp_path):
     save_report(rep, tmp_path / "out", pictures=False)
     html = (tmp_path / "out" / "report.html").read_text()
     assert "Calibration model: <b>fem</b>" in html
-    lum = run_fit(run, spec, grid_s=600.0, candidates=["fixture_expansion"])
+    # like for like: the FEM path calibrates no base extras (--base-extra is refused with it),
+    # so neither does the lumped path here. With its default extras the lumped path has a
+    # freedom the FEM path lacks: the axial scale trades with h_air on these 36 points
+    # (h_air 1.50, measured 2026-11-26). Without extras: h_air 1.375, f0 0.355 against the
+    # FEM path's 1.389, 0.371
+    lum = run_fit(run, spec, grid_s=600.0, candidates=["fixture_expansion"], base_extra=())
     assert lum.to_dict()["calibration_model"] == "lumped"
     lum_before = {p["name"]: p["value"] for p in lum.to_dict()["parameters_before"]}
     for k, v in (("h_air", 2.0), ("f0", 0.4)):
