@@ -371,18 +371,21 @@ class GreyBox:
         the plain network lacks, effects' and seats', keep theirs)."""
         key = ("stretch", self.nodes, self.effects, self._seats)
         if key not in self._cache:
+            # the exponents belong to the plain network: read once per node count, shared by
+            # every effect set's structure
+            plain_key = ("stretch_exponents", self.nodes)
+            if plain_key not in self._cache:
+                self._cache[plain_key] = _stretch_exponents(self.spec, self.nodes)
             model = self._structure()[0]
             names = [e[3] for e in model.system.edges]
-            sides_edge, sides_cap = {}, {}
-            chain = {}
-            for longer, s in ((True, STRETCH_PROBE), (False, 1.0 / STRETCH_PROBE)):
-                ge, gc, gp = _stretch_exponents(self.spec, self.nodes, s)
-                sides_edge[longer] = np.array([ge.get(n, 0.0) for n in names])
-                sides_cap[longer] = np.array([
-                    max((gc.get(lab, 0.0) for lab in labs), key=abs, default=0.0)
-                    for labs in model.system.labels])
+            sides, chain = {}, {}
+            for longer, (ge, gc, gp) in self._cache[plain_key].items():
+                sides[longer] = (
+                    np.array([ge.get(n, 0.0) for n in names]),
+                    np.array([max((gc.get(lab, 0.0) for lab in labs), key=abs, default=0.0)
+                              for labs in model.system.labels]))
                 chain[longer] = gp
-            self._cache[key] = ({k: (sides_edge[k], sides_cap[k]) for k in sides_edge}, chain)
+            self._cache[key] = (sides, chain)
         return self._cache[key]
 
     def _p1(self, th: dict[str, float], growth_m: np.ndarray) -> np.ndarray:
@@ -436,23 +439,6 @@ class GreyBox:
 
         model, edge_group, preload, adv, mount, drag = self._structure()
         base = model.system
-        scale = theta.get("axial_scale", 1.0)
-        edge_exp, cap_exp = (self._stretch()[0][scale > 1.0] if scale != 1.0
-                             else (np.zeros(len(base.edges)), np.zeros(len(base.capacity))))
-        edges = []
-        for k, (i, j, G, name) in enumerate(base.edges):
-            g = edge_group[k]
-            factor = (theta[g] if g is not None else 1.0) * scale ** edge_exp[k]
-            if factor != 1.0:
-                G = _scaled(G, factor)
-            if k == adv:
-                R = theta.get("R_adv_K_W", 0.0)
-                G = 1.0 / R if R > 0 else 1e9  # R = 0: the films see the supply
-            if k == mount:
-                G = theta.get("G_mount_W_K", 0.0)
-            if name.startswith("seat:"):
-                G = theta.get("G_seat_W_K", 0.0)
-            edges.append((i, j, G, name))
         for f, name in preload:
             f.tc_1_K = theta.get(name, 0.0)
         rs = theta["rotor_share"]
@@ -472,6 +458,23 @@ class GreyBox:
             if len(systems) > 64:
                 for k in systems[:32]:
                     del self._cache[k]
+            scale = theta.get("axial_scale", 1.0)
+            edge_exp, cap_exp = (self._stretch()[0][scale > 1.0] if scale != 1.0
+                                 else (np.zeros(len(base.edges)), np.zeros(len(base.capacity))))
+            edges = []
+            for k, (i, j, G, name) in enumerate(base.edges):
+                g = edge_group[k]
+                factor = (theta[g] if g is not None else 1.0) * scale ** edge_exp[k]
+                if factor != 1.0:
+                    G = _scaled(G, factor)
+                if k == adv:
+                    R = theta.get("R_adv_K_W", 0.0)
+                    G = 1.0 / R if R > 0 else 1e9  # R = 0: the films see the supply
+                if k == mount:
+                    G = theta.get("G_mount_W_K", 0.0)
+                if name.startswith("seat:"):
+                    G = theta.get("G_seat_W_K", 0.0)
+                edges.append((i, j, G, name))
             system = dc_replace(base, edges=edges, _cache={},
                                 capacity=base.capacity * theta.get("heat_capacity", 1.0)
                                 * scale ** cap_exp)
@@ -559,44 +562,51 @@ STRETCH_PROBE = 1.2
 _STRETCH_RPM = 3000.0
 
 
-def _stretch_exponents(spec: Spec, nodes: int, factor: float
-                       ) -> tuple[dict[str, float], dict[str, float], float]:
-    """Exponents e, per edge name and per block label, with which the plain network's
-    conductances and capacities change from ``spec`` to ``spec`` stretched axially by
-    ``factor`` (value ratio = factor^e), and the P1 chain's (its largest row entry's)."""
+def _stretch_exponents(spec: Spec, nodes: int
+                       ) -> dict[bool, tuple[dict[str, float], dict[str, float], float]]:
+    """Per side of 1 (``True``: the spec stretched axially by ``STRETCH_PROBE``, ``False``: by
+    its inverse), the exponents e, per edge name and per block label, with which the plain
+    network's conductances and capacities change from ``spec`` to the stretched spec (value
+    ratio = factor^e), and the P1 chain's (its largest row entry's)."""
     from lumped.blocks import conductance_at
     from spindle.spec import stretch_axially
 
     def plain(sp: Spec) -> LumpedModel:
         return LumpedModel(sp, network=build_network(sp, nodes))
 
-    a, b = plain(spec), plain(stretch_axially(spec, factor))
-    ea, eb = a.system.edges, b.system.edges
+    a = plain(spec)
+    ea = a.system.edges
     names = [e[3] for e in ea]
-    if names != [e[3] for e in eb] or len(set(names)) != len(names):
-        from spindle.errors import InputError
+    out = {}
+    for longer, factor in ((True, STRETCH_PROBE), (False, 1.0 / STRETCH_PROBE)):
+        b = plain(stretch_axially(spec, factor))
+        eb = b.system.edges
+        if names != [e[3] for e in eb] or len(set(names)) != len(names):
+            from spindle.errors import InputError
 
-        raise InputError(str(spec.path), "axial_scale", "the lumped network's layout changes "
-                         f"when the spindle is stretched axially by {factor:g}, so its "
-                         "lengths cannot be scaled as one parameter",
-                         "leave axial_scale out: --base-extra G_seat_W_K")
-    log_f = np.log(factor)
-    edge = {}
-    for (_, _, Ga, name), (_, _, Gb, _) in zip(ea, eb, strict=True):
-        ga, gb = conductance_at(Ga, _STRETCH_RPM), conductance_at(Gb, _STRETCH_RPM)
-        edge[name] = float(np.log(gb / ga) / log_f) if ga > 0 and gb > 0 else 0.0
-    cap = {}
-    for labs, ca, cb in zip(a.system.labels, a.system.capacity, b.system.capacity,
-                            strict=True):
-        if ca > 0 and cb > 0:
-            for lab in labs:
-                cap[lab] = float(np.log(cb / ca) / log_f)
-    chain = 0.0
-    if "P1" in a.chain.rows:
-        ra, rb = a.chain.rows["P1"], b.chain.rows["P1"]
-        k = int(np.argmax(np.abs(ra)))
-        chain = float(np.log(rb[k] / ra[k]) / log_f) if ra[k] != 0 and rb[k] != 0 else 0.0
-    return edge, cap, chain
+            raise InputError(str(spec.path), "axial_scale", "the lumped network's layout "
+                             f"changes when the spindle is stretched axially by {factor:g}, "
+                             "so its lengths cannot be scaled as one parameter",
+                             "leave axial_scale out: --base-extra G_seat_W_K")
+        log_f = np.log(factor)
+        edge = {}
+        for (_, _, Ga, name), (_, _, Gb, _) in zip(ea, eb, strict=True):
+            ga, gb = conductance_at(Ga, _STRETCH_RPM), conductance_at(Gb, _STRETCH_RPM)
+            edge[name] = float(np.log(gb / ga) / log_f) if ga > 0 and gb > 0 else 0.0
+        cap = {}
+        for labs, ca, cb in zip(a.system.labels, a.system.capacity, b.system.capacity,
+                                strict=True):
+            if ca > 0 and cb > 0:
+                for lab in labs:
+                    cap[lab] = float(np.log(cb / ca) / log_f)
+        chain = 0.0
+        if "P1" in a.chain.rows:
+            ra, rb = a.chain.rows["P1"], b.chain.rows["P1"]
+            k = int(np.argmax(np.abs(ra)))
+            chain = (float(np.log(rb[k] / ra[k]) / log_f) if ra[k] != 0 and rb[k] != 0
+                     else 0.0)
+        out[longer] = (edge, cap, chain)
+    return out
 
 
 def windage_from_motor(sources_W: dict[str, np.ndarray], c_W_krpm3: float,

@@ -277,9 +277,23 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     measured = _measured(run, channels, held.grid_s, fit_fraction, blocks)
     inputs, switches = _place_gap_switches(run, spec, drive, held, measured, channels, nodes,
                                            tuple(base_extra), say)
-    cal = Calibrator(GreyBox(spec, drive, inputs, nodes, base_extra=tuple(base_extra)),
-                     measured, channels, progress=say)
+
+    def calibrator(on: Inputs) -> Calibrator:
+        return Calibrator(GreyBox(spec, drive, on, nodes, base_extra=tuple(base_extra)),
+                          measured, channels, progress=say)
+
+    cal = calibrator(inputs)
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
+
+    def anchored(cal: Calibrator, start: dict[str, float]) -> tuple[object, Fit]:
+        """The FEM anchor on ``cal``'s inputs, set on its grey box, and the base calibrated
+        with the priors from ``start``."""
+        say(f"solving the FEM reference (level {fem_level}) on this run's inputs")
+        anchor = fem_discrepancy(cal.gb, channels, fem_level)
+        cal.gb.discrepancy = anchor.offsets
+        say("calibrating the base model")
+        return anchor, cal.fit_with_prior({**spec_values, **anchor.theta_ref}, start=start)[1]
+
     anchor = None
     fem_cal_info = None
     # an extra whose spec value is its range's bound (a conductance the spec lacks) starts
@@ -293,11 +307,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     elif model == "fem":
         base, anchor, fem_cal_info = _calibrate_on_fem(cal, fem_level, say)
     else:
-        say(f"solving the FEM reference (level {fem_level}) on this run's inputs")
-        anchor = fem_discrepancy(cal.gb, channels, fem_level)
-        cal.gb.discrepancy = anchor.offsets
-        say("calibrating the base model")
-        _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref}, start=start)
+        anchor, base = anchored(cal, start)
         if switches:
             # placed by the spec's model, whose level on a spindle the spec only approximates
             # can be kelvins off after the gap and pull the switch to the gap's edge; placed
@@ -308,15 +318,8 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                                                cal.gb.discrepancy)
             if [m.switch_s for m in moved] != [w.switch_s for w in switches]:
                 inputs, switches = again, moved
-                cal = Calibrator(GreyBox(spec, drive, inputs, nodes,
-                                         base_extra=tuple(base_extra)),
-                                 measured, channels, progress=say)
-                say("solving the FEM reference again on the re-placed inputs")
-                anchor = fem_discrepancy(cal.gb, channels, fem_level)
-                cal.gb.discrepancy = anchor.offsets
-                say("calibrating the base model again")
-                _, base = cal.fit_with_prior({**spec_values, **anchor.theta_ref},
-                                             start=base.theta)
+                cal = calibrator(inputs)
+                anchor, base = anchored(cal, base.theta)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
                            fem_cal_info, switches)
 
