@@ -34,7 +34,10 @@ CASES = [
 ]
 KNOWN_MISSED = [
     ("dev-09", "sensor_lag", {"tau_s": 1200.0}, "T_stator",
-     "the model's own stator onset is not concave on the loaded run: untestable"),
+     "the model's own stator onset is not concave on the loaded run: untestable; the base "
+     "then calibrates far off (rotor_share 0.49, stator_contact and axial_scale at bounds) "
+     "and, with the friction exponent in the base, the load test names coolant_dynamics "
+     "(R 0.00083 K/W, 1.2 K at its peak) where before nothing was named"),
 ]
 
 
