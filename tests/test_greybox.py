@@ -214,6 +214,24 @@ def test_a_failing_refit_blocks_only_candidates_on_its_channels(refits, expected
     assert (chosen and chosen[2]) == expected
 
 
+@pytest.mark.parametrize("front, rear, named", [
+    # 95 % intervals of the front and rear coefficients [1/K]: the loop's preload must be
+    # carried by the rigidly preloaded front set (the peer's loaded control with a spec
+    # further off: front [0, 0.016], rear [0.016, 0.068], a misfit, not a preload)
+    ((0.0, 0.0156), (0.0161, 0.0684), False),
+    ((0.5, 1.4), (0.1, 0.6), True),  # the peer's preload run: front 0.96, rear 0.35
+    ((0.05, 0.4), (0.0, 0.3), True),  # the rear set floating: front alone
+    ((float("nan"), float("nan")), (0.1, 0.2), False),  # unresolved: not named
+])
+def test_a_preload_is_named_only_on_the_front_set(front, rear, named):
+    from compare.fit.calibrate import Fit, front_set_carries
+
+    fit = Fit(("bearing_preload",), None, {}, [], {"k_preload_1_K": front,
+              "k_preload_rear_1_K": rear}, np.eye(2), {}, 0.0, 1, 1.0, {}, {})
+    assert front_set_carries(fit, "bearing_preload") is named
+    assert front_set_carries(fit, "mount_conduction")  # no other effect is judged so
+
+
 def test_resample_leaves_gaps_empty():
     t = np.concatenate([np.arange(0, 600, 1.0), np.arange(1800, 2400, 1.0)])
     y = t * 0.01
