@@ -238,6 +238,9 @@ class BaseCalibration:
     fem_calibration: dict | None = None
     #: compare.fit.gaps.GapSwitch per logging gap with an operating change inside
     gap_switches: list = field(default_factory=list)
+    #: which model placed them: the calibrated, anchored one (the lumped path) or the spec's
+    #: (the FEM calibration and the unanchored path place them once, before calibrating)
+    switches_placed_by: str = "the spec's model"
 
 
 def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, nodes: int = 11,
@@ -296,6 +299,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
 
     anchor = None
     fem_cal_info = None
+    placed_by = "the spec's model"
     # an extra whose spec value is its range's bound (a conductance the spec lacks) starts
     # inside its range: a start on the bound can stall there
     params = cal.gb.parameters()
@@ -316,12 +320,13 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
             again, moved = _place_gap_switches(run, spec, drive, held, measured, channels,
                                                nodes, tuple(base_extra), say, base.theta,
                                                cal.gb.discrepancy)
+            placed_by = "the calibrated model"
             if [m.switch_s for m in moved] != [w.switch_s for w in switches]:
                 inputs, switches = again, moved
                 cal = calibrator(inputs)
                 anchor, base = anchored(cal, base.theta)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
-                           fem_cal_info, switches)
+                           fem_cal_info, switches, placed_by)
 
 
 def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measured: Measured,
@@ -445,8 +450,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                                    measured.fit_points())
     warns += [f"the speed changed from {g.speed_before_rpm:.0f} to {g.speed_after_rpm:.0f} rpm "
               f"inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} h); the change "
-              f"is placed at {g.switch_s / 3600:.2f} h, where the calibrated model fits the "
-              "hour after the gap best (compare.fit.gaps)" for g in prep.gap_switches]
+              f"is placed at {g.switch_s / 3600:.2f} h, where {prep.switches_placed_by} fits "
+              "the hour after the gap best (compare.fit.gaps)" for g in prep.gap_switches]
     cv = {}
     if cv_blocks:
         say(f"cross-validating over {cv_blocks} blocks")
