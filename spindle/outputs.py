@@ -5,12 +5,15 @@ half-written output; an output never replaces one of the run's inputs."""
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import math
 import os
 import re
 import shutil
+import sys
 import tempfile
+import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -61,15 +64,88 @@ def safe_name(name: str) -> str:
     return text[:100] or "unnamed"
 
 
-#: file in every output folder: it marks the folder as one spindle-verify wrote, so that a
-#: later run may replace it as a whole (a folder without it and not empty is refused)
+#: file in every output folder: the manifest of what spindle-verify wrote there (each file's
+#: path and SHA-256), so that a later run replaces only those and refuses anything else
 MARKER = ".spindle-verify"
+MANIFEST_FORMAT = "spindle-verify-outputs/1"
 
 
-def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Path:
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _manifest(folder: Path) -> dict[str, str]:
+    """What the marker of ``folder`` says the tool wrote (relative POSIX path -> SHA-256); empty
+    for a marker of an older version (plain text) or none."""
+    try:
+        data = json.loads((folder / MARKER).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return {}
+    files = data.get("files") if isinstance(data, dict) else None
+    return {str(k): str(v) for k, v in files.items()} if isinstance(files, dict) else {}
+
+
+def _write_manifest(folder: Path) -> None:
+    files = {}
+    for p in sorted(folder.rglob("*")):
+        rel = p.relative_to(folder).as_posix()
+        if p.is_file() and rel != MARKER:
+            files[rel] = _sha256(p)
+        elif p.is_dir() and not any(p.iterdir()):
+            files[rel + "/"] = "folder"
+    text = json.dumps({"format": MANIFEST_FORMAT, "written_by": "spindle-verify",
+                       "note": "the files the run wrote; the next run into this folder replaces "
+                               "these and refuses (or with --force moves aside) anything else",
+                       "files": files}, indent=1) + "\n"
+    (folder / MARKER).write_text(text, encoding="utf-8")
+
+
+def foreign_files(folder: str | Path) -> list[str]:
+    """The entries of ``folder`` that spindle-verify did not write there (relative paths,
+    sorted): files its manifest does not list, files edited since (another SHA-256), links,
+    and empty folders. A folder that does not exist holds none."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    known = _manifest(folder)
+    found = []
+    for p in sorted(folder.rglob("*")):
+        rel = p.relative_to(folder).as_posix()
+        if p.is_symlink() or (p.is_file() and rel != MARKER and known.get(rel) != _sha256(p)):
+            found.append(rel)
+        elif p.is_dir() and not any(p.iterdir()) and rel + "/" not in known:
+            found.append(rel + "/")
+        elif not p.is_dir() and not p.is_file():  # a socket, a fifo
+            found.append(rel)
+    return found
+
+
+def _list_some(names: Sequence[str], most: int = 5) -> str:
+    shown = ", ".join(names[:most])
+    return shown + (f" and {len(names) - most} more" if len(names) > most else "")
+
+
+def _refuse_foreign(path: Path, found: Sequence[str]) -> InputError:
+    edited = [n for n in found if n in _manifest(path)]
+    what = (f"holds {len(found)} file{'s' if len(found) > 1 else ''} spindle-verify did not "
+            f"write there ({_list_some(found)})")
+    if edited:
+        what += f"; {_list_some(edited)} {'was' if len(edited) == 1 else 'were'} edited since"
+    return InputError(str(path), "--out", what, "give a new or empty folder, move those files "
+                      "away, or add --force to have them moved aside into a sibling "
+                      f"'{path.name}.kept-<time>' folder (nothing is deleted)")
+
+
+def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
+                     force: bool = False) -> Path:
     """Refuse, before any work is done, an output folder that cannot be one: a file, an input,
-    a folder holding one of the inputs, a place that cannot be created or written, or a
-    folder with files that an earlier run did not write (no :data:`MARKER`)."""
+    a folder holding one of the inputs, a place that cannot be created or written, or (unless
+    ``force``) a folder holding anything spindle-verify did not write there
+    (:func:`foreign_files`)."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise InputError(str(path), "--out", "is a file, not a folder",
@@ -91,17 +167,15 @@ def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Pat
     if not os.access(base, os.W_OK | os.X_OK):
         raise InputError(str(path), "--out", f"cannot be written ({base} is not writable)",
                          "give a folder in a place you can write to")
-    if path.is_dir() and not (path / MARKER).exists() and any(path.iterdir()):
-        raise InputError(str(path), "--out", "holds files spindle-verify did not write (an "
-                         "output folder is replaced as a whole, and these would be lost)",
-                         "give a new or empty folder, or one an earlier spindle-verify run "
-                         "wrote")
     if path.is_dir():
         nested = next((q.parent for q in path.glob(f"*/**/{MARKER}")), None)
-        if nested is not None:
+        if nested is not None and not force:
             raise InputError(str(path), "--out", f"holds the output of another run "
-                             f"({nested.relative_to(path)}), which replacing it would delete",
+                             f"({nested.relative_to(path)}), which replacing it would move",
                              "give a folder of its own, e.g. a subfolder or a sibling")
+        found = foreign_files(path)
+        if found and not force:
+            raise _refuse_foreign(path, found)
     return path
 
 
@@ -126,12 +200,15 @@ def _clean_leftovers(parent: Path, name: str) -> None:
 
 
 @contextmanager
-def output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[Path]:
+def output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
+               force: bool = False) -> Iterator[Path]:
     """Yield a temporary folder to write into; on success it replaces ``path`` as a whole
     (an earlier run's folder is moved aside, the new one renamed into place, the old one
     removed), so the folder never mixes two runs' files and a failed run leaves the old one
-    as it was."""
-    path = check_output_dir(path, inputs)
+    as it was. Only what an earlier run wrote is ever removed: anything else in ``path`` is
+    refused (before the work and again at the replacement), or with ``force`` moved into a
+    sibling ``<name>.kept-<time>`` folder."""
+    path = check_output_dir(path, inputs, force)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -141,20 +218,45 @@ def output_dir(path: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[
     tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.tmp-{os.getpid()}-", dir=path.parent))
     try:
         yield tmp  # no input lies inside path (check_output_dir), so none is replaced
-        (tmp / MARKER).write_text("written by spindle-verify; the next run into this folder "
-                                  "replaces it as a whole\n", encoding="utf-8")
+        _write_manifest(tmp)
         os.chmod(tmp, 0o777 & ~_UMASK)  # mkdtemp makes 0700; outputs are ordinary folders
-        _replace_folder(tmp, path)
+        _replace_folder(tmp, path, force)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def _replace_folder(new: Path, path: Path) -> None:
-    """Rename ``new`` to ``path``; an existing ``path`` is first moved aside (restored if the
-    rename fails) and removed after."""
+def _keep_aside(path: Path, found: Sequence[str]) -> Path:
+    """Move the entries ``found`` of ``path`` into a new sibling ``<name>.kept-<time>``
+    folder, keeping their relative paths; say so on stderr."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    kept = path.parent / f"{path.name}.kept-{stamp}"
+    n = 1
+    while kept.exists():
+        n += 1
+        kept = path.parent / f"{path.name}.kept-{stamp}-{n}"
+    for rel in found:
+        src = path / rel.rstrip("/")
+        dst = kept / rel.rstrip("/")
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        os.rename(src, dst)
+    print(f"spindle-verify: moved {len(found)} entr{'ies' if len(found) > 1 else 'y'} it did "
+          f"not write from {path} into {kept} (--force): {_list_some(found)}", file=sys.stderr)
+    return kept
+
+
+def _replace_folder(new: Path, path: Path, force: bool = False) -> None:
+    """Rename ``new`` to ``path``. From an existing ``path`` what the user put there is first
+    moved into a sibling folder (:func:`_keep_aside`; only with ``force``, without it the run
+    is refused as before its work); the rest, all the tool's, is moved aside (restored if the
+    rename fails) and removed."""
     if not path.exists():
         os.rename(new, path)
         return
+    found = foreign_files(path)  # again: the user may have added files during the run
+    if found and not force:
+        raise _refuse_foreign(path, found)
+    if found:  # first, so that what is moved aside and removed below is only the tool's
+        _keep_aside(path, found)
     old = Path(tempfile.mkdtemp(prefix=f".{path.name}.old-{os.getpid()}-", dir=path.parent))
     os.rmdir(old)
     os.rename(path, old)

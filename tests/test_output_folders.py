@@ -1,6 +1,8 @@
-"""Output folders (issue 14): a run replaces its folder as a whole or leaves it as it was;
-a folder with files spindle-verify did not write is refused; a run killed by SIGTERM leaves
-nothing behind, one killed by SIGKILL leaves a hidden folder that the next run removes."""
+"""Output folders (issues 14, 31): a run replaces what an earlier run wrote or leaves it as it
+was; a folder holding anything spindle-verify did not write there (a file a user added, one of
+the tool's files the user edited) is refused with exit 2, and with ``--force`` those files are
+moved aside, never deleted; a run killed by SIGTERM leaves nothing behind, one killed by
+SIGKILL leaves a hidden folder that the next run removes."""
 
 from __future__ import annotations
 
@@ -52,10 +54,93 @@ def test_a_folder_with_foreign_files_is_refused_before_any_work(tmp_path):
     out = tmp_path / "mine"
     out.mkdir()
     (out / "thesis.tex").write_text("precious", encoding="utf-8")
-    with pytest.raises(InputError, match="did not write"), output_dir(out):
+    with pytest.raises(InputError, match="did not write.*thesis.tex"), output_dir(out):
         pytest.fail("the body must not run")
     assert (out / "thesis.tex").read_text(encoding="utf-8") == "precious"
     assert sorted(p.name for p in out.iterdir()) == ["thesis.tex"]
+
+
+def test_a_file_added_to_an_earlier_runs_folder_is_refused(tmp_path):
+    out = tmp_path / "res"
+    _write(out, "table.csv")
+    (out / "sub").mkdir()
+    (out / "sub" / "notes.txt").write_text("mine", encoding="utf-8")
+    with pytest.raises(InputError, match="sub/notes.txt") as err, output_dir(out):
+        pytest.fail("the body must not run")
+    assert "--force" in str(err.value)
+    assert (out / "sub" / "notes.txt").read_text(encoding="utf-8") == "mine"
+    assert (out / "table.csv").exists()
+
+
+def test_a_file_of_the_tools_edited_by_the_user_is_refused(tmp_path):
+    out = tmp_path / "res"
+    _write(out, "table.csv", "1,2")
+    (out / "table.csv").write_text("1,2 and my remark", encoding="utf-8")
+    with pytest.raises(InputError, match="table.csv was edited since"), output_dir(out):
+        pytest.fail("the body must not run")
+    assert (out / "table.csv").read_text(encoding="utf-8") == "1,2 and my remark"
+
+
+def test_force_moves_the_users_files_aside_and_deletes_none(tmp_path, capsys):
+    out = tmp_path / "res"
+    _write(out, "table.csv", "1,2")
+    (out / "table.csv").write_text("edited", encoding="utf-8")
+    (out / "sub").mkdir()
+    (out / "sub" / "notes.txt").write_text("mine", encoding="utf-8")
+    with output_dir(out, force=True) as tmp:
+        (tmp / "table.csv").write_text("3,4", encoding="utf-8")
+    kept = [p for p in tmp_path.iterdir() if p.name.startswith("res.kept-")]
+    assert len(kept) == 1, list(tmp_path.iterdir())
+    assert (kept[0] / "table.csv").read_text(encoding="utf-8") == "edited"
+    assert (kept[0] / "sub" / "notes.txt").read_text(encoding="utf-8") == "mine"
+    assert (out / "table.csv").read_text(encoding="utf-8") == "3,4"
+    assert not (out / "sub").exists()
+    assert str(kept[0]) in capsys.readouterr().err
+    assert _hidden(tmp_path) == []
+    _write(out, "table.csv", "5,6")  # the new folder is the tool's alone again: no --force
+
+
+def test_a_file_added_during_the_run_is_refused_at_the_replacement(tmp_path):
+    out = tmp_path / "res"
+    _write(out, "old.txt", "kept")
+    with pytest.raises(InputError, match="late.txt"), output_dir(out) as tmp:
+        (tmp / "new.txt").write_text("new", encoding="utf-8")
+        (out / "late.txt").write_text("mine", encoding="utf-8")
+    assert (out / "late.txt").read_text(encoding="utf-8") == "mine"
+    assert (out / "old.txt").read_text(encoding="utf-8") == "kept"
+    assert not (out / "new.txt").exists()
+    assert _hidden(tmp_path) == []
+
+
+def test_a_folder_of_an_older_version_without_a_manifest_is_refused(tmp_path):
+    """A plain-text marker lists nothing, so nothing in the folder is known to be the tool's."""
+    out = tmp_path / "res"
+    out.mkdir()
+    (out / MARKER).write_text("written by spindle-verify\n", encoding="utf-8")
+    (out / "table.csv").write_text("1,2", encoding="utf-8")
+    with pytest.raises(InputError, match="table.csv"), output_dir(out):
+        pytest.fail("the body must not run")
+
+
+def test_the_cli_refuses_a_users_file_with_exit_2_and_force_keeps_it(tmp_path):
+    """Issue 31's steps: a steady lumped solve, a note added to its folder, the same solve
+    again: exit 2 naming the note, which is still there; with --force it is moved aside."""
+    out = tmp_path / "dl" / "out"
+    cmd = [sys.executable, "-m", "compare.cli", "solve", "spl2782", "--model", "lumped",
+           "--nodes", "5", "--no-pictures", "--quiet", "--out", str(out)]
+    first = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    assert first.returncode == 0, first.stderr
+    (out / "notes.txt").write_text("notes\n", encoding="utf-8")
+    again = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    assert again.returncode == 2, again.stderr
+    assert "notes.txt" in again.stderr and "--out" in again.stderr
+    assert "Traceback" not in again.stderr
+    assert (out / "notes.txt").read_text(encoding="utf-8") == "notes\n"
+    forced = subprocess.run([*cmd, "--force"], cwd=ROOT, capture_output=True, text=True)
+    assert forced.returncode == 0, forced.stderr
+    kept = list((tmp_path / "dl").glob("out.kept-*/notes.txt"))
+    assert [k.read_text(encoding="utf-8") for k in kept] == ["notes\n"]
+    assert not (out / "notes.txt").exists()
 
 
 def test_an_empty_folder_is_accepted(tmp_path):
@@ -72,6 +157,10 @@ def test_a_folder_holding_another_runs_output_is_not_replaced(tmp_path):
     with pytest.raises(InputError, match="output of another run"), output_dir(outer):
         pytest.fail("the body must not run")
     assert (inner / "report.json").exists()
+    with output_dir(outer, force=True) as tmp:  # forced: the other run's folder moved aside
+        (tmp / "report.html").write_text("new", encoding="utf-8")
+    assert [p.relative_to(tmp_path).as_posix() for p in tmp_path.glob("study.kept-*/**/*.json")] \
+        == [f"{p.name}/fit-run/report.json" for p in tmp_path.glob("study.kept-*")]
 
 
 def test_the_default_output_folders_do_not_nest(capsys):

@@ -60,16 +60,23 @@ def add_spec(parser: argparse.ArgumentParser) -> None:
 
 def add_out(parser: argparse.ArgumentParser, default: str) -> None:
     """``--out``: the output folder, ``default`` as the help shows it (e.g. results/<spec>)."""
-    parser.add_argument("--out", help=f"output folder (default {default})")
+    parser.add_argument("--out", help=f"output folder (default {default}); a run replaces "
+                        "what an earlier run wrote there and refuses a folder holding anything "
+                        "else")
+    parser.add_argument("--force", action="store_true",
+                        help="write into an output folder that holds files spindle-verify did "
+                        "not write (or that were edited since): they are moved into a sibling "
+                        "'<folder>.kept-<time>' folder, never deleted")
 
 
-def out_folder(out: str | None, default: str, inputs: list) -> Path:
+def out_folder(out: str | None, default: str, inputs: list, force: bool = False) -> Path:
     """The output folder: ``out``, else ``default`` (a path under results/ whose spec and run
     names the caller made safe with :func:`spindle.outputs.safe_name`), checked before any
-    work (:func:`spindle.outputs.check_output_dir`)."""
+    work (:func:`spindle.outputs.check_output_dir`; ``force``: files the tool did not write
+    are allowed, to be moved aside)."""
     from spindle.outputs import check_output_dir
 
-    return check_output_dir(Path(out) if out else Path(default), inputs)
+    return check_output_dir(Path(out) if out else Path(default), inputs, force)
 
 
 def add_no_pictures(parser: argparse.ArgumentParser, what: str = "PNGs") -> None:

@@ -51,12 +51,12 @@ def _cmd_crosscheck(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/crosscheck", [spec.path])
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/crosscheck", [spec.path], force=args.force)
     inputs: list[str] = []
     case = (None if args.case is None
             else load_case_input(spec, args.case, spec.default_load_case(), inputs))
     progress.stage(f"solving level {args.level} with scikit-fem and with CalculiX")
-    with output_dir(out, inputs=[spec.path, *inputs]) as tmp:
+    with output_dir(out, inputs=[spec.path, *inputs], force=args.force) as tmp:
         result = crosscheck(spec, args.level, case,
                             keep_dir=(tmp / "ccx") if args.keep_deck else None)
         files = result.save(tmp)

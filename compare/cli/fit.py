@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from compare.cli.common import (
     NODE_COUNT,
     add_no_pictures,
+    add_out,
     add_quiet,
     number,
     out_folder,
@@ -54,14 +55,14 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
                          "drop one of the two options")
     spec = load_spec(args.spec)
     default = f"results/{safe_name(spec.name)}/fit-{safe_name(Path(args.run).stem)}"
-    out = out_folder(args.out, default, [spec.path, args.run])
+    out = out_folder(args.out, default, [spec.path, args.run], force=args.force)
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
                   progress=progress.say,
                   fem_level=None if args.lumped_only else args.fem_level, model=args.model,
                   base_extra=base_extra, blocks=args.blocks,
                   cv_blocks=args.cv_blocks)
-    with output_dir(out, inputs=[spec.path, args.run]) as tmp, progress.pictures():
+    with output_dir(out, inputs=[spec.path, args.run], force=args.force) as tmp, progress.pictures():
         save_report(rep, tmp, pictures=not args.no_pictures)
     progress.done()
     print(report_summary_text(rep))
@@ -77,7 +78,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "effects it supports, report the error before and after")
     fp.add_argument("run", metavar="RUN.csv", help="bench export (format: docs/bench.md)")
     fp.add_argument("--spec", default="spl2782", help="the spindle (default spl2782)")
-    fp.add_argument("--out", help="output folder (default results/<spec>/fit-<run>)")
+    add_out(fp, "results/<spec>/fit-<run>")
     fp.add_argument("--fit-fraction", type=number(0.2, 0.9), default=0.6,
                     help="fraction of the run used for fitting; the rest validates (0.6)")
     fp.add_argument("--blocks", type=number(1, 20, integer=True), default=1,

@@ -34,7 +34,7 @@ def _cmd_measures(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/measures", [spec.path])
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/measures", [spec.path], force=args.force)
     for n in args.lumped_nodes:
         if n not in PRESETS and not (n.isdigit() and int(n) >= 2):
             raise InputError("command line", "--nodes", f"'{n}' is not a lumped model",
@@ -60,7 +60,7 @@ def _cmd_measures(args: argparse.Namespace, progress: Progress) -> int:
                        sweeps=not args.no_sweeps, points=args.points or 7,
                        scheduler=args.scheduler, workers=args.workers,
                        progress=progress.say)
-    with output_dir(out, inputs=inputs) as tmp, progress.pictures():
+    with output_dir(out, inputs=inputs, force=args.force) as tmp, progress.pictures():
         files = rep.save(tmp, pictures=not args.no_pictures)
     progress.done()
     b = rep.baseline

@@ -28,7 +28,7 @@ def _cmd_mesh(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", [spec.path])
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", [spec.path], force=args.force)
     rows = []
     print(f"{'level':>5} {'elements':>9} {'nodes':>8} {'dofs_P1':>8} {'dofs_P2':>8} {'h_max_mm':>9}")
     for level in range(args.level + 1):
@@ -38,7 +38,7 @@ def _cmd_mesh(args: argparse.Namespace, progress: Progress) -> int:
         rows.append({**c2, "dofs_P1": c1["dofs_P1"], "h_max_m": sm.h_max_m})
         print(f"{level:5d} {c2['elements']:9d} {c2['nodes']:8d} {c1['dofs_P1']:8d} "
               f"{c2['dofs_P2']:8d} {sm.h_max_m * 1e3:9.3f}")
-    with output_dir(out, inputs=[spec.path]) as tmp, progress.pictures():
+    with output_dir(out, inputs=[spec.path], force=args.force) as tmp, progress.pictures():
         save_mesh_vtu(sm, tmp / f"mesh_level{args.level}.vtu")
         (tmp / "mesh.json").write_text(json.dumps(
             {"spec": spec.name, "parts": sm.part_names, "levels": rows,

@@ -10,6 +10,7 @@ from compare.cli.common import (
     NODE_COUNT,
     POSITIVE,
     TIME_STEP_S,
+    add_out,
     number,
     out_folder,
     with_progress,
@@ -37,7 +38,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", [spec.path])
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", [spec.path], force=args.force)
     say = progress.say
     cases = load_cases(spec, args.cases) if args.cases else None
     if args.rank is not None and args.rank < 1:
@@ -52,7 +53,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
             f"(dt {args.rank_dt:g} s)")
         ranking = rank_sensors(spec, rank_case, args.rank, args.candidates, None, args.method,
                                args.rank_level, args.rank_dt, args.tol_temp, args.tol_growth)
-    with output_dir(out, inputs=[spec.path]) as tmp, progress.pictures():
+    with output_dir(out, inputs=[spec.path], force=args.force) as tmp, progress.pictures():
         files = choice.save(tmp, pictures=not args.no_pictures)
         if ranking is not None:
             files += ranking.save(tmp, pictures=not args.no_pictures)
@@ -111,7 +112,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    help="ranking: FEM level (default 1)")
     p.add_argument("--rank-dt", type=TIME_STEP_S, default=300.0,
                    help="ranking: time step [s] (default 300)")
-    p.add_argument("--out", help="output folder (default results/<spec>/sensors)")
+    add_out(p, "results/<spec>/sensors")
     p.add_argument("--no-pictures", action="store_true", help="skip the PNGs")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(func=run)

@@ -49,7 +49,7 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
     progress.stage("reading the spec")
     spec = load_spec(args.spec)
     inputs = [spec.path, *(x for x in (args.case, args.cycle) if x and Path(x).is_file())]
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/solve", inputs)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/solve", inputs, force=args.force)
     t0 = time.perf_counter()
     if args.model == "lumped":
         from lumped import build
@@ -91,7 +91,7 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
         result = ref.steady(case)
     t_solve = time.perf_counter() - t0 - t_asm
     result.check_plausible(spec.path)
-    with output_dir(out, inputs=inputs) as tmp, progress.pictures():
+    with output_dir(out, inputs=inputs, force=args.force) as tmp, progress.pictures():
         files = result.save(tmp, pictures=not args.no_pictures)
     progress.done()
     _print_result(args, ref, result, case, header, t_asm, t_solve)
