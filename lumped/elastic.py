@@ -135,9 +135,11 @@ class GrowthChain:
         return {k: float(w @ (x - self.T_ref)) for k, w in self.rows.items()}
 
     def history(self, times_s: np.ndarray, X: np.ndarray) -> dict[str, np.ndarray]:
-        """Readings over time [m] from X (n_times x n_states), lags applied."""
+        """Readings over time [m] from X (n_times x n_states), lags applied, zeroed at the
+        start X[0] (a transient's read-outs are relative to its initial state, as a bench
+        zeroes its displacement sensor)."""
         out = {}
         for k, w in self.rows.items():
-            y = (X - self.T_ref) @ w
+            y = (X - X[0]) @ w
             out[k] = self.lags[k].filter(times_s, y) if k in self.lags else y
         return out

@@ -27,7 +27,8 @@ class RealTimePredictor:
     """Streaming predictor at sample time ``dt_s`` [s] for ``model``.
 
     Inputs u follow ``model.system.input_names`` (heat-source powers [W], then ambient and
-    coolant temperatures [K]); ``reading`` names the growth reading returned (P1).
+    coolant temperatures [K]); ``reading`` names the growth reading returned (P1), zeroed
+    at the start state ``x0`` [K] (per mass, uniform, or None: the spec's T_initial_K).
     """
 
     def __init__(self, model: LumpedModel, dt_s: float, x0: np.ndarray | float | None = None,
@@ -42,18 +43,19 @@ class RealTimePredictor:
         n = model.n_states
         self.n, self.m = n, model.system.n_inputs
         w = model.chain.rows.get(reading)
-        self._T_ref = model.chain.T_ref
-        # outputs: the sensors, then the growth reading (affine: w . (x - T_ref))
+        x_start = model._initial(x0)
+        # outputs: the sensors, then the growth reading w . (x - x_start): zeroed at the start,
+        # as a bench zeroes P1 (and as LumpedModel.transient reads it)
         self.O = np.vstack([model.S, (w if w is not None else np.zeros(n))[None, :]])
         self._offset = np.zeros(len(self.O))
-        self._offset[-1] = -self._T_ref * (w.sum() if w is not None else 0.0)
+        self._offset[-1] = -(w @ x_start) if w is not None else 0.0
         self._steps: dict[float, np.ndarray] = {}
         self._modal: dict[float, tuple] = {}
         for s in speeds_rpm:
             self._fused(s)
         self._speed, self._Z = None, None
         self.xu = np.empty(n + self.m + 1)  # [x, u, 1]: the 1 carries the growth offset
-        self.xu[:n] = model._initial(x0)
+        self.xu[:n] = x_start
         self.xu[-1] = 1.0
         self._buf = np.empty(n + len(self.O))
 

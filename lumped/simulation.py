@@ -17,7 +17,7 @@ from lumped.elastic import GrowthChain, KelvinVoigt
 from lumped.results import LumpedSteadyResult, LumpedTransientResult
 from spindle.errors import SolverError
 from spindle.geometry import TOL_M
-from spindle.loads import LoadCase, time_grid
+from spindle.loads import LoadCase, start_temperature_K, time_grid
 from spindle.spec import Spec, as_spec
 
 
@@ -125,7 +125,10 @@ class LumpedModel:
     def transient(self, case: LoadCase, dt_s: float, T0: np.ndarray | float | None = None,
                   progress: Callable[[float], None] | None = None) -> LumpedTransientResult:
         """Exact zero-order-hold integration over ``case.duration_s`` on the reference's time
-        grid (every dt_s and every input sample); inputs held at their mid-step values."""
+        grid (every dt_s and every input sample); inputs held at their mid-step values. ``T0``
+        [K]: the mass temperatures at the start, a uniform one, or None for the case's
+        ambient at t = 0; the growth readings are zeroed at the start, as a bench zeroes
+        P1."""
         if dt_s <= 0 or case.duration_s <= 0:
             raise SolverError("a transient run needs dt_s > 0 and a duration > 0")
         sys = self.system
@@ -133,7 +136,7 @@ class LumpedModel:
         mid = 0.5 * (grid[1:] + grid[:-1])
         U = self.inputs(case, mid)
         speeds = np.asarray(case.speed_rpm(mid), dtype=float)
-        x = self._initial(T0)
+        x = self._initial(T0, case)
         X = np.empty((len(grid), sys.n_states))
         X[0] = x
         m = len(sys.source_names)
@@ -157,12 +160,15 @@ class LumpedModel:
                                      E_in, E_out, E_stored, out_by,
                                      self.chain.history(grid, X))
 
-    def _initial(self, T0: np.ndarray | float | None) -> np.ndarray:
+    def _initial(self, T0: np.ndarray | float | None, case: LoadCase | None = None
+                 ) -> np.ndarray:
+        """Mass temperatures [K] from T0 (per mass, uniform, or None: the case's ambient at
+        t = 0, without a case the spec's T_initial_K)."""
         n = self.system.n_states
-        if T0 is None:
+        if T0 is None and case is None:
             return np.full(n, self.spec.T_initial_K)
-        if np.isscalar(T0):
-            return np.full(n, float(T0))
+        if T0 is None or np.isscalar(T0):
+            return np.full(n, start_temperature_K(case, T0))
         x = np.asarray(T0, dtype=float)
         if x.shape != (n,):
             raise SolverError(f"T0 has shape {x.shape}; the model has {n} masses")

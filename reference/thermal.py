@@ -25,7 +25,7 @@ from meshes import SpindleMesh
 from reference.forms import capacity, conduction, film, surface_flux, volume_source
 from reference.probes import probe_matrix
 from spindle.errors import SolverError
-from spindle.loads import LoadCase, time_grid
+from spindle.loads import LoadCase, start_temperature_K, time_grid
 from spindle.spec import BearingLink, ContactLink
 from spindle.units import ZERO_C_K
 
@@ -309,7 +309,7 @@ class ThermalModel:
         fnames = list(functionals or {})
         readout = np.vstack([self.probe_matrix(pts).toarray()]
                             + ([np.array([functionals[k] for k in fnames])] if fnames else []))
-        x0 = np.full(self.op.M.shape[0], self.spec.T_initial_K if T0 is None else float(T0))
+        x0 = np.full(self.op.M.shape[0], start_temperature_K(case, T0))
         if method == "modal":
             Y, bound = self._modal_readouts(case, grid, readout, x0), np.zeros(len(readout))
         else:
@@ -394,7 +394,7 @@ class ThermalModel:
 
         theta = 1 is backward Euler (first order), theta = 0.5 Crank-Nicolson (second order).
         Steps of ``dt_s`` land on every sample time of the inputs. ``T0`` is the initial
-        field (K), a uniform temperature, or None for the spec's initial temperature.
+        field (K), a uniform temperature, or None for the case's ambient at t = 0.
         Fields are kept every ``save_every`` steps (0: first and last only).
         ``functionals`` maps names to vectors g whose values g . T are recorded every step
         (the thermoelastic sensors are such functionals).
@@ -408,10 +408,8 @@ class ThermalModel:
         grid = time_grid(case, dt_s)
         op = self.op
         N = op.M.shape[0]
-        if T0 is None:
-            T = np.full(N, self.spec.T_initial_K)
-        elif np.isscalar(T0):
-            T = np.full(N, float(T0))
+        if T0 is None or np.isscalar(T0):
+            T = np.full(N, start_temperature_K(case, T0))
         else:
             T = np.asarray(T0, dtype=float).copy()
         T_start = T.copy()

@@ -143,6 +143,13 @@ class LoadCase:
         return replace(self, sources={**self.sources, **sources})
 
 
+def start_temperature_K(case: LoadCase, T0: float | None = None) -> float:
+    """The uniform temperature [K] a transient of ``case`` starts from: ``T0``, or by default
+    the case's ambient at t = 0 (a spindle at rest in its room). Every model starts there,
+    and their growth read-outs are zeroed there."""
+    return float(case.T_ambient_K(0.0)) if T0 is None else float(T0)
+
+
 def time_grid(case: LoadCase, dt_s: float) -> np.ndarray:
     """Output times of a transient run [s]: every dt_s, plus every sample time of the
     inputs, so that steps land on the inputs' corners (both models use the same grid). More

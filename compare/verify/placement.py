@@ -208,9 +208,9 @@ def snapshots(spec: Spec, case: LoadCase, candidates: dict[str, tuple[float, flo
     X = np.column_stack([point(n) for n in candidates])
     cols = []
     for t in targets:
-        if t.kind == "growth":  # as ReferenceModel.transient, without the centrifugal term
-            g = gains[t.names[0]]
-            cols.append(res.functionals[f"growth:{t.names[0]}"] - model.elastic.T_ref * g.sum())
+        if t.kind == "growth":  # as ReferenceModel.transient (zeroed at the start), without
+            f = res.functionals[f"growth:{t.names[0]}"]  # the centrifugal term
+            cols.append(f - f[0])
         else:
             cols.extend(point(n) for n in t.names)
     return Snapshots(res.times_s, list(candidates), dict(candidates), X, targets,

@@ -26,9 +26,10 @@ from reference.rom.model import (
     pod_directions,
     project,
     reduced_model,
+    zeroed_readings,
 )
 from spindle.errors import SolverError
-from spindle.loads import LoadCase, time_grid
+from spindle.loads import LoadCase, start_temperature_K, time_grid
 
 #: reduced sizes tried, smallest first (the issue's budget: at most 100 states)
 SIZES = (4, 6, 8, 10, 12, 15, 20, 25, 30, 40, 50, 60, 80, 100)
@@ -100,7 +101,7 @@ def build_rom(reference, training: LoadCase, dt_s: float = 60.0, tol_temp_K: flo
     timings["candidates"] = time.perf_counter() - t1
     say(f"{W.shape[1]} candidate directions; POD on {training.name}")
     t2 = time.perf_counter()
-    T0 = full.T_initial_K
+    T0 = start_temperature_K(training)  # where fem_transient starts
     _, Zc = cand.simulate(full.inputs, training, dt_s, cand.z_one * T0, "be")
     Phi, _ = pod_directions(cand, Zc - np.outer(np.ones(len(Zc)), cand.z_one * T0),
                             _response_columns(cand, full, training, dt_s, speeds_rpm, shifts))
@@ -119,7 +120,8 @@ def build_rom(reference, training: LoadCase, dt_s: float = 60.0, tol_temp_K: flo
             break
         red = cand.truncated(Phi[:, :r])
         _, Z = red.simulate(full.inputs, training, dt_s, red.z_one * T0, "be")
-        err = output_errors(full, Z @ red.O.T + red.offset, Y_ref)
+        err = output_errors(full, zeroed_readings(Z @ red.O.T + red.offset,
+                                                  len(full.sensor_names)), Y_ref)
         tried.append(r)
         errors.append(err)
         say(f"r = {r}: {err['temperature_max_K']:.3g} K, " + ", ".join(
@@ -156,7 +158,8 @@ def _calibrated_indicator(full: FullSystem, V: np.ndarray, rom: ReducedModel,
     from reference.rom.indicator import residual_indicator
 
     ind = residual_indicator(full, V)
-    grid, Z = rom.system.simulate(rom.inputs, training, dt_s, rom.initial(), "be")
+    z0 = rom.initial(start_temperature_K(training))  # where Y_ref starts (fem_transient)
+    grid, Z = rom.system.simulate(rom.inputs, training, dt_s, z0, "be")
     true = output_errors(full, rom.outputs(Z), Y_ref)["temperature_max_K"]
     ind.calibration_K = true / max(float(ind.bound(rom, training, grid, Z).max()), 1e-300)
     return ind

@@ -40,7 +40,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from spindle.errors import SolverError
-from spindle.loads import LoadCase, time_grid
+from spindle.loads import LoadCase, start_temperature_K, time_grid
 from spindle.spec import BearingLink
 
 TWO_PI = 2.0 * math.pi
@@ -166,7 +166,7 @@ def fem_transient(full: FullSystem, case: LoadCase, dt_s: float, T0: float | Non
     from reference.thermal import factorize
 
     grid = time_grid(case, dt_s)
-    T = np.full(full.n, full.T_initial_K if T0 is None else float(T0))
+    T = np.full(full.n, start_temperature_K(case, T0))
     Y = np.empty((len(grid), len(full.offset)))
     Y[0] = full.O @ T
     lus: dict[tuple, object] = {}
@@ -186,7 +186,16 @@ def fem_transient(full: FullSystem, case: LoadCase, dt_s: float, T0: float | Non
         Y[k] = full.O @ T
         if progress is not None:
             progress(grid[k] / case.duration_s)
-    return grid, Y + full.offset
+    return grid, zeroed_readings(Y + full.offset, len(full.sensor_names))
+
+
+def zeroed_readings(Y: np.ndarray, n_sensors: int) -> np.ndarray:
+    """Outputs (n_t, sensors then growth readings) with each growth reading [m] relative to
+    its value at the start, as reference.simulation.zeroed_at_start (temperatures as they
+    are)."""
+    Y = np.array(Y, dtype=float)
+    Y[:, n_sensors:] -= Y[0, n_sensors:]
+    return Y
 
 
 def fem_steady(full: FullSystem, case: LoadCase, t: float = 0.0) -> np.ndarray:
@@ -393,6 +402,7 @@ class ReducedModel:
         return case_inputs(case, t, self.source_names, self.source_defaults)
 
     def initial(self, T0: float | None = None) -> np.ndarray:
+        """The reduced state of the uniform field T0 [K] (None: the spec's T_initial_K)."""
         return self.system.z_one * (self.spec.T_initial_K if T0 is None else float(T0))
 
     def outputs(self, Z: np.ndarray) -> np.ndarray:
@@ -412,15 +422,17 @@ class ReducedModel:
 
     def transient(self, case: LoadCase, dt_s: float, T0: float | None = None,
                   method: str = "be"):
-        """Transient on time_grid(case, dt_s): ``method`` "be" (the reference's backward
-        Euler) or "exact" (exact for inputs linear between grid points)."""
+        """Transient on time_grid(case, dt_s) from the uniform T0 [K] (None: the case's ambient
+        at t = 0), growth readings zeroed at the start: ``method`` "be" (the reference's
+        backward Euler) or "exact" (exact for inputs linear between grid points)."""
         from reference.rom.results import ROMTransientResult
 
         if dt_s <= 0 or case.duration_s <= 0:
             raise SolverError("a transient run needs dt_s > 0 and a duration > 0")
         t0 = time.perf_counter()
-        grid, Z = self.system.simulate(self.inputs, case, dt_s, self.initial(T0), method)
-        Y = self.outputs(Z)
+        z0 = self.initial(start_temperature_K(case, T0))
+        grid, Z = self.system.simulate(self.inputs, case, dt_s, z0, method)
+        Y = zeroed_readings(self.outputs(Z), len(self.sensor_names))
         ns = len(self.sensor_names)
         res = ROMTransientResult(self, case, grid, list(self.sensor_names), Y[:, :ns],
                                  {k: Y[:, ns + j] for j, k in enumerate(self.readings)}, Z,

@@ -23,7 +23,9 @@ _CHUNK = 16384  # samples per block of the batch replay (as lumped.realtime: sta
 
 class ROMPredictor:
     """Streaming predictor at sample time ``dt_s`` [s]; inputs u follow
-    ``model.input_names`` (source powers [W], ambient and coolant [K]), held over a sample."""
+    ``model.input_names`` (source powers [W], ambient and coolant [K]), held over a sample.
+    The growth readings are zeroed at the start field, uniform ``T0`` [K] (None: the spec's
+    T_initial_K)."""
 
     def __init__(self, model: ReducedModel, dt_s: float, T0: float | None = None,
                  speeds_rpm: Sequence[float] = (), reading: str = "P1",
@@ -32,8 +34,11 @@ class ROMPredictor:
         self.resolution = float(speed_resolution_rpm)
         sysr = model.system
         self.n, self.m = sysr.r, len(model.input_names)
-        self.O, self.offset = sysr.O, sysr.offset
         self.n_sensors = len(model.sensor_names)
+        z0 = model.initial(T0)
+        # growth readings zeroed at the start, as ReducedModel.transient reads them
+        self.O, self.offset = sysr.O, sysr.offset.copy()
+        self.offset[self.n_sensors:] = -(sysr.O[self.n_sensors:] @ z0)
         self._reading = self.n_sensors + model.readings.index(reading) if reading in \
             model.readings else None
         self._steps: dict[float, np.ndarray] = {}
@@ -42,7 +47,7 @@ class ROMPredictor:
             self.fused(s)
         self._speed, self._Z = None, None
         self.xu = np.empty(self.n + self.m + 1)  # [z, u, 1]: the 1 carries the offsets
-        self.xu[:self.n] = model.initial(T0)
+        self.xu[:self.n] = z0
         self.xu[-1] = 1.0
         self._buf = np.empty(self.n + len(self.O))
 
