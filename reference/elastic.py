@@ -10,7 +10,8 @@ How the bodies hang together (see docs/reference.md):
   locates the shaft axially (fixed bearing). The rear pair's rolling layer keeps its normal
   stiffness but has a vanishing shear modulus (1e-6 of its own), so the shaft slides axially
   through it (floating bearing).
-- The rotor-stator air gap is an air layer (E = 1e5 Pa): it carries no load.
+- The rotor-stator air gap has no stiffness: its elements add nothing to the stiffness, and
+  the DOFs only they hold are removed, so it carries no load.
 - Supports: u_r = 0 on the axis; the housing is held axially at one point, the reference
   point of the first axial-displacement sensor (P1: the housing fixation below the front
   bearing), or, without one, the lowest-z point on the axis.

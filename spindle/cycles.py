@@ -483,6 +483,13 @@ def read_cycle_toml(path: str | Path) -> Cycle:
                       "give at least one { speed_rpm = ..., duration_s = ... }")
     steps = tuple(_read_step(f, d, f"cycle.steps[{i}]") for i, d in enumerate(raw))
     duration = float(sum(s.duration_s for s in steps))
+    if duration > CYCLE_MAX_S:  # before the temperatures are sampled over it
+        k = int(np.argmax([s.duration_s for s in steps]))
+        key = "duration_h" if "duration_h" in raw[k] else "duration_s"
+        raise f.error(f"cycle.steps[{k}].{key}", f"the steps last {duration / 3600:.4g} h, "
+                      f"more than {CYCLE_MAX_S / 3600:g} h (this step: "
+                      f"{steps[k].duration_s / 3600:.4g} h)", "give step durations in seconds "
+                      "(duration_s) or hours (duration_h) for a run of hours to days")
     amb = _read_temperature(f, data, "ambient", duration, TimeSeries.constant(DEFAULT_T_C + ZERO_C_K))
     cool = _read_temperature(f, data, "coolant", duration, amb)
     return Cycle(name=head.get("name", path.stem), description=head.get("description", ""),

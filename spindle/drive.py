@@ -11,22 +11,13 @@ sources of the same names).
 
 from __future__ import annotations
 
-from importlib import resources
 from pathlib import Path
 
 from spindle.cycles import Cycle, load_cycle
 from spindle.drive_file import Drive, read_drive_toml
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries, read_cycle_csv
-from spindle.spec import Spec
-
-
-def shipped_drives() -> dict[str, Path]:
-    """Shipped drive files (spindle/data/drives/*.toml) by name (the file stem)."""
-    root = resources.files("spindle").joinpath("data/drives")
-    return {Path(str(p)).stem: Path(str(p)) for p in sorted(root.iterdir(), key=str)
-            if str(p).endswith(".toml")}
-
+from spindle.spec import Spec, drive_file_path, shipped_drives
 
 #: The shipped drives by name, read once at import.
 DRIVES: dict[str, Drive] = {name: read_drive_toml(path) for name, path in shipped_drives().items()}
@@ -44,11 +35,12 @@ def drive_for(spec: Spec) -> Drive | None:
         return None
     if preset in DRIVES:
         return DRIVES[preset]
-    path = Path(spec.path).parent / Path(preset).expanduser()  # an absolute preset stays as is
-    if path.is_file():
+    path = drive_file_path(spec.path, preset)  # checked when the spec was read; gone since?
+    if path is not None:
         return read_drive_toml(path)
     raise InputError(spec.path, "power_balance.preset",
-                     f"'{preset}' is neither a shipped drive nor a drive file (no file {path})",
+                     f"'{preset}' is neither a shipped drive nor a drive file (no file "
+                     f"{Path(spec.path).parent / preset})",
                      f"use one of: {', '.join(sorted(DRIVES))}, or the path of a drive TOML "
                      "relative to the spec's folder (format: docs/power.md)")
 

@@ -167,6 +167,12 @@ def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
     if not os.access(base, os.W_OK | os.X_OK):
         raise InputError(str(path), "--out", f"cannot be written ({base} is not writable)",
                          "give a folder in a place you can write to")
+    try:  # the permission bits may allow what the place refuses (/proc, a read-only mount)
+        os.rmdir(tempfile.mkdtemp(prefix=".spindle-verify-probe-", dir=base))
+    except OSError as exc:
+        raise InputError(str(path), "--out", f"cannot be created in {base} "
+                         f"({exc.strerror or exc})",
+                         "give a folder in a place you can write to") from None
     if path.is_dir():
         nested = next((q.parent for q in path.glob(f"*/**/{MARKER}")), None)
         if nested is not None and not force:
@@ -211,11 +217,13 @@ def output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
     path = check_output_dir(path, inputs, force)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        _clean_leftovers(path.parent, path.name)
+        # a place the permission bits allow may still refuse a folder (/proc, a read-only
+        # mount): the first write there is the test
+        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.tmp-{os.getpid()}-", dir=path.parent))
     except OSError as exc:
-        raise InputError(str(path), "--out", f"cannot be created ({exc.strerror})",
+        raise InputError(str(path), "--out", f"cannot be created ({exc.strerror or exc})",
                          "give a folder in a place you can write to") from None
-    _clean_leftovers(path.parent, path.name)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.tmp-{os.getpid()}-", dir=path.parent))
     try:
         yield tmp  # no input lies inside path (check_output_dir), so none is replaced
         _write_manifest(tmp)

@@ -534,6 +534,24 @@ def shipped_specs() -> dict[str, Path]:
     return {Path(str(p)).stem: Path(str(p)) for p in root.iterdir() if str(p).endswith(".toml")}
 
 
+def shipped_drives() -> dict[str, Path]:
+    """Shipped drive files (spindle/data/drives/*.toml) by name (the file stem)."""
+    root = resources.files("spindle").joinpath("data/drives")
+    return {Path(str(p)).stem: Path(str(p)) for p in sorted(root.iterdir(), key=str)
+            if str(p).endswith(".toml")}
+
+
+def drive_file_path(spec_file: str | Path, preset: str) -> Path | None:
+    """The drive file a ``[power_balance] preset`` names: a shipped drive's, else a path
+    relative to the spec's folder (an absolute one as it is); None if there is no such
+    file."""
+    shipped = shipped_drives()
+    if preset in shipped:
+        return shipped[preset]
+    path = Path(spec_file).parent / Path(preset).expanduser()
+    return path if path.is_file() else None
+
+
 def resolve_spec_path(name_or_path: str | Path) -> Path:
     """A path to a TOML file, or the name of a shipped spec."""
     p = Path(name_or_path)
@@ -596,6 +614,11 @@ def _build(r: _Reader, data: dict[str, Any]) -> Spec:
     sensors, arrays = _read_sensors(r, data, parts)
     pb = r.table(data, "power_balance", "", required=False) or {}
     preset = r.string(pb, "preset", "power_balance", required=False)
+    if preset is not None and drive_file_path(r.file, preset) is None:
+        r.add("power_balance.preset", f"'{preset}' is neither a shipped drive nor a drive "
+              f"file (no file {Path(r.file).parent / preset})",
+              f"use one of: {', '.join(sorted(shipped_drives()))}, or the path of a drive "
+              "TOML relative to the spec's folder (format: docs/power.md)")
 
     if not r.problems:
         _check_size(r, parts, h0)
@@ -883,7 +906,10 @@ def _read_sensors(r: _Reader, data: dict[str, Any],
         arr = _read_sensor_array(r, ad, f"sensor_arrays[{i}]", parts)
         if arr is not None:
             arrays.append(arr)
-            sensors.extend(array_sensors(arr, next(p for p in parts if p.name == arr.part)))
+            # a part with a problem of its own (a section left out) may not span its length:
+            # its sensors wait for that problem's fix, which is reported already
+            if arr.part not in r.broken["part"]:
+                sensors.extend(array_sensors(arr, next(p for p in parts if p.name == arr.part)))
     seen: set[str] = set()
     for s in sensors:
         if s.name in seen:

@@ -108,6 +108,22 @@ CORPUS = [
     ("--out is an input", {"s.toml": FIN}, ["solve", "s.toml", "--out", "s.toml"], "--out"),
     ("--out holds an input", {"s.toml": FIN}, ["solve", "s.toml", "--out", "."], "--out"),
     ("--out under a file", {"s.toml": FIN}, ["solve", "s.toml", "--out", "s.toml/x"], "--out"),
+    # issue 31: the held-out corpus's last five (two tracebacks in array_sensors, one from the
+    # output folder, a preset accepted by a steady solve, a duration reported as a sampling)
+    ("shaft section of spl2782 without z_end", {"s.toml": _sub(
+        SPL, 'z_start = 0.074, z_end = 0.415,', 'z_start = 0.074,')},
+     ["solve", "s.toml", "--level", "0"], "parts[0].sections[2].z_end"),
+    ("spl2782 cone below its bore at z_end", {"s.toml": _sub(
+        SPL, 'r_inner = 0.0125, r_outer = 0.0475 }', 'r_inner = 0.0125, r_outer = [0.0475, 0.01] }')},
+     ["solve", "s.toml", "--level", "0"], "parts[0].sections[2].r_inner"),
+    ("--out where no folder can be made", {}, ["solve", "spl2782", "--out", "/proc/x"],
+     "--out"),
+    ("unknown preset, steady solve", {"s.toml": _sub(SPL, 'preset = "spl2782"',
+                                                     'preset = "spl9999"')},
+     ["solve", "s.toml", "--model", "lumped"], "power_balance.preset"),
+    ("cycle step of a million hours", {"c.toml": _sub(CYCLE, "speed_rpm = 4300.0, duration_h = 3.0",
+                                                      "speed_rpm = 4300.0, duration_h = 1e6")},
+     ["solve", "spl2782", "--model", "lumped", "--cycle", "c.toml"], "cycle.steps[3].duration_h"),
 ]
 
 
