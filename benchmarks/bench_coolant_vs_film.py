@@ -67,17 +67,18 @@ def main(argv: list[str] | None = None) -> None:
         ap.error("--R must be > 0, --seed and --level >= 0")
 
     from compare.fit.greybox import GreyBox, default_theta
-    from compare.fit.mismatch import Mismatch, random_cycle
+    from compare.fit.mismatch import Mismatch
     from compare.fit.run import greybox_inputs
-    from compare.fit.synth import RANDOM_MAX_SPEED_RPM, reference_run, synth
+    from compare.fit.synth import reference_run, synth
     from spindle.bench import read_bench
+    from spindle.cycles import drawn_cycle
     from spindle.drive import cycle_load_case, drive_for
     from spindle.spec import load_spec
 
     t0 = time.perf_counter()
     spec = load_spec("spl2782")
     drive = drive_for(spec)
-    cycle = random_cycle(np.random.default_rng([args.seed, 2]), RANDOM_MAX_SPEED_RPM)
+    cycle = drawn_cycle("random", args.seed)
 
     def fem(f: float, effect: str = "clean", truth: dict | None = None) -> dict:
         s = Mismatch({"h_coolant": f}, 1.0, 1.0, 1.0, 0.0, 0.06,

@@ -1,5 +1,5 @@
 """CSV text with comment lines, as the cycle files are (spindle.loads.read_cycle_csv and
-spindle.cycles.read_cycle_steps_csv; formats in docs/cycles.md).
+spindle.cycle_files.read_cycle_steps_csv; formats in docs/cycles.md).
 
 A line whose first non-blank character is ``#`` is a comment; blank lines are skipped. The
 first other line is the header. Every reader keeps the file line of each row so that its

@@ -10,14 +10,13 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from spindle.cycle_files import read_cycle_steps_csv, read_cycle_toml
 from spindle.cycles import (
     Cycle,
     Step,
     chiller_cycling,
     drifting_ambient,
     load_cycle,
-    read_cycle_steps_csv,
-    read_cycle_toml,
     shipped_cycles,
 )
 from spindle.errors import InputError

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from compare.fit.load_events import MIN_TORQUE_SPAN_NM, coolant_load_test, load_plateaus
-from compare.fit.mismatch import ramped_steps, random_cycle
+from spindle.cycles import ramped_steps, random_cycle
 
 PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"
 #: a loaded cycle: (start [s], speed [rpm]); the torque ramps 20 -> 40 -> 20 N m in each

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from compare.fit.greybox import film_groups
-from compare.fit.mismatch import Mismatch, draw_mismatch, perturbed_spec, ramped_steps, random_cycle
+from compare.fit.mismatch import Mismatch, draw_mismatch, perturbed_spec
+from spindle.cycles import ramped_steps, random_cycle
 from spindle.drive import drive_for
 from spindle.faces import exposed_faces, surface_faces
 from spindle.spec import ContactLink, load_spec

@@ -23,8 +23,7 @@ from spindle.errors import InputError
 
 
 def _check_cycles(texts: list[str]) -> None:
-    from compare.fit.synth import RANDOM_CYCLES
-    from spindle.cycles import shipped_cycles
+    from spindle.cycles import RANDOM_CYCLES, shipped_cycles
 
     for text in texts:
         name, _, seed = text.partition(":")

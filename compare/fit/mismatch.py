@@ -14,9 +14,8 @@ catalogue data plausibly misses, and :meth:`Mismatch.apply` builds it:
 - the motor's loss split: rotor share 0.03-0.15 (the spec: 0.06);
 - the FEM level the data come from (1 or 2; ``fit`` anchors on level 0).
 
-:func:`random_cycle` makes a cycle the spec does not have: non-monotonic speed steps up to
-the drive's maximum speed, optionally loaded, with the ambient drift and chiller cycling of
-the shipped cycles. Everything is drawn from the seed, so a run is reproducible from it.
+The cycles such a run follows are drawn too (:func:`spindle.cycles.drawn_cycle`).
+Everything is drawn from the seed, so a run is reproducible from it.
 """
 
 from __future__ import annotations
@@ -27,7 +26,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from compare.fit.greybox import film_groups
-from spindle.cycles import Cycle, Step, chiller_cycling, drifting_ambient
 from spindle.drive import Drive
 from spindle.spec import ContactLink, Spec, stretch_axially
 
@@ -69,21 +67,6 @@ class Mismatch:
                 "fem_level": self.fem_level}
 
 
-def ramped_steps(speed_rpm: float, duration_s: float, low_Nm: float, high_Nm: float,
-                 step_s: float = 300.0) -> list[Step]:
-    """One speed step of ``duration_s`` [s] cut into ``step_s`` pieces (the last takes the
-    remainder, so the pieces keep a time step's grid: a FEM run factorises once per step
-    length) whose process torque [N m] rises linearly from ``low_Nm`` to ``high_Nm`` over the
-    first half and falls back over the second (rounded to 0.1 N m)."""
-    k = max(int(duration_s // step_s), 2)
-    edges = np.concatenate([np.arange(k) * (duration_s / k if duration_s < 2 * step_s
-                                            else step_s), [duration_s]])
-    mid = 0.5 * (edges[:-1] + edges[1:]) / duration_s
-    shape = 1.0 - np.abs(2.0 * mid - 1.0)
-    return [Step(speed_rpm, float(b - a), round(low_Nm + (high_Nm - low_Nm) * float(f), 1))
-            for a, b, f in zip(edges[:-1], edges[1:], shape, strict=True)]
-
-
 def _log_uniform(rng: np.random.Generator, lo: float, hi: float) -> float:
     return float(math.exp(rng.uniform(math.log(lo), math.log(hi))))
 
@@ -108,44 +91,3 @@ def perturbed_spec(spec: Spec, seed: int) -> Spec:
     if seed < 0:
         raise ValueError(f"the seed of a spec's perturbation is >= 0, not {seed}")
     return draw_mismatch(np.random.default_rng([seed, 1])).apply_to_spec(spec)
-
-
-def random_cycle(rng: np.random.Generator, max_speed_rpm: float, loaded: bool = False,
-                 duration_h: float = 16.0, ramped: bool = False) -> Cycle:
-    """A 16 h cycle the spec does not have: a standstill start, speed steps of 45-120 min in a
-    random (non-monotonic) order over 15-100 % of ``max_speed_rpm`` [rpm], rounded to
-    100 rpm, the top speed among them, and a 2 h cool-down; loaded runs hold a process torque
-    of 0-40 N m per step. ``ramped`` (a loaded run as a bench logs one, e.g. a peer's
-    ../shared/bench-runs/dev-08): within each speed step the torque ramps from a low level of
-    5-20 N m up to 10-25 N m above it and back, in 5 min steps (:func:`ramped_steps`). Ambient
-    drift and chiller cycling as the shipped cycles."""
-    total = duration_h * 3600.0
-    cool = 7200.0
-    steps = [Step(0.0, 900.0)]
-    plateau_of = [-1]  # the speed plateau (index into speeds) of each step
-    t = 900.0
-    speeds = []
-    while t < total - cool - 1800.0:
-        dur = min(float(rng.uniform(45, 120)) * 60.0, total - cool - t)
-        n = round(float(rng.uniform(0.15, 1.0)) * max_speed_rpm / 100.0) * 100.0
-        speeds.append(n)
-        torque = round(float(rng.uniform(0.0, 40.0)), 1) if loaded else 0.0
-        if ramped:  # whole minutes, so that the 5 min pieces keep the 60 s grid
-            dur = 60.0 * round(dur / 60.0)
-            low = float(rng.uniform(5.0, 20.0))
-            pieces = ramped_steps(n, dur, low, low + float(rng.uniform(10.0, 25.0)))
-        else:
-            pieces = [Step(n, dur, torque)]
-        steps.extend(pieces)
-        plateau_of.extend([len(speeds) - 1] * len(pieces))
-        t += dur
-    if max_speed_rpm not in speeds:  # the top speed at least once, somewhere in the middle
-        middle = (1 + len(speeds)) // 2  # that plateau's steps, all of them when ramped
-        steps = [replace(s, speed_rpm=float(max_speed_rpm)) if plateau == middle else s
-                 for s, plateau in zip(steps, plateau_of, strict=True)]
-    steps.append(Step(0.0, total - t))
-    name = "random-ramped-load" if ramped else f"random{'-loaded' if loaded else ''}"
-    return Cycle(name=name,
-                 description="random non-monotonic speed steps (compare.fit.mismatch)",
-                 source="generated", steps=tuple(steps),
-                 T_ambient_K=drifting_ambient(total), T_coolant_K=chiller_cycling(total))

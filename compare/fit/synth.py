@@ -287,24 +287,17 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
     return header, data
 
 
-#: cycles synth makes itself (compare.fit.mismatch.random_cycle) rather than load
-RANDOM_CYCLES = ("random", "random-loaded", "random-ramped-load")
-#: the top speed of a random cycle [rpm]: the SPL2782 family's bench runs go to 6000 rpm
-#: (a peer's runs in ../shared/bench-runs), above the spl-16h cycle's rated 4300 rpm
-RANDOM_MAX_SPEED_RPM = 6000.0
-
-
 def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, level: int = 1,
           dt_s: float = 60.0, mismatch: bool = False) -> dict:
     """Write the synthetic run and its truth sidecar; returns the truth.
 
     ``cycle_name``: a shipped cycle or cycle file, or ``random`` / ``random-loaded`` /
     ``random-ramped-load`` (a cycle drawn from the seed,
-    :func:`compare.fit.mismatch.random_cycle`). ``mismatch``: the data
+    :func:`spindle.cycles.drawn_cycle`). ``mismatch``: the data
     come from a spindle that differs from ``spec`` (:func:`compare.fit.mismatch.draw_mismatch`,
     drawn from the seed; its FEM level replaces ``level``), recorded in the truth."""
-    from compare.fit.mismatch import draw_mismatch, random_cycle
-    from spindle.cycles import load_cycle
+    from compare.fit.mismatch import draw_mismatch
+    from spindle.cycles import RANDOM_CYCLES, drawn_cycle, load_cycle
     from spindle.drive import cycle_load_case, drive_for
     from spindle.outputs import atomic_write
 
@@ -315,12 +308,8 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
              "cycle": cycle_name, "fem_level": level, "spec": spec.name}
     # the mismatch and the random cycle have streams of their own, so that a seed's effect
     # and bench sampling stay what they were without them
-    if cycle_name in RANDOM_CYCLES:
-        cycle = random_cycle(np.random.default_rng([seed, 2]), RANDOM_MAX_SPEED_RPM,
-                             loaded=cycle_name == "random-loaded",
-                             ramped=cycle_name == "random-ramped-load")
-    else:
-        cycle = load_cycle(cycle_name)
+    cycle = drawn_cycle(cycle_name, seed) if cycle_name in RANDOM_CYCLES else \
+        load_cycle(cycle_name)
     drive = drive_for(spec)
     if mismatch:
         mm = draw_mismatch(np.random.default_rng([seed, 1]))

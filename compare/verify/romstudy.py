@@ -22,20 +22,16 @@ from spindle.loads import LoadCase
 
 def named_case(spec, name: str, seed: int = 0) -> LoadCase:
     """The load case of a shipped cycle (or cycle file) through the spec's power balance, or
-    of ``random`` / ``random-loaded``: the cycle ``spindle-verify synth`` draws from ``seed``
-    (compare.fit.mismatch.random_cycle, top speed RANDOM_MAX_SPEED_RPM), named with its
-    seed."""
+    of ``random`` / ``random-loaded`` / ``random-ramped-load``: the cycle ``spindle-verify
+    synth`` draws from ``seed`` (spindle.cycles.drawn_cycle), named with its seed."""
     from dataclasses import replace
 
-    from compare.fit.mismatch import random_cycle
-    from compare.fit.synth import RANDOM_CYCLES, RANDOM_MAX_SPEED_RPM
-    from spindle.cycles import load_cycle
+    from spindle.cycles import RANDOM_CYCLES, drawn_cycle, load_cycle
     from spindle.drive import cycle_load_case
 
     if name in RANDOM_CYCLES:
-        cycle = random_cycle(np.random.default_rng([seed, 2]), RANDOM_MAX_SPEED_RPM,
-                             loaded=name == "random-loaded")
-        return replace(cycle_load_case(spec, cycle), name=f"{name} (seed {seed})")
+        case = cycle_load_case(spec, drawn_cycle(name, seed))
+        return replace(case, name=f"{name} (seed {seed})")
     cycle = load_cycle(name)
     case = cycle_load_case(spec, cycle)
     return replace(case, duration_s=0.0) if cycle.steady else case

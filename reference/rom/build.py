@@ -37,7 +37,7 @@ SIZES = (4, 6, 8, 10, 12, 15, 20, 25, 30, 40, 50, 60, 80, 100)
 #: cycles' errors exceed the training cycle's by up to 2.0x on spl2782 (docs/rom.md)
 SAFETY = 2.0
 #: the top of the speed range the basis covers [rpm]: the random cycles' top speed
-#: (compare.fit.synth.RANDOM_MAX_SPEED_RPM), above spl-16h's 4300 rpm
+#: (spindle.cycles.RANDOM_MAX_SPEED_RPM), above spl-16h's 4300 rpm
 TOP_SPEED_RPM = 6000.0
 
 
