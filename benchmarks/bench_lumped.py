@@ -53,18 +53,18 @@ def bench(spec_name: str, nodes: int, repeat: int) -> dict:
     t = time.perf_counter()
     pred = RealTimePredictor(model, dt, x0=T0, speeds_rpm=np.unique(speeds))
     for s in np.unique(speeds):
-        pred._modes(s)
+        pred.modes(s)
     out["precompute_s"] = time.perf_counter() - t
     runs = []
     for _ in range(repeat):
-        pred.xu[:pred.n] = T0
+        pred.state = T0
         t = time.perf_counter()
         _, P1 = pred.run(U, speeds)
         runs.append(time.perf_counter() - t)
     out["samples"] = len(U)
     out["replay_16h_1s_s"] = min(runs)
     out["P1_peak_um"] = float(P1.max() * 1e6)
-    pred.xu[:pred.n] = T0
+    pred.state = T0
     t = time.perf_counter()
     step = pred.step
     for k in range(len(U)):

@@ -136,7 +136,7 @@ class LumpedModel:
         mid = 0.5 * (grid[1:] + grid[:-1])
         U = self.inputs(case, mid)
         speeds = np.asarray(case.speed_rpm(mid), dtype=float)
-        x = self._initial(T0, case)
+        x = self.initial_state(T0, case)
         X = np.empty((len(grid), sys.n_states))
         X[0] = x
         m = len(sys.source_names)
@@ -160,7 +160,7 @@ class LumpedModel:
                                      E_in, E_out, E_stored, out_by,
                                      self.chain.history(grid, X))
 
-    def _initial(self, T0: np.ndarray | float | None, case: LoadCase | None = None
+    def initial_state(self, T0: np.ndarray | float | None, case: LoadCase | None = None
                  ) -> np.ndarray:
         """Mass temperatures [K] from T0 (per mass, uniform, or None: the case's ambient at
         t = 0, without a case the spec's T_initial_K)."""

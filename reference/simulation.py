@@ -84,7 +84,7 @@ class ReferenceModel:
         """(times [s], sensors [K], growth readings [m], each read-out's bound on its time
         error [K or m]) on time_grid(case, dt_s), exact in time for inputs linear between
         grid points (ThermalModel.exact_readouts)."""
-        gains = self._gains()
+        gains = self.growth_gains()
         if self.elastic is not None:  # the gains are kept; its LU is not needed (memory)
             self.elastic.release()
         t, names, S, F, bound = self.thermal.exact_readouts(
@@ -92,7 +92,7 @@ class ReferenceModel:
         growth = self._growth(gains, F, self._step_speeds(case, t))
         return (t, {n: S[:, j] for j, n in enumerate(names)}, zeroed_at_start(growth), bound)
 
-    def _gains(self) -> dict[str, tuple[np.ndarray, float]]:
+    def growth_gains(self) -> dict[str, tuple[np.ndarray, float]]:
         """Each growth reading's thermal gain g [m/K per DOF] and centrifugal c [m s^2]."""
         return {k: self.elastic.gain(k) for k in self.readings} if self.elastic else {}
 
@@ -111,7 +111,7 @@ class ReferenceModel:
         """The thermal transient (:meth:`ThermalModel.solve_transient`; T0 [K], default the
         case's ambient at t = 0) and its growth readings [m], zeroed at the start
         (:func:`zeroed_at_start`) as are the displacement fields."""
-        gains = self._gains()
+        gains = self.growth_gains()
         res = self.thermal.solve_transient(case, dt_s, theta, T0, save_every, progress,
                                            functionals={k: g for k, (g, _) in gains.items()})
         t = res.times_s

@@ -270,6 +270,18 @@ class ThermalModel:
         """Drop the cached factorisations (memory; they are made again when next needed)."""
         self._lu.clear()
 
+    def set_coefficients(self, films: list | None = None, contacts: list | None = None,
+                         links: list | None = None) -> None:
+        """Replace the operator's film, contact or link terms (each a list as
+        :class:`Operator` holds it: the same surfaces and links, with other coefficients,
+        since the conductance is affine in them) and drop every factorisation made with the
+        old ones. A list not given is kept."""
+        op = self.op
+        op.films = list(op.films if films is None else films)
+        op.contacts = list(op.contacts if contacts is None else contacts)
+        op.links = list(op.links if links is None else links)
+        self._lu.clear()
+
     def solve_steady(self, case: LoadCase | None = None, t: float = 0.0):
         """Steady state for the inputs of ``case`` at time ``t`` [s]."""
         from reference.results import SteadyResult

@@ -65,8 +65,7 @@ def reference_model(spec: Spec, level: int = 1, elastic: bool = True):
         return model
     model, base = _MODELS[key]
     by_name = {s.name: s for s in spec.surfaces}
-    model.thermal.op.films = [(by_name[s.name], R, b) for s, R, b in base]
-    model.thermal._lu.clear()
+    model.thermal.set_coefficients(films=[(by_name[s.name], R, b) for s, R, b in base])
     model.spec = model.thermal.spec = spec
     return model
 

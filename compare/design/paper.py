@@ -88,15 +88,14 @@ class PaperStudy:
         self.nominal, self.cycle = load_cycle("nominal"), load_cycle("spl-16h")
 
     def apply(self, factors: dict[str, float]) -> Drive:
-        op = self.ref.thermal.op
         group = {s: g for g, names in FILM_GROUPS.items() for s in names}
-        op.films = [(replace(s, h_W_m2K=s.h_W_m2K.scaled(factors.get(group.get(s.name), 1.0))),
-                     R, b) for s, R, b in self._films]
-        op.contacts = [(replace(lk, h_W_m2K=lk.h_W_m2K * factors.get("contact", 1.0)), C)
-                       for lk, C in self._contacts]
-        op.links = [(replace(lk, h_W_m2K=lk.h_W_m2K.scaled(factors.get("air_gap", 1.0)))
-                     if isinstance(lk, AirGapLink) else lk, A) for lk, A in self._links]
-        self.ref.thermal._lu.clear()
+        self.ref.thermal.set_coefficients(
+            films=[(replace(s, h_W_m2K=s.h_W_m2K.scaled(factors.get(group.get(s.name), 1.0))),
+                    R, b) for s, R, b in self._films],
+            contacts=[(replace(lk, h_W_m2K=lk.h_W_m2K * factors.get("contact", 1.0)), C)
+                      for lk, C in self._contacts],
+            links=[(replace(lk, h_W_m2K=lk.h_W_m2K.scaled(factors.get("air_gap", 1.0)))
+                    if isinstance(lk, AirGapLink) else lk, A) for lk, A in self._links])
         drive = drive_for(self.spec)  # a shipped preset or the spec's own drive file
         if "f0" in factors:
             drive = drive.with_f0(factors["f0"])

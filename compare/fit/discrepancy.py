@@ -103,7 +103,7 @@ def fem_discrepancy(gb: GreyBox, channels: tuple[str, ...] | list[str], level: i
     t0 = time.perf_counter()
     fem = reference_channels(gb, channels, level)
     theta = default_theta(base_params(gb.drive))
-    plain = GreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, _cache=gb._cache)
+    plain = gb.plain()
     lumped = plain.simulate(theta)
     offsets = {c: fem[c] - lumped[c] for c in channels}
     rms = {c: float(np.sqrt(np.mean(offsets[c] ** 2))) for c in channels}

@@ -112,17 +112,16 @@ class FemGreyBox:
         if self._cache.get("fem_applied") != factors:
             f = dict(zip(names, factors, strict=True))
             stator = {p.name for p in self.spec.parts if p.role == "stator"}
-            op = ref.thermal.op
             # a factor of exactly 1 keeps the spec's own object: the default point is then the
             # FEM reference of compare.fit.discrepancy bit for bit
-            op.films = [(s if g is None or f[g] == 1.0 else
-                         replace(s, h_W_m2K=s.h_W_m2K.scaled(f[g])), R, b)
-                        for s, R, b, g in films]
-            op.contacts = [(lk if f[g] == 1.0 else replace(lk, h_W_m2K=lk.h_W_m2K * f[g]), C)
-                           for lk, C in contacts
-                           for g in ["stator_contact" if set(lk.parts) & stator else "contact"]]
-            op.links = list(links)  # no air-gap parameter in the grey box
-            ref.thermal._lu.clear()  # the factorisations hold the old coefficients
+            ref.thermal.set_coefficients(
+                films=[(s if g is None or f[g] == 1.0 else
+                        replace(s, h_W_m2K=s.h_W_m2K.scaled(f[g])), R, b)
+                       for s, R, b, g in films],
+                contacts=[(lk if f[g] == 1.0 else replace(lk, h_W_m2K=lk.h_W_m2K * f[g]), C)
+                          for lk, C in contacts
+                          for g in ["stator_contact" if set(lk.parts) & stator else "contact"]],
+                links=links)  # no air-gap parameter in the grey box
             self._cache["fem_applied"] = factors
         return ref
 

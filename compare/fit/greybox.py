@@ -38,12 +38,12 @@ import numpy as np
 from lumped.blocks import Convection, FixedTemperature, PrescribedHeatFlow
 from lumped.build import build_network
 from lumped.elastic import first_order_lag
-from lumped.realtime import modal_recursion
 from lumped.simulation import LumpedModel
 from spindle.bench import interval_heat_W
 from spindle.drive import Drive
 from spindle.drive_file import FRICTION_REF_RPM, MOTOR_SOURCES
 from spindle.spec import Spec
+from spindle.streaming import modal_recursion
 
 ROTATING = ("shaft", "tool", "rotor")
 #: the parameters that change the conductance matrix K (the others change sources or read-outs)
@@ -265,6 +265,11 @@ class GreyBox:
         """The same model with another effect set (sharing caches and discrepancy)."""
         return GreyBox(self.spec, self.drive, self.inputs, self.nodes, tuple(effects),
                        lag_channel, self._cache, self.discrepancy, self.base_extra)
+
+    def plain(self) -> GreyBox:
+        """The spec's lumped model on the same inputs: no effects, no base extras, no
+        discrepancy (sharing the caches)."""
+        return GreyBox(self.spec, self.drive, self.inputs, self.nodes, _cache=self._cache)
 
     @property
     def _seats(self) -> bool:

@@ -489,7 +489,7 @@ def _calibrate_on_fem(cal: Calibrator, fem_level: int, say: Callable[[str], None
     gb = cal.gb
     channels = list(cal.channels)
     theta_spec = default_theta(base_params(gb.drive))
-    plain = GreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, _cache=gb._cache)
+    plain = gb.plain()
     say(f"building the FEM reference (level {fem_level}) for the calibration")
     fem = FemGreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, fem_level,
                      progress=lambda m: say("  " + m))

@@ -145,7 +145,7 @@ def full_system(reference) -> FullSystem:
         terms.append((_coefficient(s, "film"), R))
     names, pts = th.sensor_points()
     rows = [th.probe_matrix(pts).toarray()]
-    gains = reference._gains()
+    gains = reference.growth_gains()
     readings = list(gains)
     offset = np.zeros(len(names) + len(readings))
     if readings:
@@ -333,12 +333,12 @@ class ReducedSystem:
             ua = full_inputs(case, np.array([t0 + eps * dt, t1 - eps * dt]))
             a = Q.T @ (B @ ua[0])
             b = (Q.T @ (B @ ua[1]) - a) / dt
-            g1, g2, e = _phi(lam, dt)
+            g1, g2, e = phi_integrals(lam, dt)
             Z[k] = Q @ (e * (Q.T @ Z[k - 1]) + g1 * a + g2 * b)
         return grid, Z
 
 
-def _phi(lam: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def phi_integrals(lam: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Exact integrals of exp(-lam (dt - s)) and s exp(-lam (dt - s)) over [0, dt]."""
     e = np.exp(-lam * dt)
     g1 = np.where(lam * dt > 1e-8, -np.expm1(-lam * dt) / np.maximum(lam, 1e-300), dt)
