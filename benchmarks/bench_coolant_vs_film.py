@@ -23,9 +23,10 @@ from pathlib import Path
 import numpy as np
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
+from spindle.tolerances import channel_tolerance, edge_scale
 
 #: tolerance units [K; m for P1] of the fit
-TOL = {"T1": 1.0, "T2": 1.0, "T_stator": 1.0, "P1": 1.5e-6}
+TOL = {c: channel_tolerance(c) for c in ("T1", "T2", "T_stator", "P1")}
 
 
 def _best_factor(simulate, target: dict[str, np.ndarray]) -> tuple[float, dict]:
@@ -49,7 +50,7 @@ def _table(label: str, f: float, spec_run: dict, coolant: dict, film: dict) -> N
     print(f"{label}: best jacket factor {f:.3f}")
     print(f"  {'channel':9} {'effect RMS':>10} {'max':>7}   {'left RMS':>8} {'max':>7}")
     for k in TOL:
-        u = 1e6 if k == "P1" else 1.0
+        u = edge_scale(k)
         d, e = coolant[k] - spec_run[k], coolant[k] - film[k]
         print(f"  {k:9} {u * np.sqrt(np.mean(d ** 2)):10.3f} {u * np.max(np.abs(d)):7.3f}   "
               f"{u * np.sqrt(np.mean(e ** 2)):8.3f} {u * np.max(np.abs(e)):7.3f}")

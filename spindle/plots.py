@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from spindle.outputs import atomic_write
+from spindle.tolerances import GROWTH_TOLERANCE_M
 
 
 def pyplot():
@@ -69,7 +70,7 @@ def timeseries_png(times_s: np.ndarray, names: list[str], values_C: np.ndarray, 
 
 
 def growth_band_png(times_s: np.ndarray, T1_C: np.ndarray, P1_um: np.ndarray, path: Path,
-                    title: str = "", band_um: float = 1.5,
+                    title: str = "", band_um: float = GROWTH_TOLERANCE_M * 1e6,
                     measured: tuple[np.ndarray, np.ndarray] | None = None) -> None:
     """T1 and P1 over the cycle, P1 with the paper's ±1.5 µm tolerance band around the
     prediction (paper Fig. 11-13); ``measured`` = (times_s, P1_um) adds a test run."""

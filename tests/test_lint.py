@@ -128,3 +128,26 @@ def test_the_private_reach_reader_can_fail(tmp_path):
     f = tmp_path / "x.py"
     f.write_text("def g(model):\n    model.thermal._lu.clear()\n")
     assert _private_reaches(f, tmp_path) == ["x.py:2: model.thermal._lu"]
+
+
+def test_the_paper_tolerances_have_one_home():
+    """1 K and 1.5 µm are defined once, in SI (spindle/tolerances.py); elsewhere they are
+    read from there, and a channel's µm come from its edge_scale, not from a literal
+    ``1e6 if c == "P1"`` (issue 31 found both tolerances twice, in two units)."""
+    import ast
+
+    home = ROOT / "spindle" / "tolerances.py"
+    found = []
+    for pkg in ("spindle", "meshes", "reference", "lumped", "compare", "benchmarks", "docs"):
+        for f in sorted((ROOT / pkg).rglob("*.py")):
+            if f == home:
+                continue
+            for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Constant) and node.value in (1.5e-6, 1.5e-3):
+                    found.append(f"{f.relative_to(ROOT)}:{node.lineno}: {node.value}")
+                if isinstance(node, ast.IfExp) and isinstance(node.test, ast.Compare) \
+                        and isinstance(node.test.ops[0], ast.Eq) \
+                        and "'P1'" in ast.unparse(node.test) \
+                        and "1000000.0" in ast.unparse(node.body):
+                    found.append(f"{f.relative_to(ROOT)}:{node.lineno}: {ast.unparse(node)}")
+    assert not found, "\n".join(found)

@@ -39,6 +39,7 @@ import numpy as np
 
 from compare.fit.events import EventTest
 from compare.fit.greybox import BASE_PARAMS, EFFECTS, EXTRA_BASE_PARAMS, GreyBox, Param
+from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
 
 #: |z| of every base parameter after an effect that is needed for plausibility (95 % central)
 RESTORED_Z = 1.96
@@ -49,7 +50,8 @@ RESTORED_Z = 1.96
 #: passed the relative gains on excesses near zero; the true ones of the matrix and the
 #: injected cases peak at 1.6-6 um
 MATERIAL_PEAK = 0.5
-TOLERANCE = {"T1": 1.0, "T2": 1.0, "T_stator": 1.0, "P1": 1.5e-6}  # K, K, K, m (paper)
+#: the paper's tolerance per bench channel [K; m for P1] (spindle.tolerances)
+TOLERANCE = {c: channel_tolerance(c) for c in ("T1", "T2", "T_stator", "P1")}
 
 
 def implausible_z(alpha: float) -> float:
@@ -879,7 +881,7 @@ def cv_score(cv: dict, floor: Mapping[str, float] | None = None,
     for c, r in cv["pooled"].items():  # rmse in K, or in µm for P1
         if channels is not None and c not in channels:
             continue
-        w = r["rmse"] / (TOLERANCE[c] * (1e6 if c == "P1" else 1.0))
+        w = r["rmse"] / (TOLERANCE[c] * edge_scale(c))
         f = (floor or {}).get(c, 0.0)
         total += max(w * w - f * f, 0.0)
     return total
@@ -888,7 +890,7 @@ def cv_score(cv: dict, floor: Mapping[str, float] | None = None,
 def _error_row(channel: str, d: np.ndarray) -> dict:
     """rmse, max, bias (channel unit at the edges: K or um) and within_tolerance of
     differences ``d`` [SI]; the errors of Calibrator.errors and of cross_validate."""
-    scale, unit = (1e6, "um") if channel == "P1" else (1.0, "K")
+    scale, unit = edge_scale(channel), edge_unit(channel, ascii=True)
     return {"rmse": float(np.sqrt(np.mean(d * d)) * scale),
             "max": float(np.max(np.abs(d)) * scale), "bias": float(np.mean(d) * scale),
             "unit": unit,

@@ -66,6 +66,7 @@ from spindle.errors import InputError, SolverError
 from spindle.outputs import jsonable
 from spindle.results import check_plausible
 from spindle.spec import Spec
+from spindle.tolerances import edge_absolute, edge_scale, edge_unit
 from spindle.units import ZERO_C_K
 
 REPORT_FORMAT = "spindle-verify-fit/1"
@@ -597,7 +598,7 @@ def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
     n = len(rep.channels)
     fig, axes = plt.subplots(n, 2, figsize=(13, 2.8 * n), layout="constrained", squeeze=False)
     for i, c in enumerate(rep.channels):
-        scale, off, unit = (1e6, 0.0, "µm") if c == "P1" else (1.0, ZERO_C_K, "°C")
+        scale, off, unit = edge_absolute(c)
         tol = TOLERANCE[c] * scale
         meas = rep.measured.values[c] * scale - off
         for j, (fit, label) in enumerate(((sel.base, "before"), (sel.final, "after"))):
@@ -657,7 +658,7 @@ def _pictures(rep: FitReport, out: Path) -> list[tuple[str, str]]:
         with_it = st.fit
         for i, c in enumerate(rep.channels):
             ax = axes[0, i]
-            scale = 1e6 if c == "P1" else 1.0
+            scale = edge_scale(c)
             ax.plot(g, (rep.measured.values[c] - before_it.model[c]) * scale, lw=0.8,
                     label="residual of the base model")
             ax.plot(g, (with_it.model[c] - before_it.model[c]) * scale, lw=1.2,
@@ -691,8 +692,7 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
             f"reference itself (level {anchor['fem_level']}; {fc.get('fem_runs', 0)} FEM runs, "
             f"{fc.get('seconds', 0.0):.0f} s); the effects were selected on the lumped model "
             "anchored to the FEM at the calibrated values. FEM minus lumped there, RMS: "
-            + ", ".join(f"{c} {v * (1e6 if c == 'P1' else 1):.3g} "
-                        f"{'µm' if c == 'P1' else 'K'}"
+            + ", ".join(f"{c} {v * edge_scale(c):.3g} {edge_unit(c)}"
                         for c, v in anchor["fem_minus_lumped_rms"].items())
             + ". Base parameters in prior standard deviations from the spec's values "
             "(|z| > 2.58 is implausible): " + ", ".join(f"{k} {v:+.2f}" for k, v in z.items())
@@ -703,8 +703,7 @@ def _html(rep: FitReport, doc: dict, out: Path, pngs: list[tuple[str, str]]) -> 
             "<p>Calibration model: lumped. "
             f"Model: the lumped model anchored to the FEM reference (level "
             f"{anchor['fem_level']}) on this run's inputs; FEM minus lumped at the spec's values, "
-            "RMS: " + ", ".join(f"{c} {v * (1e6 if c == 'P1' else 1):.3g} "
-                                f"{'µm' if c == 'P1' else 'K'}"
+            "RMS: " + ", ".join(f"{c} {v * edge_scale(c):.3g} {edge_unit(c)}"
                                 for c, v in anchor["fem_minus_lumped_rms"].items())
             + ". Base parameters in prior standard deviations from the spec's values "
             "(|z| > 2.58 is implausible): " + ", ".join(f"{k} {v:+.2f}" for k, v in z.items())
@@ -805,7 +804,7 @@ def _events_html(doc: dict) -> str:
         meaning = t["meaning"]
         if t.get("material") is False and t.get("peak_effect"):
             ch, v = max(t["peak_effect"].items(), key=lambda kv: kv[1] / TOLERANCE[kv[0]])
-            size = f"{v * 1e6:.2f} µm" if ch == "P1" else f"{v:.2f} K"
+            size = f"{v * edge_scale(ch):.2f} {edge_unit(ch)}"
             meaning += (f"; at its estimate it moves {ch} by at most {size}, less than the "
                         "tolerance: not material, not named")
         rows.append([label, t["channel"],

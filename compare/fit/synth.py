@@ -38,6 +38,7 @@ from compare.fit.greybox import EFFECTS
 from lumped.elastic import first_order_lag
 from spindle.loads import LoadCase, SpeedTable, TimeSeries
 from spindle.spec import Spec
+from spindle.tolerances import edge_absolute
 from spindle.units import RPM_TO_RAD_S, ZERO_C_K
 
 OUTSIDE = ("electronics_drift",)
@@ -273,7 +274,8 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
         v = np.interp(t, t_model, y)
         if instant and name in instant:
             v = v + instant[name](t)
-        cols[f"{name}_um" if name == "P1" else f"{name}_C"] = v * 1e6 if name == "P1" else v - ZERO_C_K
+        scale, off, _ = edge_absolute(name)
+        cols[f"{name}_um" if name == "P1" else f"{name}_C"] = v * scale - off
     cols["P1_um"] = cols["P1_um"] - cols["P1_um"][0]
     for key, (sd, q) in NOISE.items():
         if key in cols:

@@ -20,10 +20,11 @@ import numpy as np
 from compare.report import markdown_table
 from spindle.loads import LoadCase
 from spindle.spec import Spec
+from spindle.tolerances import GROWTH_TOLERANCE_M, TEMPERATURE_TOLERANCE_K
 from spindle.units import ZERO_C_K
 
-TOL_TEMP_K = 1.0  # paper: "small temperature deviations of 1 K ... are acceptable"
-TOL_GROWTH_UM = 1.5  # paper: "position deviations of ±1.5 µm"
+TOL_TEMP_K = TEMPERATURE_TOLERANCE_K  # the paper's (spindle.tolerances)
+TOL_GROWTH_UM = GROWTH_TOLERANCE_M * 1e6  # the same in µm, the unit of the tables
 NODES = (2, 3, 5, 7, 11, 15, 21, 31, 41)
 PRESET_NODES = {5: "paper5", 11: "paper11"}
 

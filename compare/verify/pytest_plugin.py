@@ -23,6 +23,8 @@ from dataclasses import dataclass
 import pytest
 
 from compare.verify.accuracy import (
+    TOL_GROWTH_UM,
+    TOL_TEMP_K,
     AccuracyResult,
     Entry,
     fem_entry,
@@ -81,7 +83,7 @@ class SpindleVerify:
         return model_error(spec, model, case, reference_level, dt_s)
 
     def assert_within(self, spec: str, model: str, case: str | None = None,
-                      tol_temp_K: float = 1.0, tol_growth_um: float = 1.5,
+                      tol_temp_K: float = TOL_TEMP_K, tol_growth_um: float = TOL_GROWTH_UM,
                       reference_level: int = 2, dt_s: float = 120.0) -> Verdict:
         v = model_error(spec, model, case, reference_level, dt_s)
         msgs = []
