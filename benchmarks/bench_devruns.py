@@ -16,10 +16,11 @@ their prior range, and the wall time; then the totals. Runs go through
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
+
+from verdicts import RMS_HEADER, fit_outcome, named_text, read_truth, rms_cells, run_verdicts
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
@@ -49,6 +50,7 @@ def fit_one(case: DevRun) -> dict:
     """``fit`` on one run; the figures the table prints."""
     from compare.fit.run import named_effects, run_fit, selection_trace
     from spindle.spec import load_spec
+    from spindle.tolerances import channel_tolerance, edge_scale
 
     t = time.perf_counter()
     spec = load_spec(case.spec)
@@ -59,19 +61,16 @@ def fit_one(case: DevRun) -> dict:
     rep = run_fit(case.path, spec, base_extra=case.base_extra,
                   blocks=case.blocks, cv_blocks=case.cv_blocks, fit_fraction=case.fit_fraction)
     doc = rep.to_dict()
-    named = named_effects(doc)
-    plain = [e["name"] for e in doc["effects"]]
-    unexplained = bool(doc["unexplained"]["unexplained"])
+    out = fit_outcome(doc)
     # the issue's verdict: the true effect named alone; nothing named on a control run
-    right = plain == ([case.truth] if case.truth else [])
-    val = doc["error_after"]["validation"]
-    return {"run": case.label, "truth": case.truth, "named": named,
-            "unexplained": unexplained, "right": right,
-            "validation_rmse": {c: v["rmse"] for c, v in val.items()},
+    right = out["named_plain"] == ([case.truth] if case.truth else [])
+    return {"run": case.label, "truth": case.truth, "named": named_effects(doc),
+            "unexplained": out["unexplained"], "right": right,
+            "validation_rmse": out["validation_rmse"],
             "cross_validated_rmse": {c: v["rmse"] for c, v in (
                 doc["cross_validation"].get("final", {}).get("pooled", {}).items())},
-            "within_tolerance": {c: v["rmse"] <= (1.5 if c == "P1" else 1.0)
-                                 for c, v in val.items()},
+            "within_tolerance": {c: v <= channel_tolerance(c) * edge_scale(c)
+                                 for c, v in out["validation_rmse"].items()},
             "implausible": {k: round(v, 2) for k, v in (doc.get("parameters_prior_z") or {})
                             .items() if abs(v) > 2.58},
             **selection_trace(doc, ("estimate", "se", "z", "p_value", "model_reference", "scale", "scales")),
@@ -102,41 +101,24 @@ def main(argv: list[str] | None = None) -> None:
     if args.spec_mismatch is not None and args.spec_mismatch < 0:
         ap.error("--spec-mismatch: a seed >= 0")
 
-    from compare.executor import run_cases, stderr_progress
-
-    truth = json.loads((args.runs / "truth.json").read_text(encoding="utf-8"))
+    truth = read_truth(args.runs)
     labels = args.only or sorted(truth)
     extra = (None if args.base_extra is None
              else tuple(n for n in args.base_extra if n != "none"))
     cases = [DevRun(args.runs / f"{k}.csv", args.spec, truth[k]["truth"], extra,
                     args.blocks, args.cv_blocks, args.fit_fraction, args.spec_mismatch)
              for k in labels]
-    t = time.perf_counter()
-    outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
-    rows = []
-    print(f"{'run':8} {'truth':24} {'named':30} ok  validation RMS after (T1 T2 Tst K, P1 µm)"
-          "   s  cross-validated RMS after")
-    for o in outcomes:
-        if o.error:
-            print(f"{o.label:8} failed: {o.error}")
-            continue
-        r = o.value
-        rows.append(r)
-        v = r["validation_rmse"]
-        named = ", ".join(r["named"]) or ("unexplained" if r["unexplained"] else "nothing")
-        print(f"{r['run']:8} {str(r['truth']):24} {named:30} {'yes' if r['right'] else 'NO ':3} "
-              + " ".join(f"{v.get(c, float('nan')):5.2f}" for c in ("T1", "T2", "T_stator", "P1"))
-              + f" {r['seconds']:5.0f}  "
-              + " ".join(f"{r['cross_validated_rmse'].get(c, float('nan')):5.2f}"
-                         for c in ("T1", "T2", "T_stator", "P1"))
-              + (f"  implausible {r['implausible']}"
-                                            if r["implausible"] else ""))
-    n_right = sum(r["right"] for r in rows)
-    print(f"right verdicts: {n_right} of {len(cases)}; wall time {time.perf_counter() - t:.0f} s "
-          f"on {args.workers} workers")
-    if args.json:
-        args.json.write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
 
+    def line(r: dict) -> str:
+        return (f"{r['run']:8} {str(r['truth']):24} "
+                f"{named_text(r['named'], r['unexplained']):30} {'yes' if r['right'] else 'NO ':3} "
+                f"{rms_cells(r['validation_rmse'])} {r['seconds']:5.0f}  "
+                f"{rms_cells(r['cross_validated_rmse'])}"
+                + (f"  implausible {r['implausible']}" if r["implausible"] else ""))
+
+    run_verdicts(fit_one, cases, workers=args.workers, line=line, json_path=args.json,
+                 header=f"{'run':8} {'truth':24} {'named':30} ok  {RMS_HEADER}   s  "
+                        "cross-validated RMS after")
 
 if __name__ == "__main__":
     main()

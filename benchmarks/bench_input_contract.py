@@ -23,10 +23,11 @@ import io
 import json
 import random
 import re
-import sys
 import tempfile
 import time
 from pathlib import Path
+
+from verdicts import run_verdicts
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "spindle" / "data" / "specs"
@@ -181,13 +182,27 @@ def run_case(case: dict) -> dict:
             temps = [v for v in (doc.get("sensors_C") or {}).values() if v is not None]
             impossible = "NaN" in text or any(v <= -273.15 for v in temps)
     first = lines[0] if lines else ""
-    return {"kind": case["kind"], "label": case["label"], "exit": code, "traceback": traceback,
-            "lines": len(lines), "seconds": round(seconds, 2),
-            "clean": code == 2 and len(lines) >= 1 and ("fix:" in first or "usage:" in first
-                                                        or "error:" in first),
-            "one_line": code != 2 or len(lines) == 1 or first.startswith("usage:"),
-            "written_on_refusal": bool(written) and code != 0,
-            "inputs_modified": after != before, "impossible": impossible, "message": first[:200]}
+    row = {"kind": case["kind"], "label": case["label"], "exit": code, "traceback": traceback,
+           "lines": len(lines), "seconds": round(seconds, 2),
+           "clean": code == 2 and len(lines) >= 1 and ("fix:" in first or "usage:" in first
+                                                       or "error:" in first),
+           "one_line": code != 2 or len(lines) == 1 or first.startswith("usage:"),
+           "written_on_refusal": bool(written) and code != 0,
+           "inputs_modified": after != before, "impossible": impossible, "message": first[:200]}
+    # the contract held: no traceback, a refusal clean and in one line, nothing impossible
+    # written, no input touched, nothing left by a refusal, within a minute
+    row["right"] = not (row["traceback"] or (code != 0 and not row["clean"])
+                        or not row["one_line"] or impossible or row["inputs_modified"]
+                        or row["written_on_refusal"] or seconds > 60)
+    return row
+
+
+class Case(dict):
+    """A case (files, command line) with the label the runner's progress prints."""
+
+    @property
+    def label(self) -> str:
+        return f"{self['kind']} {self['label']}"
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -196,6 +211,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--cycles", type=int, default=80, help="cycle mutations (default 80)")
     ap.add_argument("--bench", type=int, default=60, help="bench-file breaks (default 60)")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--workers", type=int, default=2, help="cases at a time (default 2)")
     ap.add_argument("--json", type=Path, help="also write every case's outcome here")
     args = ap.parse_args(argv)
     import compare.entry  # noqa: F401  (one BLAS thread, as the command runs)
@@ -203,11 +219,12 @@ def main(argv: list[str] | None = None) -> None:
     rng = random.Random(args.seed)
     cases = (spec_cases(rng, args.specs) + cycle_cases(rng, args.cycles)
              + bench_cases(rng, args.bench) + option_cases())
-    rows, t0 = [], time.perf_counter()
-    for i, case in enumerate(cases, 1):
-        rows.append(run_case(case))
-        if i % 25 == 0:
-            print(f"[{i}/{len(cases)}] {time.perf_counter() - t0:.0f} s", file=sys.stderr)
+    t0 = time.perf_counter()
+    rows = run_verdicts(
+        run_case, [Case(c) for c in cases], workers=args.workers, json_path=args.json,
+        header="cases where the contract failed:",
+        line=lambda r: "" if r["right"] else (f"  ! {r['kind']} {r['label']}: exit {r['exit']} "
+                                              f"{r['traceback'] or ''} {r['message']}"))
     refused = [r for r in rows if r["exit"] != 0]
     kinds = ", ".join(f"{k} {sum(r['kind'] == k for r in rows)}"
                       for k in ("spec", "cycle", "bench", "option"))
@@ -222,15 +239,6 @@ def main(argv: list[str] | None = None) -> None:
     print(f"  impossible results written: {sum(r['impossible'] for r in rows)}")
     print(f"  inputs modified: {sum(r['inputs_modified'] for r in rows)}")
     print(f"  files written on a refusal: {sum(r['written_on_refusal'] for r in rows)}")
-    for r in rows:
-        if r["traceback"] or (r["exit"] != 0 and not r["clean"]) or not r["one_line"] \
-                or r["impossible"] or r["inputs_modified"] or r["written_on_refusal"] \
-                or r["seconds"] > 60:
-            print(f"  ! {r['kind']} {r['label']}: exit {r['exit']} {r['traceback'] or ''} "
-                  f"{r['message']}")
-    if args.json:
-        args.json.write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
-
 
 if __name__ == "__main__":
     main()

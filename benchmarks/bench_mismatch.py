@@ -22,6 +22,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from verdicts import RMS_HEADER, fit_outcome, named_text, rms_cells, run_verdicts
+
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
 
@@ -55,18 +57,17 @@ def run_one(case: Case) -> dict:
             truth = synth(spec, case.cycle, case.effect, case.seed, run, mismatch=True)
         t_synth = time.perf_counter() - t
         doc = run_fit(run, spec).to_dict()
-    named = [e["name"] for e in doc["effects"]]
-    unexplained = bool(doc["unexplained"]["unexplained"])
+    out = fit_outcome(doc)
+    named, unexplained = out["named_plain"], out["unexplained"]
     if case.effect == "clean":
         right = named == []
     elif case.effect == "electronics_drift":
         right = named == [] and unexplained
     else:
         right = named == [case.effect]
-    val = doc["error_after"]["validation"]
     return {"case": case.label, "effect": case.effect, "seed": case.seed, "named": named,
             "how": [e.get("needed_by") for e in doc["effects"]], "unexplained": unexplained,
-            "right": right, "validation_rmse": {c: v["rmse"] for c, v in val.items()},
+            "right": right, "validation_rmse": out["validation_rmse"],
             "truth": truth, "synth_s": t_synth,
             **selection_trace(doc),
             "seconds": time.perf_counter() - t}
@@ -90,37 +91,19 @@ def main(argv: list[str] | None = None) -> None:
     if args.keep:
         args.keep.mkdir(parents=True, exist_ok=True)
 
-    from compare.executor import run_cases, stderr_progress
-
     effects = args.only or [*sorted(EFFECTS), "clean", "electronics_drift"]
     cases = [Case(e, s, args.cycle, args.spec, str(args.keep) if args.keep else None)
              for e in effects for s in args.seeds]
-    t = time.perf_counter()
-    outcomes = run_cases(run_one, cases, workers=args.workers, progress=stderr_progress())
-    rows = []
-    print(f"{'case':26} {'named':34} ok  validation RMS after (T1 T2 Tst K, P1 µm)    s")
-    for o in outcomes:
-        if o.error:
-            print(f"{o.label:26} failed: {o.error}")
-            continue
-        r = o.value
-        rows.append(r)
-        v = r["validation_rmse"]
-        named = ", ".join(f"{n} ({h})" for n, h in zip(r["named"], r["how"], strict=True)) \
-            or ("unexplained" if r["unexplained"] else "nothing")
-        print(f"{r['case']:26} {named:34} {'yes' if r['right'] else 'NO ':3} "
-              + " ".join(f"{v.get(c, float('nan')):5.2f}" for c in ("T1", "T2", "T_stator", "P1"))
-              + f" {r['seconds']:5.0f}")
-    print("right, per effect:")
-    for e in effects:
-        mine = [r for r in rows if r["effect"] == e]
-        print(f"  {e:24} {sum(r['right'] for r in mine)} of {len(mine)}")
-    n_right = sum(r["right"] for r in rows)
-    print(f"right verdicts: {n_right} of {len(cases)}; wall time {time.perf_counter() - t:.0f} s "
-          f"on {args.workers} workers")
-    if args.json:
-        args.json.write_text(json.dumps(rows, indent=2, default=str) + "\n", encoding="utf-8")
 
+    def line(r: dict) -> str:
+        named = named_text([f"{n} ({h})" for n, h in zip(r["named"], r["how"], strict=True)],
+                           r["unexplained"])
+        return (f"{r['case']:26} {named:34} {'yes' if r['right'] else 'NO ':3} "
+                f"{rms_cells(r['validation_rmse'])} {r['seconds']:5.0f}")
+
+    run_verdicts(run_one, cases, workers=args.workers, line=line, json_path=args.json,
+                 group=lambda r: r["effect"],
+                 header=f"{'case':26} {'named':34} ok  {RMS_HEADER}    s")
 
 if __name__ == "__main__":
     main()

@@ -15,11 +15,12 @@ named).
 from __future__ import annotations
 
 import argparse
-import json
 import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from verdicts import RMS_HEADER, fit_outcome, named_text, read_truth, rms_cells, run_verdicts
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
@@ -79,13 +80,12 @@ def fit_one(case: Injected) -> dict:
     named = named_effects(doc)
     want = [] if case.effect == "none" else [case.effect + (f"({case.channel})"
                                                            if case.channel else "")]
-    val = doc["error_after"]["validation"]
+    out = fit_outcome(doc)
     estimate = {k: v for e in doc["effects"] for k, v in e["parameters"].items()
                 if k != "channel"}
     return {"case": case.label, "truth": want, "named": named, "right": named == want,
-            "unexplained": bool(doc["unexplained"]["unexplained"]), "injected": case.params,
-            "estimate": estimate,
-            "validation_rmse": {c: v["rmse"] for c, v in val.items()},
+            "unexplained": out["unexplained"], "injected": case.params,
+            "estimate": estimate, "validation_rmse": out["validation_rmse"],
             **selection_trace(doc),
             "seconds": time.perf_counter() - t}
 
@@ -108,39 +108,20 @@ def main(argv: list[str] | None = None) -> None:
     if args.spec_mismatch is not None and args.spec_mismatch < 0:
         ap.error("--spec-mismatch: a seed >= 0")
 
-    from compare.executor import run_cases, stderr_progress
-
-    truth_file = args.runs / "truth.json"
-    if not truth_file.is_file():
-        raise SystemExit(f"error: {truth_file} not found; --runs must name a folder with the "
-                         "runs' truth.json (../shared/bench-runs)")
-    truth = json.loads(truth_file.read_text(encoding="utf-8"))
+    truth = read_truth(args.runs)
     controls = args.controls or sorted(k for k, v in truth.items()
                                        if v.get("truth") in (None, "none"))
     cases = [Injected(args.runs / f"{c}.csv", e, p, ch, args.spec, args.spec_mismatch)
              for c in controls
              for e, p, ch in INJECTIONS if not args.only or e in args.only]
-    t = time.perf_counter()
-    outcomes = run_cases(fit_one, cases, workers=args.workers, progress=stderr_progress())
-    rows = []
-    print(f"{'case':46} {'named':26} ok  estimate      validation RMS after (T1 T2 Tst K, P1 µm)")
-    for o in outcomes:
-        if o.error:
-            print(f"{o.label:46} failed: {o.error}")
-            continue
-        r = o.value
-        rows.append(r)
-        v = r["validation_rmse"]
-        named = ", ".join(r["named"]) or ("unexplained" if r["unexplained"] else "nothing")
-        est = " ".join(f"{x:.3g}" for x in r["estimate"].values())
-        print(f"{r['case']:46} {named:26} {'yes' if r['right'] else 'NO ':3} {est:13} "
-              + " ".join(f"{v.get(c, float('nan')):5.2f}" for c in ("T1", "T2", "T_stator", "P1")))
-    n_right = sum(r["right"] for r in rows)
-    print(f"right verdicts: {n_right} of {len(cases)}; wall time {time.perf_counter() - t:.0f} s "
-          f"on {args.workers} workers")
-    if args.json:
-        args.json.write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
 
+    def line(r: dict) -> str:
+        est = " ".join(f"{x:.3g}" for x in r["estimate"].values())
+        return (f"{r['case']:46} {named_text(r['named'], r['unexplained']):26} "
+                f"{'yes' if r['right'] else 'NO ':3} {est:13} {rms_cells(r['validation_rmse'])}")
+
+    run_verdicts(fit_one, cases, workers=args.workers, line=line, json_path=args.json,
+                 header=f"{'case':46} {'named':26} ok  estimate      {RMS_HEADER}")
 
 if __name__ == "__main__":
     main()

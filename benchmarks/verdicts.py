@@ -1,0 +1,88 @@
+"""What the verdict benchmarks share (bench_devruns, bench_mismatch, bench_peerinject,
+bench_input_contract): run cases through :func:`compare.executor.run_cases`, print a row per
+case, count the right verdicts (in all and per group), write the rows as JSON.
+
+A benchmark gives ``one(case) -> dict`` (a row with a boolean ``"right"``), a header and
+``line(row) -> str``; :func:`run_verdicts` does the rest. Imported by the scripts beside it
+(``python benchmarks/bench_x.py`` puts this folder on the path).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+#: the channels of a fit's validation RMS, in the order the tables print them
+CHANNELS = ("T1", "T2", "T_stator", "P1")
+RMS_HEADER = "validation RMS after (T1 T2 Tst K, P1 µm)"
+
+
+def rms_cells(rmse: dict[str, float], width: int = 5) -> str:
+    """The RMS per channel [K; µm for P1] as fixed-width cells (nan where a run lacks one)."""
+    return " ".join(f"{rmse.get(c, float('nan')):{width}.2f}" for c in CHANNELS)
+
+
+def fit_outcome(doc: dict) -> dict:
+    """What every verdict table reads from a fit's report.json: the named effects (plain
+    names), whether the report says unexplained, and the validation RMS after per channel."""
+    return {"named_plain": [e["name"] for e in doc["effects"]],
+            "unexplained": bool(doc["unexplained"]["unexplained"]),
+            "validation_rmse": {c: v["rmse"] for c, v in doc["error_after"]["validation"]
+                                .items()}}
+
+
+def named_text(named: Sequence[str], unexplained: bool) -> str:
+    """The named effects as the tables print them, or 'unexplained' / 'nothing'."""
+    return ", ".join(named) or ("unexplained" if unexplained else "nothing")
+
+
+def read_truth(folder: Path) -> dict:
+    """The runs' truth.json of a folder; a missing or broken one ends the script with one
+    message and exit status 2, not a traceback."""
+    path = Path(folder) / "truth.json"
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        problem = "not found; --runs must name a folder with the runs and their truth.json"
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        problem = f"cannot be read ({exc}); give a folder with a valid truth.json"
+    print(f"error: {path}: {problem}", file=sys.stderr)
+    sys.exit(2)
+
+
+def run_verdicts(one: Callable[[object], dict], cases: Sequence, *, workers: int,
+                 header: str, line: Callable[[dict], str],
+                 group: Callable[[dict], str] | None = None,
+                 json_path: Path | None = None) -> list[dict]:
+    """Run ``one`` on every case (a process pool of ``workers``, progress on stderr), print
+    ``header`` and a ``line`` per row (an empty line is not printed; a case that failed says
+    so), the right verdicts per ``group`` and in all, and write the rows to ``json_path``.
+    Returns the rows."""
+    from compare.executor import run_cases, stderr_progress
+    from spindle.outputs import write_json
+
+    t = time.perf_counter()
+    outcomes = run_cases(one, list(cases), workers=workers, progress=stderr_progress())
+    rows = []
+    print(header)
+    for o in outcomes:
+        if o.error:
+            print(f"{o.label} failed: {o.error}")
+            continue
+        rows.append(o.value)
+        text = line(o.value)
+        if text:
+            print(text)
+    if group is not None:
+        print("right, per group:")
+        for g in dict.fromkeys(group(r) for r in rows):
+            mine = [r for r in rows if group(r) == g]
+            print(f"  {g:24} {sum(r['right'] for r in mine)} of {len(mine)}")
+    print(f"right verdicts: {sum(r['right'] for r in rows)} of {len(cases)}; wall time "
+          f"{time.perf_counter() - t:.0f} s on {workers} workers")
+    if json_path is not None:
+        write_json(Path(json_path), rows)  # a list, as before: write_json takes any JSON
+    return rows
