@@ -106,7 +106,7 @@ def _regions(spec: Spec) -> list[Region]:
             out.append(Region(part.name, name, spec.materials[sec.material], shape))
     air = spec.materials.get("air")
     if air is None:
-        from spindle.spec import shipped_materials
+        from spindle.spec_reader import shipped_materials
         air = shipped_materials()["air"]
     for i, lk in enumerate(spec.links):
         if not isinstance(lk, AirGapLink):

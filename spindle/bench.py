@@ -9,9 +9,9 @@ rules, errors and decisions in docs/bench.md). This module reads it as it is:
   (comments and blank lines counted) and the fix; the command line turns it into exit status 2.
 * :func:`check_against_spec` maps the measured channels (T1, T2, T_stator, P1) to the spec's
   sensors of the same name and kind.
-* :func:`inputs` turns the run into a :class:`~spindle.loads.LoadCase` on a time grid: speed
-  held, ambient and coolant averaged, heat sources from the drive's power balance per grid
-  interval.
+* :func:`spindle.bench_inputs.inputs` turns the run into a :class:`~spindle.loads.LoadCase`
+  on a time grid: speed held, ambient and coolant averaged, heat sources from the drive's
+  power balance per grid interval.
 
 SI inside (K, m, W, s); °C and µm appear only in the file's column names and in
 :attr:`BenchRun.columns` (which keeps the file's units).
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 import re
 import sys
 import warnings
@@ -32,10 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from spindle.drive import Drive, drive_for
 from spindle.errors import InputError
-from spindle.loads import LoadCase, TimeSeries
-from spindle.power import power_balance
 from spindle.spec import Spec
 from spindle.units import CYCLE_MAX_S, POWER_MAX_KW, SPEED_MAX_RPM, TORQUE_MAX_NM, ZERO_C_K
 
@@ -623,164 +619,3 @@ def check_against_spec(run: BenchRun, spec: Spec) -> list[str]:
                          "T_stator: temperature; P1: kind = \"axial_displacement\"), or use the "
                          "spec of the spindle on the bench")
     return mapped
-
-
-# ============================================================================ model inputs
-
-
-def bench_grid(run: BenchRun, grid_s: float | None = None) -> np.ndarray:
-    """Times of the model's inputs [s]: every ``grid_s`` (default 60 s) from 0 to the end of
-    the run, plus the run's first and last sample times; strictly increasing (points closer
-    than 1e-6 grid_s to the run's start or end are dropped in their favour)."""
-    step = DEFAULT_GRID_S if grid_s is None else float(grid_s)
-    if not math.isfinite(step) or step <= 0:
-        raise InputError(str(run.path), "grid_s", f"{grid_s!r} is not a time step > 0 s",
-                         "give the grid spacing in seconds, e.g. 60")
-    t0, t1 = float(run.time_s[0]), float(run.time_s[-1])
-    pts = np.arange(0.0, t1, step)
-    tol = 1e-6 * step
-    pts = pts[(np.abs(pts - t0) > tol) & (np.abs(pts - t1) > tol)]
-    return np.unique(np.concatenate([pts, [t0, t1]]))
-
-
-def _valid(run: BenchRun, col: str) -> tuple[np.ndarray, np.ndarray]:
-    y = run.columns[col]
-    ok = ~np.isnan(y)
-    return run.time_s[ok], y[ok]
-
-
-def held(t_samples: np.ndarray, y_samples: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Zero-order hold: at each ``t`` the last sample at or before it; before the first
-    sample, the first value (units of y)."""
-    idx = np.searchsorted(t_samples, t, side="right") - 1
-    return y_samples[np.clip(idx, 0, len(y_samples) - 1)]
-
-
-#: speed scatter a drive shows around its set speed: a logged speed within this band of the
-#: current operating step belongs to it (the spindle's drive holds 0.1-0.3 % in practice)
-SPEED_BAND_REL = 0.01
-SPEED_BAND_RPM = 20.0
-
-
-def settled_speed(speed_rpm: np.ndarray, rel: float = SPEED_BAND_REL,
-                  band_rpm: float = SPEED_BAND_RPM) -> np.ndarray:
-    """The operating steps of a logged speed [rpm]: consecutive values within
-    max(``band_rpm``, ``rel`` x level) of the step's first value form one step, which takes
-    their median. The drive's few-rpm scatter then does not make every interval a new
-    operating point (each one costs the models a new set of film coefficients and modes)."""
-    n = np.asarray(speed_rpm, dtype=float)
-    out = np.empty_like(n)
-    start = 0
-    for k in range(1, len(n) + 1):
-        if k == len(n) or abs(n[k] - n[start]) > max(band_rpm, rel * abs(n[start])):
-            out[start:k] = np.median(n[start:k])
-            start = k
-    return out
-
-
-def cell_means(t_samples: np.ndarray, y_samples: np.ndarray, edges: np.ndarray,
-               centres: np.ndarray) -> np.ndarray:
-    """Mean of the samples in each cell [edges[i], edges[i+1]) (the last cell closed), one per
-    cell; a cell without samples gets the samples interpolated linearly at ``centres[i]``
-    (the first or last value held outside them). Units of y."""
-    n = len(edges) - 1
-    k = np.searchsorted(edges, t_samples, side="right") - 1
-    k[t_samples == edges[-1]] = n - 1
-    inside = (k >= 0) & (k < n)
-    count = np.bincount(k[inside], minlength=n)
-    total = np.bincount(k[inside], weights=y_samples[inside], minlength=n)
-    out = np.interp(centres, t_samples, y_samples)
-    has = count > 0
-    out[has] = total[has] / count[has]
-    return out
-
-
-def interval_heat_W(drive: Drive, speed_rpm: float, load_torque_Nm: float,
-                    power_kW: float) -> tuple[dict[str, float], bool]:
-    """Heat per source [W] at one bench operating point, and whether the power was clipped.
-
-    ``drive.heat_W(speed, torque, P)`` with the measured electrical power P [kW] clipped at
-    >= 0. Below ``STANDSTILL_RPM`` the spindle stands: every source is 0 W. If P is below the
-    mechanical power (bearing friction plus load torque) at this speed, as a noisy no-load
-    reading or an interval that straddles a speed step can be, the motor losses are set to 0
-    (P = P_mech) and the bool is True."""
-    if speed_rpm < STANDSTILL_RPM:
-        return {k: 0.0 for k in drive.heat_W(0.0, 0.0, 0.0)}, False
-    P = max(float(power_kW), 0.0)
-    try:
-        return drive.heat_W(speed_rpm, load_torque_Nm, P), False
-    except ValueError:
-        pb = power_balance(drive.motor, drive.bearings_at(speed_rpm), speed_rpm, load_torque_Nm,
-                           drive.T_winding_K)
-        return drive.heat_W(speed_rpm, load_torque_Nm, pb.motor.P_mech_W / 1e3), True
-
-
-def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
-           grid_s: float | None = None) -> tuple[LoadCase, np.ndarray]:
-    """The model inputs of a bench run on a time grid: ``(LoadCase, grid [s])``.
-
-    Grid: :func:`bench_grid` (every ``grid_s``, default 60 s, from 0 to the end, plus the run's
-    first and last sample). Speed [rpm]: the bench logs it on change, so it is held (the last
-    valid sample at or before each grid point; before the first, the first value), a
-    'previous' series on the grid. Ambient and coolant [K]: the mean of the valid samples in
-    the cell around each grid point (half-way to its neighbours), linear between grid points.
-    Power [kW] and load torque [N m] (0 when not measured): the mean of the valid samples in
-    each grid interval [t_i, t_i+1); where an interval or cell has no sample (a gap) the
-    samples are interpolated linearly at its centre. Heat sources [W]: per interval,
-    :func:`interval_heat_W` (the power balance ``drive.heat_W(speed at t_i, torque, power)``),
-    held over the interval ('previous' series at t_i); the spec's sources the power balance
-    does not feed get 0 W. ``drive`` defaults to the spec's ``[power_balance] preset``; without
-    one, InputError. A :class:`BenchWarning` reports intervals where the power was below the
-    mechanical power (motor losses set to 0 there). ``duration_s`` = the run's duration.
-    """
-    drive = drive if drive is not None else drive_for(spec)
-    if drive is None:
-        raise InputError(spec.path, "power_balance.preset", "the spec names no drive, so the bench "
-                         "run's electrical power cannot be turned into heat sources",
-                         "add [power_balance] preset = \"spl2782\" (or the preset of this spindle) to "
-                         "the spec, or pass drive=")
-    grid = bench_grid(run, grid_s)
-    mids = 0.5 * (grid[:-1] + grid[1:])
-    dual = np.concatenate([[grid[0]], mids, [grid[-1]]])
-
-    ts, ys = _valid(run, "speed_rpm")
-    speed = held(ts, ys, grid)
-    T_env = cell_means(*_valid(run, "T_env_C"), dual, grid) + ZERO_C_K
-    T_cool = cell_means(*_valid(run, "T_coolant_C"), dual, grid) + ZERO_C_K
-    power = cell_means(*_valid(run, "power_kW"), grid, mids)
-    torque = (cell_means(*_valid(run, "load_torque_Nm"), grid, mids) if run.load_torque_measured
-              else np.zeros(len(mids)))
-
-    heats: list[dict[str, float]] = []
-    clipped: list[float] = []
-    for i, (n, M, P) in enumerate(zip(speed[:-1], torque, power, strict=True)):
-        h, was_clipped = interval_heat_W(drive, float(n), float(M), float(P))
-        heats.append(h)
-        if was_clipped:
-            clipped.append(float(grid[i]))
-    if clipped:
-        warnings.warn(BenchWarning(
-            f"{run.path}: power_kW: in {len(clipped)} of {len(mids)} intervals (first at "
-            f"t = {clipped[0]:g} s) the mean electrical power is below the mechanical power of the "
-            "bearing friction and load torque at the held speed; the motor losses are 0 there"),
-            stacklevel=2)
-    names = [h.name for h in spec.heat_sources]
-    missing = sorted(set(heats[0]) - set(names))
-    if missing:
-        raise InputError(spec.path, "heat_sources", f"the power balance feeds sources {missing} "
-                         "that the spec does not have",
-                         "name the spec's heat sources stator, rotor, front_bearing, rear_bearing")
-    starts = tuple(float(x) for x in grid[:-1])
-    sources = {k: TimeSeries.constant(0.0) for k in names}
-    sources.update({k: TimeSeries(starts, tuple(float(h[k]) for h in heats), "previous")
-                    for k in heats[0]})
-    times = tuple(float(x) for x in grid)
-    case = LoadCase(
-        name=run.name,
-        speed_rpm=TimeSeries(times, tuple(float(x) for x in speed), "previous"),
-        T_ambient_K=TimeSeries(times, tuple(float(x) for x in T_env), "linear"),
-        T_coolant_K=TimeSeries(times, tuple(float(x) for x in T_cool), "linear"),
-        sources=sources,
-        duration_s=run.duration_s,
-    )
-    return case, grid

@@ -17,7 +17,8 @@ from spindle.cycles import Cycle, load_cycle
 from spindle.drive_file import Drive, read_drive_toml
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries, read_cycle_csv
-from spindle.spec import Spec, drive_file_path, shipped_drives
+from spindle.spec import Spec
+from spindle.spec_reader import drive_file_path, shipped_drives
 
 #: The shipped drives by name, read once at import.
 DRIVES: dict[str, Drive] = {name: read_drive_toml(path) for name, path in shipped_drives().items()}

@@ -17,7 +17,7 @@ from typing import Any
 from spindle.checks import omega_rad_s
 from spindle.errors import Problem, SpecError
 from spindle.power import BearingParams, MotorParams, PowerBalance, bearing_friction, power_balance
-from spindle.spec import read_toml
+from spindle.spec_reader import read_toml
 
 
 @dataclass(frozen=True)

@@ -8,14 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spindle.bench import (
-    BenchRun,
-    BenchWarning,
-    bench_grid,
-    check_against_spec,
-    inputs,
-    read_bench,
-)
+from spindle.bench import BenchRun, BenchWarning, check_against_spec, read_bench
+from spindle.bench_inputs import bench_grid, inputs
 from spindle.drive import drive_for
 from spindle.errors import InputError
 from spindle.power import power_balance
@@ -411,7 +405,7 @@ def test_settled_speed_merges_drive_scatter_and_keeps_real_steps():
     """A drive's +-5 rpm scatter around 1500 and 6000 rpm collapses to one level per step
     (the median of the step's samples); a real step, however small beyond the band (1 % or
     20 rpm), is kept; a standstill stays 0."""
-    from spindle.bench import settled_speed
+    from spindle.bench_inputs import settled_speed
 
     rng = np.random.default_rng(0)
     set_speed = np.repeat([0.0, 1500.0, 1530.0, 6000.0, 0.0], 50)

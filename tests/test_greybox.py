@@ -89,7 +89,7 @@ def test_seat_conductance_is_nested_and_cools_the_rings(setup):
 @pytest.mark.parametrize("scale", [0.88, 1.1])
 def test_axial_scale_is_the_stretched_spindle(setup, scale):
     """The default base extra axial_scale reproduces the network built anew from the spec
-    stretched along its axis (spindle.spec.stretch_axially: another code path, the network
+    stretched along its axis (spindle.stretch.stretch_axially: another code path, the network
     builder on other lengths), on both sides of 1 and away from the probe stretch (1.2) its
     exponents are read at. The per-edge power laws are exact for an edge whose conductance
     is its length or area times a constant; films and contacts that cover part of a mass
@@ -97,7 +97,7 @@ def test_axial_scale_is_the_stretched_spindle(setup, scale):
     stator's sensor noise (0.1 K), and 0.02 um (the noise of P1 is 0.05 um). At 1 the model
     is the spec's to round-off, and the stretch itself moves each channel by far more than
     the tolerance (measured 1.1-1.9 K at x1.145), so the test can fail."""
-    from spindle.spec import stretch_axially
+    from spindle.stretch import stretch_axially
 
     spec, _, inp = setup
     extra = ("G_seat_W_K", "axial_scale")

@@ -65,7 +65,7 @@ def test_fin_shaft_is_the_paper_benchmark():
 
 
 def test_every_shipped_material_cites_a_source():
-    from spindle.spec import shipped_materials
+    from spindle.spec_reader import shipped_materials
 
     for m in shipped_materials().values():
         assert len(m.source) > 20, m.name

@@ -273,7 +273,7 @@ def test_the_air_gap_carries_no_load():
     layer had E = 1e5 Pa); a stiff air gap would couple rotor and stator axially."""
     from dataclasses import replace
 
-    from spindle.spec import shipped_materials
+    from spindle.spec_reader import shipped_materials
 
     spec = load_spec("spl2782")
     air = spec.materials.get("air") or shipped_materials()["air"]

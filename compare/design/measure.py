@@ -20,7 +20,8 @@ from compare.design.formulas import lambda_added, lambda_both, lambda_improved
 from compare.design.stiffness import surface_films
 from spindle.faces import exposed_faces, surface_faces
 from spindle.loads import SpeedTable
-from spindle.spec import Spec, stretch_axially
+from spindle.spec import Spec
+from spindle.stretch import stretch_axially
 
 KINDS = ("added_surface", "improved_coefficient", "both")
 
@@ -112,7 +113,7 @@ def formula_lambda(spec: Spec, measure: Measure, speed_rpm: float) -> tuple[floa
 
 
 def scale_axially(spec: Spec, factor: float) -> Spec:
-    """The spec stretched along the axis by ``factor`` (spindle.spec.stretch_axially); for the
+    """The spec stretched along the axis by ``factor`` (spindle.stretch.stretch_axially); for the
     length sensitivity of Fig. 16."""
     return stretch_axially(spec, factor)
 

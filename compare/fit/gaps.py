@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from compare.fit.greybox import Inputs
-from spindle.bench import SPEED_BAND_REL, SPEED_BAND_RPM
+from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
 
 #: a gap is a stretch without any row longer than this many grid steps
 MIN_GAP_STEPS = 2.0

@@ -39,7 +39,7 @@ from lumped.blocks import Convection, FixedTemperature, PrescribedHeatFlow
 from lumped.build import build_network
 from lumped.elastic import first_order_lag
 from lumped.simulation import LumpedModel
-from spindle.bench import interval_heat_W
+from spindle.bench_inputs import interval_heat_W
 from spindle.drive import Drive
 from spindle.drive_file import FRICTION_REF_RPM, MOTOR_SOURCES
 from spindle.spec import Spec
@@ -121,7 +121,7 @@ EXTRA_BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
     # a spec's axial lengths come from CAD drawings whose undisclosed lengths (bearing
     # spacing, motor and housing lengths) a designer reconstructs to 10-20 %: 0.15 at 1 sigma
     Param("axial_scale", "x", 1.0, 0.8, 1.25, "factor on every axial length of the spindle "
-          "(spindle.spec.stretch_axially): axial conductances / s, radial ones, films and heat "
+          "(spindle.stretch.stretch_axially): axial conductances / s, radial ones, films and heat "
           "capacities x s, the growth chain x s", prior_sd=0.15),
 )}
 
@@ -579,7 +579,7 @@ def _stretch_exponents(spec: Spec, nodes: int
     network's conductances and capacities change from ``spec`` to the stretched spec (value
     ratio = factor^e), and the P1 chain's (its largest row entry's)."""
     from lumped.blocks import conductance_at
-    from spindle.spec import stretch_axially
+    from spindle.stretch import stretch_axially
 
     def plain(sp: Spec) -> LumpedModel:
         return LumpedModel(sp, network=build_network(sp, nodes))

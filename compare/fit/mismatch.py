@@ -27,7 +27,8 @@ import numpy as np
 
 from compare.fit.greybox import film_groups
 from spindle.drive import Drive
-from spindle.spec import ContactLink, Spec, stretch_axially
+from spindle.spec import ContactLink, Spec
+from spindle.stretch import stretch_axially
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from compare.fit.events import EventTest, _through_origin
-from spindle.bench import SPEED_BAND_REL, SPEED_BAND_RPM
+from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
 
 #: no-load segments shorter than this [s] are not read for a drift
 MIN_SEGMENT_S = 1800.0
@@ -98,7 +98,7 @@ class Segment:
 def segments(run) -> list[Segment]:
     """Constant-speed segments of a bench run (spindle.bench.BenchRun): cut where the logged
     speed changes beyond the drive's scatter band between samples (max(20 rpm, 1 %), the band
-    of spindle.bench.settled_speed). Cut only at steps of 200 rpm (the jump tests' STEP_RPM),
+    of spindle.bench_inputs.settled_speed). Cut only at steps of 200 rpm (the jump tests' STEP_RPM),
     a 5800 -> 6000 rpm step stayed inside one segment, and its 100 W more power read as a
     preload's drift at z 2.3 on three synthetic runs without one (docs/fit.md)."""
     t = np.asarray(run.time_s, dtype=float)

@@ -52,15 +52,8 @@ from compare.fit.greybox import (
     default_theta,
 )
 from compare.report import html_figure, html_page, html_table
-from spindle.bench import (
-    BenchRun,
-    bench_grid,
-    cell_means,
-    check_against_spec,
-    held,
-    read_bench,
-    settled_speed,
-)
+from spindle.bench import BenchRun, check_against_spec, read_bench
+from spindle.bench_inputs import bench_grid, cell_means, held, settled_speed
 from spindle.drive import drive_for
 from spindle.errors import InputError, SolverError
 from spindle.outputs import jsonable

@@ -70,7 +70,8 @@ def _inside(spec: Spec, z: float, r: float) -> bool:
 
 def _fine_points(spec: Spec, part: str, count: int = FINE_POINTS) -> dict[str, tuple[float, float]]:
     """``count`` points evenly along ``part`` at the mid radius of its sections [m]."""
-    from spindle.spec import SensorArray, array_sensors
+    from spindle.spec import SensorArray
+    from spindle.spec_reader import array_sensors
 
     sensors = array_sensors(SensorArray(f"{part}_fine", part, count, "mid"), spec.part(part))
     return {s.name: (s.z, s.r) for s in sensors}
