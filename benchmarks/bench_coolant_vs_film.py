@@ -74,7 +74,7 @@ def main(argv: list[str] | None = None) -> None:
     from spindle.bench import read_bench
     from spindle.cycles import drawn_cycle
     from spindle.drive import cycle_load_case, drive_for
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     t0 = time.perf_counter()
     spec = load_spec("spl2782")

@@ -49,7 +49,7 @@ class DevRun:
 def fit_one(case: DevRun) -> dict:
     """``fit`` on one run; the figures the table prints."""
     from compare.fit.run import named_effects, run_fit, selection_trace
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
     from spindle.tolerances import channel_tolerance, edge_scale
 
     t = time.perf_counter()

@@ -33,7 +33,7 @@ def main(argv: list[str] | None = None) -> None:
     from compare.fit.synth import synth
     from spindle.bench import read_bench
     from spindle.drive import drive_for
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     folder = Path(args.keep) if args.keep else Path(tempfile.mkdtemp())
     spec = load_spec("spl2782")

@@ -23,9 +23,9 @@ PAPER_SIMULINK_S = 12.0  # seed paper, section 2.2: 12 s for a 16 h cycle
 def bench(spec_name: str, nodes: int, repeat: int) -> dict:
     from lumped import build
     from lumped.realtime import RealTimePredictor
-    from spindle.cycles import load_cycle
+    from spindle.cycle_files import load_cycle
     from spindle.drive import cycle_load_case, drive_for
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(spec_name)
     t = time.perf_counter()

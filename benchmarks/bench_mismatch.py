@@ -44,7 +44,7 @@ def run_one(case: Case) -> dict:
     """``synth --mismatch`` then ``fit`` on one case; the figures the table prints."""
     from compare.fit.run import run_fit, selection_trace
     from compare.fit.synth import synth
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     t = time.perf_counter()
     spec = load_spec(case.spec)

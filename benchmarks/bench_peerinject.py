@@ -62,7 +62,7 @@ def fit_one(case: Injected) -> dict:
     """Inject, then ``fit``; the figures the table prints."""
     from compare.fit.inject import inject
     from compare.fit.run import named_effects, run_fit, selection_trace
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     t = time.perf_counter()
     text = case.control.read_text(encoding="utf-8")

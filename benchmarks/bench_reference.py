@@ -25,7 +25,7 @@ def one_level(spec_name: str, level: int, order: int) -> dict:
     from meshes import build_mesh
     from reference import ThermalModel
     from reference.thermal import factorize
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(spec_name)
     t = time.perf_counter()
@@ -63,7 +63,7 @@ def one_level(spec_name: str, level: int, order: int) -> dict:
 def cycle(spec_name: str, level: int, order: int, hours: float = 16.0) -> dict:
     from reference import ReferenceModel
     from spindle.loads import LoadCase, TimeSeries
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(spec_name)
     base = spec.default_load_case()

@@ -28,7 +28,8 @@ from compare.crosscheck.elastic_data import elastic_constraints
 from compare.crosscheck.frd import read_frd
 from compare.crosscheck.twin import reading_rows
 from reference.simulation import ReferenceModel
-from spindle.spec import Spec, load_spec
+from spindle.spec import Spec
+from spindle.spec_reader import load_spec
 
 LAYER = "rolling_layer_equivalent"
 

@@ -50,17 +50,8 @@ from spindle.errors import Problem, SpecError
 from spindle.faces import Face, exposed_faces, surface_faces
 from spindle.geometry import TOL_M
 from spindle.loads import SpeedTable
-from spindle.spec import (
-    BEARING_ROLES,
-    AirGapLink,
-    BearingLink,
-    ContactLink,
-    HeatSource,
-    Part,
-    Section,
-    Spec,
-    as_spec,
-)
+from spindle.spec import BEARING_ROLES, AirGapLink, BearingLink, ContactLink, HeatSource, Part, Section, Spec
+from spindle.spec_reader import as_spec
 
 #: the paper's models: 5 masses along shaft and housing (Fig. 5), and 11 (the 11 virtual
 #: sensors of [6], extended by the two bearing temperatures)

@@ -80,7 +80,7 @@ class Fin:
         """
         from spindle.errors import Problem, SpecError
         from spindle.faces import exposed_faces, surface_faces
-        from spindle.spec import as_spec
+        from spindle.spec_reader import as_spec
 
         spec = as_spec(spec)
 

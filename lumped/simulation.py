@@ -18,7 +18,8 @@ from lumped.results import LumpedSteadyResult, LumpedTransientResult
 from spindle.errors import SolverError
 from spindle.geometry import TOL_M
 from spindle.loads import LoadCase, start_temperature_K, time_grid
-from spindle.spec import Spec, as_spec
+from spindle.spec import Spec
+from spindle.spec_reader import as_spec
 
 
 class LumpedModel:

@@ -18,7 +18,8 @@ from skfem import MeshTri
 from spindle.errors import Problem, SpecError
 from spindle.faces import closed_radii
 from spindle.geometry import TOL_M, Trapezoid
-from spindle.spec import AirGapLink, BearingLink, ContactLink, Material, Spec, as_spec
+from spindle.spec import AirGapLink, BearingLink, ContactLink, Material, Spec
+from spindle.spec_reader import as_spec
 
 #: Facets whose normal is within 45 degrees of +r are "outer", of -r "inner", of +z "front".
 _SIDE_OF = {(True, True): "outer", (True, False): "inner",

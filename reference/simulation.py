@@ -16,7 +16,8 @@ from reference.elastic import ThermoelasticModel
 from reference.results import SteadyResult, TransientResult
 from reference.thermal import ThermalModel
 from spindle.loads import LoadCase
-from spindle.spec import Spec, as_spec
+from spindle.spec import Spec
+from spindle.spec_reader import as_spec
 from spindle.units import RPM_TO_RAD_S
 
 

@@ -8,8 +8,8 @@ edges, in fields that name their unit (``T1_C``, ``P1_um``).
 
 from spindle.errors import SpecError, SpindleVerifyError
 from spindle.loads import LoadCase, TimeSeries
-from spindle.spec import Spec, load_spec
-from spindle.spec_reader import shipped_specs
+from spindle.spec import Spec
+from spindle.spec_reader import load_spec, shipped_specs
 
 __all__ = [
     "LoadCase",

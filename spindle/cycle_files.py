@@ -1,5 +1,6 @@
-"""Cycle files (format: docs/cycles.md): the TOML reader (:func:`read_cycle_toml`) and the
-CSV step table (:func:`read_cycle_steps_csv`) behind :func:`spindle.cycles.load_cycle`.
+"""Cycle files (format: docs/cycles.md): :func:`load_cycle` takes a shipped cycle's name or a
+file, read by the TOML reader (:func:`read_cycle_toml`) or the CSV step table
+(:func:`read_cycle_steps_csv`), and checks its limits (:func:`check_cycle_limits`).
 
 Temperatures are in degC in files (fields ending ``_C``) and in K in memory. Every problem
 in a file raises :class:`~spindle.errors.InputError` naming the file, the field (with the
@@ -11,6 +12,7 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +31,7 @@ from spindle.cycles import (
 )
 from spindle.errors import InputError
 from spindle.loads import TimeSeries
-from spindle.units import CYCLE_MAX_S, ZERO_C_K
+from spindle.units import CYCLE_MAX_S, POWER_MAX_KW, SPEED_MAX_RPM, TORQUE_MAX_NM, ZERO_C_K
 
 # --------------------------------------------------------------------------- TOML reader
 
@@ -339,3 +341,64 @@ def _meta_temperature(f: _File, meta: dict[str, tuple[str, int]], key: str,
         raise f.error(f"{key} (line {lineno})", f"'{value}' is not a number",
                       f"write '# {key}: 20.0'") from None
     return f.temperature(v, f"{key} (line {lineno})")
+
+
+# --------------------------------------------------------------------------- shipped cycles
+
+
+#: the shortest step of a cycle [s]: shorter ones are a unit mistake (and vanish in the sum of
+#: the durations: a 1e-320 s step after an hour does not advance the time)
+STEP_MIN_S = 1e-3
+
+
+def check_cycle_limits(cycle: Cycle, file: str) -> Cycle:
+    """``cycle`` if its speeds and duration are those of a spindle's test cycle
+    (``spindle.units.SPEED_MAX_RPM``, ``CYCLE_MAX_S``); otherwise an InputError naming the
+    step: the work of simulating it would be absurd, and so would the result."""
+    for k, s in enumerate(cycle.steps):
+        if s.duration_s < STEP_MIN_S:
+            raise InputError(file, f"steps[{k}].duration_s", f"{s.duration_s:g} s is shorter "
+                             f"than {STEP_MIN_S:g} s", "give step durations in seconds "
+                             "(duration_s) or hours (duration_h)")
+        if s.speed_rpm > SPEED_MAX_RPM:
+            raise InputError(file, f"steps[{k}].speed_rpm", f"{s.speed_rpm:g} rpm is above "
+                             f"{SPEED_MAX_RPM:g} rpm, faster than any motor spindle",
+                             "give the speed in rpm (1/min)")
+        if abs(s.load_torque_Nm) > TORQUE_MAX_NM:
+            raise InputError(file, f"steps[{k}].load_torque_Nm", f"{s.load_torque_Nm:g} N m is "
+                             f"beyond ±{TORQUE_MAX_NM:g} N m, more than any motor spindle "
+                             "delivers", "give the process load torque in N m")
+        if s.power_kW is not None and abs(s.power_kW) > POWER_MAX_KW:
+            raise InputError(file, f"steps[{k}].power_kW", f"{s.power_kW:g} kW is beyond "
+                             f"±{POWER_MAX_KW:g} kW", "give the electrical power in kW (a value "
+                             "in W is 1000 times too large)")
+    if cycle.duration_s > CYCLE_MAX_S:
+        raise InputError(file, "duration_s", f"the steps last {cycle.duration_s / 3600:.4g} h, "
+                         f"more than {CYCLE_MAX_S / 3600:g} h", "give step durations in seconds "
+                         "(duration_s) or hours (duration_h) for a run of hours to days")
+    return cycle
+
+
+def shipped_cycles() -> dict[str, Path]:
+    """Shipped cycles (spindle/data/cycles/*.toml and *.csv) by name (the file stem)."""
+    root = resources.files("spindle").joinpath("data/cycles")
+    return {Path(str(p)).stem: Path(str(p)) for p in sorted(root.iterdir(), key=str)
+            if str(p).endswith((".toml", ".csv"))}
+
+
+def load_cycle(name_or_path: str | Path) -> Cycle:
+    """A cycle from a file (``.toml`` or ``.csv``) or the name of a shipped cycle."""
+    p = Path(name_or_path)
+    if not p.is_file():
+        shipped = shipped_cycles()
+        if str(name_or_path) not in shipped:
+            raise InputError(str(name_or_path), "file", "is neither a file nor a shipped cycle",
+                             f"give the path of a .toml or .csv cycle or one of {sorted(shipped)}")
+        p = shipped[str(name_or_path)]
+    suffix = p.suffix.lower()
+    if suffix == ".toml":
+        return check_cycle_limits(read_cycle_toml(p), str(p))
+    if suffix == ".csv":
+        return check_cycle_limits(read_cycle_steps_csv(p), str(p))
+    raise InputError(str(p), "file", f"unknown cycle file type '{p.suffix}'",
+                     "give a .toml cycle or a .csv step table")

@@ -28,8 +28,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
-from importlib import resources
-from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -42,11 +40,7 @@ if TYPE_CHECKING:  # only for the annotation: spec.py is not imported at run tim
 
 #: 0 degC in K.
 from spindle.units import (
-    CYCLE_MAX_S,
     MAX_SERIES_POINTS,
-    POWER_MAX_KW,
-    SPEED_MAX_RPM,
-    TORQUE_MAX_NM,
     ZERO_C_K,
 )
 
@@ -378,66 +372,3 @@ def drawn_cycle(name: str, seed: int) -> Cycle:
         raise ValueError(f"a drawn cycle is one of {RANDOM_CYCLES}, not {name!r}")
     return random_cycle(np.random.default_rng([seed, 2]), RANDOM_MAX_SPEED_RPM,
                         loaded=name == "random-loaded", ramped=name == "random-ramped-load")
-
-
-# --------------------------------------------------------------------------- shipped cycles
-
-
-#: the shortest step of a cycle [s]: shorter ones are a unit mistake (and vanish in the sum of
-#: the durations: a 1e-320 s step after an hour does not advance the time)
-STEP_MIN_S = 1e-3
-
-
-def check_cycle_limits(cycle: Cycle, file: str) -> Cycle:
-    """``cycle`` if its speeds and duration are those of a spindle's test cycle
-    (``spindle.units.SPEED_MAX_RPM``, ``CYCLE_MAX_S``); otherwise an InputError naming the
-    step: the work of simulating it would be absurd, and so would the result."""
-    for k, s in enumerate(cycle.steps):
-        if s.duration_s < STEP_MIN_S:
-            raise InputError(file, f"steps[{k}].duration_s", f"{s.duration_s:g} s is shorter "
-                             f"than {STEP_MIN_S:g} s", "give step durations in seconds "
-                             "(duration_s) or hours (duration_h)")
-        if s.speed_rpm > SPEED_MAX_RPM:
-            raise InputError(file, f"steps[{k}].speed_rpm", f"{s.speed_rpm:g} rpm is above "
-                             f"{SPEED_MAX_RPM:g} rpm, faster than any motor spindle",
-                             "give the speed in rpm (1/min)")
-        if abs(s.load_torque_Nm) > TORQUE_MAX_NM:
-            raise InputError(file, f"steps[{k}].load_torque_Nm", f"{s.load_torque_Nm:g} N m is "
-                             f"beyond ±{TORQUE_MAX_NM:g} N m, more than any motor spindle "
-                             "delivers", "give the process load torque in N m")
-        if s.power_kW is not None and abs(s.power_kW) > POWER_MAX_KW:
-            raise InputError(file, f"steps[{k}].power_kW", f"{s.power_kW:g} kW is beyond "
-                             f"±{POWER_MAX_KW:g} kW", "give the electrical power in kW (a value "
-                             "in W is 1000 times too large)")
-    if cycle.duration_s > CYCLE_MAX_S:
-        raise InputError(file, "duration_s", f"the steps last {cycle.duration_s / 3600:.4g} h, "
-                         f"more than {CYCLE_MAX_S / 3600:g} h", "give step durations in seconds "
-                         "(duration_s) or hours (duration_h) for a run of hours to days")
-    return cycle
-
-
-def shipped_cycles() -> dict[str, Path]:
-    """Shipped cycles (spindle/data/cycles/*.toml and *.csv) by name (the file stem)."""
-    root = resources.files("spindle").joinpath("data/cycles")
-    return {Path(str(p)).stem: Path(str(p)) for p in sorted(root.iterdir(), key=str)
-            if str(p).endswith((".toml", ".csv"))}
-
-
-def load_cycle(name_or_path: str | Path) -> Cycle:
-    """A cycle from a file (``.toml`` or ``.csv``) or the name of a shipped cycle."""
-    p = Path(name_or_path)
-    if not p.is_file():
-        shipped = shipped_cycles()
-        if str(name_or_path) not in shipped:
-            raise InputError(str(name_or_path), "file", "is neither a file nor a shipped cycle",
-                             f"give the path of a .toml or .csv cycle or one of {sorted(shipped)}")
-        p = shipped[str(name_or_path)]
-    from spindle.cycle_files import read_cycle_steps_csv, read_cycle_toml
-
-    suffix = p.suffix.lower()
-    if suffix == ".toml":
-        return check_cycle_limits(read_cycle_toml(p), str(p))
-    if suffix == ".csv":
-        return check_cycle_limits(read_cycle_steps_csv(p), str(p))
-    raise InputError(str(p), "file", f"unknown cycle file type '{p.suffix}'",
-                     "give a .toml cycle or a .csv step table")

@@ -13,7 +13,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from spindle.cycles import Cycle, load_cycle
+from spindle.cycle_files import load_cycle
+from spindle.cycles import Cycle
 from spindle.drive_file import Drive, read_drive_toml
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries, read_cycle_csv

@@ -2,8 +2,8 @@
 heat sources and sensors, in SI units, as frozen dataclasses. See docs/spec.md for every
 field.
 
-:func:`load_spec` reads and validates a TOML file (:mod:`spindle.spec_reader`); every
-problem found is reported at once, each naming the file, the field and the fix
+:func:`spindle.spec_reader.load_spec` reads and validates a TOML file; every problem found
+is reported at once, each naming the file, the field and the fix
 (:class:`~spindle.errors.SpecError`).
 """
 
@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from spindle.geometry import Trapezoid
 from spindle.loads import LoadCase, SpeedTable, TimeSeries
@@ -207,20 +206,3 @@ class Spec:
             T_coolant_K=TimeSeries.constant(self.T_coolant_K),
             sources={h.name: h.power_W for h in self.heat_sources},
         )
-
-
-def load_spec(name_or_path: str | Path) -> Spec:
-    """Read and validate a spec (a file path or a shipped name). Raises SpecError."""
-    from spindle.spec_reader import read_spec
-
-    return read_spec(name_or_path)
-
-
-def as_spec(spec: Spec | str | Path) -> Spec:
-    """``spec`` itself, or the spec a shipped name or a file path names (:func:`load_spec`):
-    what every public constructor that takes a spec accepts, as the command line does."""
-    if isinstance(spec, Spec):
-        return spec
-    if isinstance(spec, str | Path):
-        return load_spec(spec)
-    raise TypeError(f"a spec is a Spec, a shipped name or a path, not {type(spec).__name__}")

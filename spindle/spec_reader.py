@@ -1,6 +1,6 @@
 """Reading and validating a spec file (TOML, docs/spec.md) into a :class:`spindle.spec.Spec`.
 
-:func:`read_spec` (what :func:`spindle.spec.load_spec` calls) reads every table, collects
+:func:`load_spec` reads every table, collects
 every problem at once (each naming the file, the field and the fix) and raises
 :class:`~spindle.errors.SpecError` with all of them; the geometry is checked once the tables
 read cleanly. Also here: the shipped specs, materials and drives, and where a
@@ -137,10 +137,20 @@ def read_toml(path: Path) -> dict:
                                  "check the path and that the file is UTF-8 text")]) from None
 
 
-def read_spec(name_or_path: str | Path) -> Spec:
+def load_spec(name_or_path: str | Path) -> Spec:
     """Read and validate a spec (a file path or a shipped name). Raises SpecError."""
     path = resolve_spec_path(name_or_path)
     return _build(FieldReader(str(path)), read_toml(path))
+
+
+def as_spec(spec: Spec | str | Path) -> Spec:
+    """``spec`` itself, or the spec a shipped name or a file path names (:func:`load_spec`):
+    what every public constructor that takes a spec accepts, as the command line does."""
+    if isinstance(spec, Spec):
+        return spec
+    if isinstance(spec, str | Path):
+        return load_spec(spec)
+    raise TypeError(f"a spec is a Spec, a shipped name or a path, not {type(spec).__name__}")
 
 
 def _build(r: FieldReader, data: dict[str, Any]) -> Spec:

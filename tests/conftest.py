@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from skfem import Functional
 
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 MATERIALS = """
 [materials.mat_a]

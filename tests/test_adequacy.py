@@ -108,7 +108,7 @@ def test_base_inadequacy_on_a_peer_control_run():
     tolerance and moves the jacket film beyond its prior range: the verdict says both, and
     where to look (slow: one fit, about 30 s; test_synth_then_fit_end_to_end covers the path)."""
     from compare.fit.run import run_fit
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     ad = run_fit(PEER_RUNS / "dev-09.csv", load_spec("spl2782")).base_adequacy
     assert not ad["adequate"]

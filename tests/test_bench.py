@@ -13,7 +13,7 @@ from spindle.bench_inputs import bench_grid, inputs
 from spindle.drive import drive_for
 from spindle.errors import InputError
 from spindle.power import power_balance
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 HEADER = "time_s,speed_rpm,power_kW,T_env_C,T_coolant_C,T1_C,T2_C,T_stator_C,P1_um"
 

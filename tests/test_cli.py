@@ -112,7 +112,7 @@ def test_fit_bad_base_extra_exits_2(tmp_path, extra, words):
 
 def test_output_never_overwrites_input(tmp_path):
     spec = tmp_path / "sensors.csv"  # an input named like an output
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec.write_text(open(load_spec("fin-shaft").path).read())
     before = spec.read_text()

@@ -6,7 +6,7 @@ import math
 import pytest
 
 from compare.verify.convergence import GCI, ConvergenceResult, convergence_study
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 def series(exact: float, C: float, p: float, levels=(0, 1, 2, 3)):

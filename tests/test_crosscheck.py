@@ -213,7 +213,7 @@ def test_spl2782_growth_of_radial_fields_agrees(field):
     from compare.crosscheck.frd import half_ulp
     from compare.crosscheck.twin import reading_rows, twin_gains
     from reference.simulation import ReferenceModel
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec("spl2782")
     model = ReferenceModel(spec, 0, 2)

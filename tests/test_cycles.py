@@ -10,15 +10,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from spindle.cycle_files import read_cycle_steps_csv, read_cycle_toml
-from spindle.cycles import (
-    Cycle,
-    Step,
-    chiller_cycling,
-    drifting_ambient,
-    load_cycle,
-    shipped_cycles,
-)
+from spindle.cycle_files import load_cycle, read_cycle_steps_csv, read_cycle_toml, shipped_cycles
+from spindle.cycles import Cycle, Step, chiller_cycling, drifting_ambient
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
 

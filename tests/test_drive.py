@@ -5,12 +5,12 @@ import dataclasses
 import pytest
 
 from spindle import drive_file
-from spindle.cycles import load_cycle
+from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES, cycle_load_case, drive_for
 from spindle.drive_file import read_drive_toml
 from spindle.errors import InputError, SpecError
 from spindle.power import BearingParams, MotorParams, power_balance
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 def test_each_step_gets_its_power_balance():

@@ -20,10 +20,11 @@ from compare.fit.greybox import (
     film_groups,
     inputs_from_cycle,
 )
-from spindle.cycles import load_cycle
+from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES
 from spindle.loads import SpeedTable
-from spindle.spec import ContactLink, load_spec
+from spindle.spec import ContactLink
+from spindle.spec_reader import load_spec
 
 CHANNELS = ["T1", "T2", "T_stator", "P1"]
 DRIVE = DRIVES["spl2782"]

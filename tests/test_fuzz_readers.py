@@ -138,7 +138,7 @@ def _ingest_bench(path: Path) -> None:
     """What ``fit`` does with a bench file before calibrating."""
     from compare.fit.run import _measured, greybox_inputs
     from spindle.bench import check_against_spec, read_bench
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     run = read_bench(path)
     channels = check_against_spec(run, load_spec("spl2782"))
@@ -181,7 +181,7 @@ SERIES_CSV = ("time_s,speed_rpm,T_env_C,T_coolant_C\n0,0,20,19.8\n600,3000,20.2,
 def _check_cycle(path: Path) -> None:
     from spindle.drive import load_case
     from spindle.loads import time_grid
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     try:
         case = load_case(load_spec("spl2782"), path)

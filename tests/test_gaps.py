@@ -8,9 +8,9 @@ import pytest
 
 from compare.fit.gaps import gaps_with_change, place_switches
 from compare.fit.greybox import GreyBox, inputs_from_cycle
-from spindle.cycles import load_cycle
+from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 def test_only_gaps_with_a_change_beyond_the_drive_scatter_count():

@@ -11,9 +11,9 @@ from compare.cli import main
 from compare.fit.calibrate import Calibrator, Measured, choose_refit, forward_selection, resample
 from compare.fit.greybox import EFFECTS, GreyBox, inputs_from_cycle
 from lumped import build
-from spindle.cycles import load_cycle
+from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES, cycle_load_case
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 CHANNELS = ["T1", "T2", "T_stator", "P1"]
 

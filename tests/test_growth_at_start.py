@@ -22,7 +22,7 @@ from lumped.realtime import RealTimePredictor
 from reference import ReferenceModel
 from reference.rom import build_rom
 from reference.rom.realtime import ROMPredictor
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from compare.cli import main
 from spindle.errors import SpecError
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 SPECS = Path(__file__).resolve().parents[1] / "spindle" / "data" / "specs"
 FIN = (SPECS / "fin-shaft.toml").read_text(encoding="utf-8")

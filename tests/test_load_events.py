@@ -158,7 +158,7 @@ def test_coolant_signature_on_the_peer_loaded_runs():
     plateaus. About 25 s: two base calibrations."""
     from compare.fit.run import calibrate_base
     from spindle.bench import read_bench
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     truth = json.loads((PEER_RUNS / "truth.json").read_text(encoding="utf-8"))
     assert truth["dev-08"]["truth"] == "coolant_dynamics" and truth["dev-09"]["truth"] is None

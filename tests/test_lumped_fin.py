@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from lumped import Fin, build
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 from tests.conftest import observed_order
 
 

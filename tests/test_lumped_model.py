@@ -7,11 +7,11 @@ import pytest
 
 from lumped import PRESETS, LumpedModel, build
 from lumped.elastic import KelvinVoigt
-from spindle.cycles import load_cycle
+from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES, cycle_load_case
 from spindle.errors import SpecError
 from spindle.loads import LoadCase, TimeSeries
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 @pytest.fixture(scope="module")

@@ -47,9 +47,9 @@ from compare.design.measure_file import (
     shipped_measures,
 )
 from reference import ReferenceModel
-from spindle.cycles import load_cycle
+from spindle.cycle_files import load_cycle
 from spindle.drive import cycle_load_case
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).parent / "data"

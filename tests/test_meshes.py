@@ -7,7 +7,7 @@ import pytest
 from skfem import Basis, ElementTriP0, Functional
 
 from meshes import build_mesh
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 @Functional

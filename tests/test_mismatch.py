@@ -11,7 +11,8 @@ from compare.fit.mismatch import Mismatch, draw_mismatch, perturbed_spec
 from spindle.cycles import ramped_steps, random_cycle
 from spindle.drive import drive_for
 from spindle.faces import exposed_faces, surface_faces
-from spindle.spec import ContactLink, load_spec
+from spindle.spec import ContactLink
+from spindle.spec_reader import load_spec
 
 
 @pytest.fixture(scope="module")

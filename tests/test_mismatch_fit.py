@@ -27,7 +27,7 @@ import pytest
 def test_fit_on_a_mismatched_run(tmp_path, effect, seed, named):
     from compare.fit.run import run_fit
     from compare.fit.synth import synth
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec("spl2782")
     run = tmp_path / f"{effect}.csv"

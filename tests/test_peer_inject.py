@@ -47,7 +47,7 @@ def _fit(control: str, effect: str, params: tuple, channel: str | None) -> list[
 
     from compare.fit.inject import inject
     from compare.fit.run import named_effects, run_fit
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     text = inject((PEER_RUNS / f"{control}.csv").read_text(encoding="utf-8"), effect,
                   dict(params), channel)

@@ -33,7 +33,7 @@ TOLERANCE = {"T1": 1.0, "T2": 1.0, "T_stator": 1.0, "P1": 1.5}  # the paper's: K
 @functools.cache
 def _fit(label: str) -> dict:
     from compare.fit.run import run_fit
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     return run_fit(PEER_RUNS / f"{label}.csv", load_spec("spl2782")).to_dict()
 
@@ -99,7 +99,7 @@ PERTURBED = [("dev-07", 2), ("dev-02", 2), ("dev-06", 2), ("dev-09", 2)]
 def test_verdict_holds_when_the_spec_is_further_off(label, seed):
     from compare.fit.mismatch import perturbed_spec
     from compare.fit.run import run_fit
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     truth = json.loads((PEER_RUNS / "truth.json").read_text(encoding="utf-8"))[label]["truth"]
     doc = run_fit(PEER_RUNS / f"{label}.csv",

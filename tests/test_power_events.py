@@ -145,7 +145,7 @@ def test_power_signatures_on_the_peer_runs():
 def box():
     from compare.fit.greybox import Inputs
     from spindle.drive import DRIVES
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec("spl2782")
     grid = np.arange(0.0, 4 * 3600.0 + 1.0, 60.0)

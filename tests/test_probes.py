@@ -5,7 +5,7 @@ import pytest
 
 from reference import ReferenceModel
 from reference.probes import PROBE_NUDGE_M
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 def test_a_point_a_rounding_outside_the_boundary_is_probed_at_the_boundary():

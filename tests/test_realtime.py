@@ -7,10 +7,10 @@ import pytest
 from lumped import build
 from lumped.blocks import FixedTemperature, HeatCapacitor, PrescribedHeatFlow, ThermalConductor
 from lumped.realtime import RealTimePredictor
-from spindle.cycles import load_cycle
+from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES, cycle_load_case
 from spindle.loads import LoadCase
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ import pytest
 from meshes import build_mesh
 from reference import ThermalModel
 from spindle.loads import LoadCase, TimeSeries
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 @pytest.fixture(scope="module")

@@ -171,7 +171,7 @@ def test_study_rom_row():
     finest level inherits that level's discretisation error, below 1e-3 K on fin-shaft,
     tests/test_study.py)."""
     from compare.verify.study import run_study
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     study = run_study(load_spec("fin-shaft"), levels=(0, 1, 2), nodes=(3,), dt_s=600.0, rom=True)
     for acc in (study.steady, study.transient):
@@ -191,7 +191,7 @@ def test_sensors_considers_the_rom():
     fails the paper's 1 K / 1.5 µm (the harness's headline) while the ROM sized for them
     meets them on both cases, against the same FEM reference."""
     from compare.verify.nodecount import choose_nodes
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     choice = choose_nodes(load_spec("spl2782"), None, 1.0, 1.5, (11,), 0, 600.0, rom=True)
     assert choice.chosen is None

@@ -19,7 +19,7 @@ from compare.verify.cases import default_cases, load_cases
 from compare.verify.nodecount import choose_nodes
 from compare.verify.placement import Snapshots, Target, rank_sensors, rank_snapshots
 from spindle.errors import InputError
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 NODES = (2, 3, 5, 11)
 #: the FEM reference's backward Euler needs short steps: at 600 s its time error on the

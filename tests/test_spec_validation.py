@@ -3,8 +3,7 @@
 import pytest
 
 from spindle.errors import SpecError
-from spindle.spec import load_spec
-from spindle.spec_reader import shipped_specs
+from spindle.spec_reader import load_spec, shipped_specs
 from tests.conftest import write_spec
 
 GOOD = """
@@ -168,8 +167,7 @@ def test_python_api_takes_a_spec_name_or_path():
     from lumped import Fin
     from meshes import build_mesh
     from reference import ReferenceModel
-    from spindle.spec import load_spec
-    from spindle.spec_reader import resolve_spec_path
+    from spindle.spec_reader import load_spec, resolve_spec_path
 
     by_name = lumped.build("fin-shaft", 5)
     by_path = lumped.build(resolve_spec_path("fin-shaft"), 5)

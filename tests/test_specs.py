@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 def test_spl2782_masses_agree_with_paper():
@@ -34,7 +34,7 @@ def test_spl2782_sources_are_the_nominal_power_balance():
     """Issue 15 §3: one nominal point. The spec's [[heat_sources]] (what `solve` uses without
     --case) are the power balance of the `nominal` cycle, to the 0.1 W they are written to,
     so `solve spl2782` and `solve spl2782 --case nominal` answer the same."""
-    from spindle.cycles import load_cycle
+    from spindle.cycle_files import load_cycle
     from spindle.drive import drive_for
 
     s = load_spec("spl2782")

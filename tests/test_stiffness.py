@@ -30,7 +30,7 @@ from compare.design.stiffness import (
 from lumped import LumpedModel
 from reference import ReferenceModel
 from spindle.loads import SpeedTable, TimeSeries
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 DATA = Path(__file__).parent / "data"
 R, L, H, Q = 0.05, 0.2, 10.0, 100.0

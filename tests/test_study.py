@@ -10,7 +10,7 @@ import pytest
 from compare.cli import main
 from compare.verify.accuracy import AccuracyResult, Entry
 from compare.verify.study import run_study
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 @pytest.fixture(scope="module")

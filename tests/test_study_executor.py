@@ -12,7 +12,7 @@ import compare.verify.study
 from compare.cli import main
 from compare.verify.study import StudyRun, run_study
 from spindle.errors import InputError
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 # small and fast: three levels (the fewest a GCI allows), two node counts, 48 steps of 600 s
 SMALL = {"levels": (0, 1, 2), "nodes": (3, 11), "dt_s": 600.0}

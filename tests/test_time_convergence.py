@@ -13,7 +13,7 @@ import pytest
 from compare.verify.study import run_study, study_cases
 from reference import ReferenceModel
 from reference.exact import CRAM16_ERROR, cram16
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 @pytest.fixture(scope="module")

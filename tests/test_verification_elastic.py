@@ -7,7 +7,7 @@ import pytest
 from meshes import build_mesh
 from reference import ThermalModel
 from reference.elastic import ThermoelasticModel
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 TWO_BODIES = """
 [materials.soft]

@@ -8,7 +8,7 @@ import pytest
 from lumped.fin import Fin
 from meshes import build_mesh
 from reference import ThermalModel
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 K = 42.6  # steel_42CrMo4 [W/m/K]
 H = 10.0  # fin-shaft lateral film coefficient [W/m2/K]

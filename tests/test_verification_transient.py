@@ -90,7 +90,7 @@ def test_long_run_reaches_steady_state(spec_from, tmp_path):
 def test_spl2782_transient_energy_balance(theta):
     """Speed, ambient, coolant and a source all change during the run: the cumulative
     balance in - out - stored closes to round-off (the scheme conserves energy exactly)."""
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec("spl2782")
     model = ThermalModel(build_mesh(spec, 0), 2)
@@ -107,7 +107,7 @@ def test_spl2782_transient_energy_balance(theta):
 
 
 def test_spl2782_steady_energy_balance_and_residual():
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec("spl2782")
     res = ThermalModel(build_mesh(spec, 1), 2).solve_steady()

@@ -48,7 +48,7 @@ def _cmd_crosscheck(args: argparse.Namespace, progress: Progress) -> int:
     # imported here so that building the parser stays fast (compare/cli/common.py)
     from compare.crosscheck import crosscheck
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/crosscheck", [spec.path], force=args.force)

@@ -46,7 +46,7 @@ def _base_extra(names: list[str] | None) -> tuple[str, ...] | None:
 def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
     from compare.fit.run import report_summary_text, run_fit, save_report
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     base_extra = _base_extra(args.base_extra)
     if args.model == "fem" and args.lumped_only:

@@ -31,7 +31,7 @@ def _cmd_measures(args: argparse.Namespace, progress: Progress) -> int:
     from lumped.build import PRESETS
     from spindle.drive import load_case
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/measures", [spec.path], force=args.force)

@@ -25,7 +25,7 @@ def _cmd_mesh(args: argparse.Namespace, progress: Progress) -> int:
     from meshes import build_mesh
     from meshes.io import mesh_png, save_mesh_vtu
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", [spec.path], force=args.force)

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 def _cmd_baseline(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.regression import make_baseline
     from spindle.outputs import atomic_write
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)  # validates before the long run
     out = Path(args.out)

@@ -23,7 +23,8 @@ from spindle.errors import InputError
 
 
 def _check_cycles(texts: list[str]) -> None:
-    from spindle.cycles import RANDOM_CYCLES, shipped_cycles
+    from spindle.cycle_files import shipped_cycles
+    from spindle.cycles import RANDOM_CYCLES
 
     for text in texts:
         name, _, seed = text.partition(":")
@@ -45,7 +46,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     from reference.rom.export import export
     from reference.rom.realtime import ROMPredictor
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/rom", [spec.path], force=args.force)

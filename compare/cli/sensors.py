@@ -35,7 +35,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     """``spindle-verify sensors``: the node count, and with ``--rank K`` the sensor ranking.
     Returns the exit status (0; bad input raises :class:`spindle.errors.InputError`)."""
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", [spec.path], force=args.force)

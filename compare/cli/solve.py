@@ -41,7 +41,7 @@ def _print_sensor_table(table: dict, title: str) -> None:
 def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.loads import TimeSeries
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     if args.case and args.cycle:
         raise InputError("command line", "--case", "--case (a steady load point) and --cycle (a "

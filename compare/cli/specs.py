@@ -6,8 +6,7 @@ import argparse
 
 
 def _cmd_specs(args: argparse.Namespace) -> int:
-    from spindle.spec import load_spec
-    from spindle.spec_reader import shipped_specs
+    from spindle.spec_reader import load_spec, shipped_specs
 
     for name, path in sorted(shipped_specs().items()):
         spec = load_spec(path)

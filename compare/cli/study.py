@@ -30,7 +30,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.accuracy import worst_temperature_K
     from compare.verify.study import run_study
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/study", [spec.path], force=args.force)

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 def _cmd_synth(args: argparse.Namespace, progress: Progress) -> int:
     from compare.fit.greybox import EFFECTS
     from compare.fit.synth import OUTSIDE, synth
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
     known = [*EFFECTS, "clean", *OUTSIDE]

@@ -19,7 +19,8 @@ from compare.crosscheck.twin import reading_rows, twin_gains, twin_thermal
 from reference.simulation import ReferenceModel
 from spindle.errors import InputError, SolverError
 from spindle.loads import LoadCase
-from spindle.spec import Spec, load_spec
+from spindle.spec import Spec
+from spindle.spec_reader import load_spec
 
 #: ccx expands a CAX6 section into a 2-degree C3D15 wedge (+-1 degree): the hoop strain of the
 #: expanded element is exact only to O(theta^2), theta = 1 degree in radians; the growth

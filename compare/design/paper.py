@@ -31,9 +31,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from reference import ReferenceModel
-from spindle.cycles import load_cycle
+from spindle.cycle_files import load_cycle
 from spindle.drive import Drive, cycle_load_case, drive_for
-from spindle.spec import AirGapLink, Spec, load_spec
+from spindle.spec import AirGapLink, Spec
+from spindle.spec_reader import load_spec
 from spindle.units import ZERO_C_K
 
 TARGETS = {"losses_W": 5146.0, "shaft_rise_K": 41.6, "housing_rise_K": 46.1, "TCP_um": 79.7,

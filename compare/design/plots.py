@@ -15,14 +15,17 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from compare.design.cases import SWEEP_UNITS
 from compare.design.formulas import PAPER_LAMBDA_RANGE, temperature_drop_K
-from compare.design.report import MeasuresReport
 from spindle.outputs import atomic_write
 from spindle.plots import pyplot
+
+if TYPE_CHECKING:  # the report calls these plots: only its type is needed here
+    from compare.design.report import MeasuresReport
 
 _SWEEP_TITLES = {"area": "added surface A_M", "length": "length L,",
                  "film": "film coefficient alpha", "heat": "heat flow Q"}

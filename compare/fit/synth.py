@@ -299,7 +299,8 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
     come from a spindle that differs from ``spec`` (:func:`compare.fit.mismatch.draw_mismatch`,
     drawn from the seed; its FEM level replaces ``level``), recorded in the truth."""
     from compare.fit.mismatch import draw_mismatch
-    from spindle.cycles import RANDOM_CYCLES, drawn_cycle, load_cycle
+    from spindle.cycle_files import load_cycle
+    from spindle.cycles import RANDOM_CYCLES, drawn_cycle
     from spindle.drive import cycle_load_case, drive_for
     from spindle.outputs import atomic_write
 

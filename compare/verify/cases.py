@@ -30,7 +30,7 @@ def load_cases(spec: Spec, names: Sequence[str], steady_cycles: bool = True) -> 
     """Load cases from shipped cycle names (or cycle files), through the spec's power balance
     (:func:`spindle.drive.cycle_load_case`). A cycle marked ``steady`` (``nominal``) becomes a
     steady case (duration 0 s) when ``steady_cycles``; every other cycle is a transient."""
-    from spindle.cycles import load_cycle
+    from spindle.cycle_files import load_cycle
     from spindle.drive import cycle_load_case
 
     out = []

@@ -44,9 +44,9 @@ class Verdict:
 def model_error(spec_ref: str, model: str, case: str | None = None, reference_level: int = 2,
                 dt_s: float = 120.0) -> Verdict:
     """Errors of ``model`` against the FEM reference on ``case`` (see the module doc)."""
-    from spindle.cycles import load_cycle
+    from spindle.cycle_files import load_cycle
     from spindle.drive import cycle_load_case
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(spec_ref)
     kind, _, size = model.partition(":")

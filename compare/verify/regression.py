@@ -70,7 +70,7 @@ def _tolerance(name: str, tol: dict) -> float:
 def compute(spec_ref: str, settings: dict, progress: Callable[[str], None] | None = None
             ) -> dict[str, float | int | None]:
     from compare.verify.study import run_study
-    from spindle.spec import load_spec
+    from spindle.spec_reader import load_spec
 
     spec = load_spec(spec_ref)
     study = run_study(spec, settings["levels"], settings["nodes"],

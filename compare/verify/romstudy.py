@@ -26,7 +26,8 @@ def named_case(spec, name: str, seed: int = 0) -> LoadCase:
     synth`` draws from ``seed`` (spindle.cycles.drawn_cycle), named with its seed."""
     from dataclasses import replace
 
-    from spindle.cycles import RANDOM_CYCLES, drawn_cycle, load_cycle
+    from spindle.cycle_files import load_cycle
+    from spindle.cycles import RANDOM_CYCLES, drawn_cycle
     from spindle.drive import cycle_load_case
 
     if name in RANDOM_CYCLES:

@@ -280,7 +280,7 @@ def _reference_entry(conv: ConvergenceResult, case: LoadCase) -> tuple[Entry, st
 def study_cases(spec: Spec) -> tuple[LoadCase, LoadCase]:
     """(steady case, transient case): nominal and spl-16h through the power balance for a spec
     with one; otherwise its own load case, and an 8 h warm-up from ambient."""
-    from spindle.cycles import load_cycle
+    from spindle.cycle_files import load_cycle
     from spindle.drive import cycle_load_case, drive_for
 
     drive = drive_for(spec)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from reference import ReferenceModel
 from spindle.drive import load_case
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 from spindle.units import ZERO_C_K
 
 

@@ -20,7 +20,7 @@ import lumped
 from reference import ReferenceModel
 from spindle.drive import load_case
 from spindle.outputs import write_csv
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 from spindle.tolerances import GROWTH_TOLERANCE_M, TEMPERATURE_TOLERANCE_K
 from spindle.units import ZERO_C_K
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from compare.fit.run import run_fit, save_report
 from compare.fit.synth import synth
-from spindle.spec import load_spec
+from spindle.spec_reader import load_spec
 
 
 def main(out: Path, run: Path | None = None, candidates: Sequence[str] | None = None) -> dict:
