@@ -67,8 +67,9 @@ def main(argv: list[str] | None = None) -> None:
     if args.R <= 0.0 or args.seed < 0 or args.level < 0:
         ap.error("--R must be > 0, --seed and --level >= 0")
 
-    from compare.fit.greybox import GreyBox, default_theta
+    from compare.fit.greybox import GreyBox
     from compare.fit.mismatch import Mismatch
+    from compare.fit.params import default_theta
     from compare.fit.run import greybox_inputs
     from compare.fit.synth import reference_run, synth
     from spindle.bench import read_bench

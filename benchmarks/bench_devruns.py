@@ -20,7 +20,15 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from verdicts import RMS_HEADER, fit_outcome, named_text, read_truth, rms_cells, run_verdicts
+from verdicts import (
+    RMS_HEADER,
+    fit_outcome,
+    judge_verdict,
+    named_text,
+    read_truth,
+    rms_cells,
+    run_verdicts,
+)
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
@@ -32,7 +40,7 @@ DEFAULT_RUNS = ROOT.parent / "shared" / "bench-runs"
 class DevRun:
     path: Path
     spec: str
-    truth: str | None
+    truth: str | list | None
     base_extra: tuple[str, ...] | None = None
     blocks: int = 1
     cv_blocks: int = 5
@@ -48,7 +56,9 @@ class DevRun:
 
 def fit_one(case: DevRun) -> dict:
     """``fit`` on one run; the figures the table prints."""
-    from compare.fit.run import named_effects, run_fit, selection_trace
+    from compare.fit.criteria import Criteria
+    from compare.fit.report import selection_trace
+    from compare.fit.run import run_fit
     from spindle.spec_reader import load_spec
     from spindle.tolerances import channel_tolerance, edge_scale
 
@@ -62,18 +72,17 @@ def fit_one(case: DevRun) -> dict:
                   blocks=case.blocks, cv_blocks=case.cv_blocks, fit_fraction=case.fit_fraction)
     doc = rep.to_dict()
     out = fit_outcome(doc)
-    # the issue's verdict: the true effect named alone; nothing named on a control run
-    right = out["named_plain"] == ([case.truth] if case.truth else [])
-    return {"run": case.label, "truth": case.truth, "named": named_effects(doc),
-            "unexplained": out["unexplained"], "right": right,
+    return {"run": case.label, "truth": case.truth, "named": out["named"],
+            "verdict": out["verdict"], "unexplained": out["unexplained"],
+            **judge_verdict(case.truth, out["named_plain"], out["unexplained"]),
             "validation_rmse": out["validation_rmse"],
             "cross_validated_rmse": {c: v["rmse"] for c, v in (
                 doc["cross_validation"].get("final", {}).get("pooled", {}).items())},
             "within_tolerance": {c: v <= channel_tolerance(c) * edge_scale(c)
                                  for c, v in out["validation_rmse"].items()},
             "implausible": {k: round(v, 2) for k, v in (doc.get("parameters_prior_z") or {})
-                            .items() if abs(v) > 2.58},
-            **selection_trace(doc, ("estimate", "se", "z", "p_value", "model_reference", "scale", "scales")),
+                            .items() if abs(v) > Criteria(alpha=doc["alpha"]).implausible_z()},
+            **selection_trace(doc),
             "seconds": time.perf_counter() - t}
 
 
@@ -110,7 +119,7 @@ def main(argv: list[str] | None = None) -> None:
              for k in labels]
 
     def line(r: dict) -> str:
-        return (f"{r['run']:8} {str(r['truth']):24} "
+        return (f"{r['run']:8} {str(r['truth'])[:24]:24} "
                 f"{named_text(r['named'], r['unexplained']):30} {'yes' if r['right'] else 'NO ':3} "
                 f"{rms_cells(r['validation_rmse'])} {r['seconds']:5.0f}  "
                 f"{rms_cells(r['cross_validated_rmse'])}"

@@ -29,7 +29,8 @@ def main(argv: list[str] | None = None) -> None:
     args = ap.parse_args(argv)
 
     from compare.fit.greybox import GreyBox
-    from compare.fit.run import greybox_inputs, run_fit, save_report
+    from compare.fit.report import save_report
+    from compare.fit.run import greybox_inputs, run_fit
     from compare.fit.synth import synth
     from spindle.bench import read_bench
     from spindle.drive import drive_for
@@ -55,12 +56,12 @@ def main(argv: list[str] | None = None) -> None:
     rep = run_fit(run, spec)
     save_report(rep, folder / "fit")
     t_fit = time.perf_counter() - t
-    named = [s.effect for s in rep.selection.steps]
+    named = [s.label for s in rep.selection.steps]
     print(f"{run}: rows {len(bench.time_s)}, {bench.duration_s / 3600:.1f} h"
           + ("" if args.run else f"; synth (FEM, untimed) {t_synth:.1f} s"))
     print(f"read {t_read:.2f} s; one 16 h simulation {t_sim * 1e3:.1f} ms; fit to report "
           f"{t_fit:.1f} s (target 60 s: {'met' if t_fit <= 60 else 'MISSED'}); "
-          f"{rep.selection and sum(1 for _ in rep.selection.tried)} candidate fits; named "
+          f"{len(rep.selection.judged)} candidate fits; named "
           f"{named or 'nothing'}" + ("" if args.run else f" (injected {args.effect})"))
 
 

@@ -61,7 +61,8 @@ class Injected:
 def fit_one(case: Injected) -> dict:
     """Inject, then ``fit``; the figures the table prints."""
     from compare.fit.inject import inject
-    from compare.fit.run import named_effects, run_fit, selection_trace
+    from compare.fit.report import named_effects, selection_trace
+    from compare.fit.run import run_fit
     from spindle.spec_reader import load_spec
 
     t = time.perf_counter()

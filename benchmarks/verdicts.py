@@ -1,4 +1,4 @@
-"""What the verdict benchmarks share (bench_devruns, bench_mismatch, bench_peerinject,
+"""What the verdict benchmarks share (bench_devruns, bench_families, bench_peerinject,
 bench_input_contract): run cases through :func:`compare.executor.run_cases`, print a row per
 case, count the right verdicts (in all and per group), write the rows as JSON.
 
@@ -27,11 +27,49 @@ def rms_cells(rmse: dict[str, float], width: int = 5) -> str:
 
 def fit_outcome(doc: dict) -> dict:
     """What every verdict table reads from a fit's report.json: the named effects (plain
-    names), whether the report says unexplained, and the validation RMS after per channel."""
+    names and labels), the verdict's kind, whether it says unexplained, and the validation
+    RMS after per channel."""
     return {"named_plain": [e["name"] for e in doc["effects"]],
-            "unexplained": bool(doc["unexplained"]["unexplained"]),
+            "named": [e["label"] for e in doc["effects"]],
+            "verdict": doc["verdict"]["kind"],
+            "unexplained": bool(doc["verdict"]["unexplained"]),
             "validation_rmse": {c: v["rmse"] for c, v in doc["error_after"]["validation"]
                                 .items()}}
+
+
+def judge_verdict(truth, named: list[str], unexplained: bool) -> dict:
+    """How a fit's verdict compares with a run's truth: ``truth`` is None or "none" (a
+    control), "unexplained" or the name of a cause outside the library, an effect's name, or
+    a list of effects (several in one run); ``named`` the plain names the fit named, in order.
+
+    - ``right``: the verdict as a whole: a control names nothing; a run outside the library
+      names nothing and says unexplained; an effect's run names it alone; a run of several
+      names them all and nothing else;
+    - ``first``: the first name is a true effect (runs with an effect only);
+    - ``false_second``: a second name that is not a true effect after a right first one;
+    - ``wrong``: some name is not a true effect (on any run);
+    - ``kind``: "control", "outside", "effect" or "effects".
+    """
+    from compare.fit.effects import LIBRARY
+
+    if truth in (None, "none", "clean"):
+        kind, true = "control", []
+    elif isinstance(truth, list | tuple):
+        kind, true = "effects", list(truth)
+    elif truth in LIBRARY:
+        kind, true = "effect", [truth]
+    else:
+        kind, true = "outside", []
+    wrong = any(n not in true for n in named)
+    if kind in ("control", "outside"):
+        right = not named and (unexplained or kind == "control")
+        first = None
+    else:
+        right = set(named) == set(true) and len(named) == len(true)
+        first = bool(named) and named[0] in true
+    second = (bool(first) and len(named) > 1 and named[1] not in true) if first else False
+    return {"kind": kind, "right": right, "first": first, "false_second": second,
+            "wrong": wrong}
 
 
 def named_text(named: Sequence[str], unexplained: bool) -> str:

@@ -5,7 +5,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from compare.fit.adequacy import IMPLAUSIBLE_Z, base_adequacy, extrapolation_warnings
+from compare.fit.adequacy import base_adequacy, extrapolation_warnings
+from compare.fit.criteria import Criteria
+
+IMPLAUSIBLE_Z = Criteria().implausible_z()  # the plausible range at the default alpha
 
 
 def _errors(rmse_w: dict[str, tuple[float, float]]) -> dict:
@@ -39,7 +42,7 @@ def test_inadequate_names_the_channel_the_factor_and_where_to_look():
 
 @pytest.mark.parametrize("G, named", [(0.3, False), (15.0, True)])
 def test_a_path_the_spec_lacks_is_named_when_the_run_needs_it(G, named):
-    """G_seat_W_K (spec 0, no prior) above MISSING_PATH_W_K is said in the statement with
+    """G_seat_W_K (spec 0, no prior) above Criteria.missing_path_W_K is said in the statement with
     where to look, and does not by itself make the calibrated base inadequate."""
     ad = base_adequacy(_errors({"T1": (0.2, 0.3)}), {"h_coolant": 1.1, "f0": 0.3,
                                                      "G_seat_W_K": G},
@@ -117,17 +120,21 @@ def test_base_inadequacy_on_a_peer_control_run():
     assert "inadequate for this run" in ad["verdict"]
 
 
-def test_verdict_text_separates_a_missing_effect_from_an_inadequate_model():
-    """A base that needs an effect to be plausible, then is adequate with it, is not called
-    inadequate; a model still off after its effects is, with the advice to fix the spec."""
-    from compare.fit.adequacy import verdict_text
+def test_the_plausible_range_follows_alpha():
+    """The verdict's implausible range is the selection's (two-sided at the fit's alpha, issue
+    32: with --alpha 0.05 they disagreed): z = 2.2 is implausible at 5 % (1.96), not at 1 %
+    (2.58)."""
+    args = (_errors({"T1": (0.2, 0.3)}), {"h_coolant": 1.9, "f0": 0.3}, SPEC,
+            {"h_coolant": 2.2, "f0": 0.0})
+    assert base_adequacy(*args)["implausible"] == []
+    assert base_adequacy(*args, criteria=Criteria(alpha=0.05))["implausible"] == ["h_coolant"]
 
-    off = base_adequacy(_errors({"P1": (0.3, 0.4)}), {"alpha_eff": 1.5}, {"alpha_eff": 1.0},
-                        {"alpha_eff": 3.8})
-    fine = base_adequacy(_errors({"P1": (0.1, 0.1)}), {"alpha_eff": 1.02}, {"alpha_eff": 1.0},
-                         {"alpha_eff": 0.2})
-    text = verdict_text(off, fine, ["fixture_expansion"])
-    assert "alpha_eff moved to 1.5" in text and "With fixture_expansion the model explains" in text
-    assert "inadequate for this run" not in text
-    assert "inadequate for this run" in verdict_text(off, off, ["fixture_expansion"])
-    assert "inadequate for this run" in verdict_text(off, off, [])
+
+def test_no_bound_advice_where_the_bound_is_the_specs_value():
+    """A conductance the spec lacks (G_seat_W_K, spec 0 = its lower bound) calibrated to 0
+    says "not needed": no advice to look at it (issue 32)."""
+    ad = base_adequacy(_errors({"T1": (0.2, 0.3)}), {"h_coolant": 1.0, "f0": 0.3,
+                                                     "G_seat_W_K": 0.0},
+                       {**SPEC, "G_seat_W_K": 0.0}, {"h_coolant": 0.0, "f0": 0.0},
+                       {"G_seat_W_K": (0.0, 200.0)})
+    assert ad["at_bound"] == [] and "bearing seats" not in ad["statement"]

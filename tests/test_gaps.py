@@ -76,7 +76,8 @@ def test_the_calibrated_model_places_the_switch_where_the_spec_model_cannot():
     the model at the spindle's values, which the first calibration approaches, within one grid
     step (60 s). Measured: the spec's model chose 6480 s, the true model 6360 s, for 6300 s;
     on this project's mismatched FEM runs the second placement cut the error from 206-495 s
-    to 26-123 s (docs/fit.md, *Input timing*)."""
+    to 26-123 s (docs/fit-history.md, *Input timing*)."""
+    from compare.fit.criteria import Criteria
     from compare.fit.run import _measured, _place_gap_switches, greybox_inputs
     from spindle.bench import BenchRun
     from spindle.units import ZERO_C_K
@@ -106,7 +107,7 @@ def test_the_calibrated_model_places_the_switch_where_the_spec_model_cannot():
 
     def place(th):
         return _place_gap_switches(run, spec, drive, inputs, measured, channels, 11, (),
-                                   lambda _m: None, th)[1][0].switch_s
+                                   lambda _m: None, Criteria(), th)[1][0].switch_s
 
     assert abs(place(None) - true_switch_s) > 120.0  # the spec's model: off
     assert place(theta) == pytest.approx(true_switch_s, abs=60.0)

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from compare.cli import main
-from compare.fit.calibrate import Calibrator, Measured, choose_refit, forward_selection, resample
-from compare.fit.greybox import EFFECTS, GreyBox, inputs_from_cycle
+from compare.fit.calibrate import Calibrator, Measured, resample
+from compare.fit.effects import LIBRARY, label
+from compare.fit.greybox import GreyBox, inputs_from_cycle
 from lumped import build
 from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES, cycle_load_case
@@ -43,22 +44,27 @@ def test_greybox_is_the_lumped_model(setup):
     np.testing.assert_allclose(out["P1"], tr.growth_m["P1"] - tr.growth_m["P1"][0], atol=1e-14)
 
 
-@pytest.mark.parametrize("name", sorted(EFFECTS))
-def test_every_effect_is_nested_and_acts(setup, name):
+#: one candidate label per library effect (a per-channel effect on P1)
+LABELS = [label(n, "P1" if e.per_channel else None) for n, e in sorted(LIBRARY.items())]
+
+
+@pytest.mark.parametrize("lab", LABELS)
+def test_every_effect_is_nested_and_acts(setup, lab):
     spec, _, inp = setup
     base = GreyBox(spec, DRIVES["spl2782"], inp).simulate({})
-    gb = GreyBox(spec, DRIVES["spl2782"], inp, effects=(name,), lag_channel="P1")
+    gb = GreyBox(spec, DRIVES["spl2782"], inp, effects=(lab,))
     neutral = gb.simulate({})  # every effect parameter at its neutral default
     # exact nesting, except coolant_dynamics, whose R = 0 limit is an advection conductance
     # of 1e9 W/K (kW over 1e9 W/K: ~1e-6 K)
-    tol = 1e-5 if name == "coolant_dynamics" else 1e-12
+    tol = 1e-5 if lab == "coolant_dynamics" else 1e-12
     for c in CHANNELS:
         np.testing.assert_allclose(neutral[c], base[c], atol=tol * (1e-6 if c == "P1" else 1))
-    on = gb.simulate({p.name: p.lo + 0.75 * (p.hi - p.lo) for p in EFFECTS[name].params})
+    effect = LIBRARY[lab.split("(")[0]]
+    on = gb.simulate({p.name: p.lo + 0.75 * (p.hi - p.lo) for p in effect.params})
     moved = [c for c in CHANNELS if np.max(np.abs(on[c] - base[c])) > (1e-8 if c == "P1"
                                                                       else 1e-3)]
-    assert moved, f"{name} changes nothing"
-    if name in ("centrifugal_shortening", "fixture_expansion", "sensor_lag"):
+    assert moved, f"{lab} changes nothing"
+    if effect.channels == ("P1",) or effect.per_channel:
         assert moved == ["P1"]  # output effects touch their channel only
 
 
@@ -140,7 +146,7 @@ def test_a_warming_coolant_is_not_a_weaker_jacket_film(setup):
     """The coolant's warming (R) lifts the housing's wetted bore with the stator's heat, which
     no jacket-film factor does, so the two are told apart by the bearing temperatures: the
     best factor alone leaves a good part of the warming at T2 (measured here on spl-16h: 0.81
-    of 1.98 K RMS, factor 0.33; docs/fit.md, *Coolant warming is not a film factor*: 1.0 of
+    of 1.98 K RMS, factor 0.33; docs/fit-history.md, *Coolant warming is not a film factor*: 1.0 of
     2.3 K on a random cycle, the FEM 0.8 K). Bar: a third of the effect's RMS at T2, and
     0.3 K, ten times the bench's T sensor noise (0.03 K)."""
     from scipy.optimize import minimize_scalar
@@ -161,75 +167,6 @@ def test_a_warming_coolant_is_not_a_weaker_jacket_film(setup):
     rms = {c: float(np.sqrt(np.mean((film(best)[c] - cool[c]) ** 2))) for c in ("T1", "T2")}
     effect = float(np.sqrt(np.mean((cool["T2"] - plain["T2"]) ** 2)))
     assert rms["T2"] > max(0.3, effect / 3.0), (rms, effect, float(np.exp(best)))
-
-
-def test_forward_selection_finds_a_known_effect(setup):
-    """Data from the grey box itself with fixture_expansion (k = 1.5 µm/K) and noise: the
-    selection names it, not the other candidate, and recovers k within its interval."""
-    spec, _, inp = setup
-    truth = GreyBox(spec, DRIVES["spl2782"], inp, effects=("fixture_expansion",))
-    out = truth.simulate({"k_fix_um_K": 1.5, "f0": 0.4})
-    rng = np.random.default_rng(3)
-    vals = {c: out[c] + rng.normal(0, 0.1e-6 if c == "P1" else 0.05, len(inp.grid_s))
-            for c in CHANNELS}
-    cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
-    sel = forward_selection(cal, ["fixture_expansion", "windage_loss"])
-    assert [s.effect for s in sel.steps] == ["fixture_expansion"]
-    fit = sel.final
-    # estimate within 0.1 µm/K of the truth and a 95 % interval narrower than 0.25 µm/K
-    # (seeds 3 and 4 give 1.449 +- 0.031 and 1.479 +- 0.030)
-    assert abs(fit.theta["k_fix_um_K"] - 1.5) < 0.1
-    lo, hi = fit.ci95["k_fix_um_K"]
-    assert hi - lo < 0.25
-    assert fit.validation_score() < 0.5 * sel.base.validation_score()
-
-
-@pytest.mark.parametrize("refits, expected", [
-    # (qualifies, log-posterior gain, label): the best-likelihood refit must qualify itself;
-    # a weaker qualifying one is not a fallback (Bacher and Madsen 2011, issue 13: the
-    # fallback named a mount sink on a fixture-expansion run when the split moved)
-    ([(False, 30.0, "fixture"), (True, 17.0, "mount")], None),
-    ([(True, 30.0, "fixture"), (True, 17.0, "mount")], "fixture"),
-    ([(True, 17.0, "mount"), (True, 30.0, "fixture")], "fixture"),
-    ([(False, 5.0, "a"), (False, 9.0, "b")], None),
-    ([], None),
-])
-def test_a_round_accepts_the_best_refit_only_when_it_qualifies(refits, expected):
-    chosen = choose_refit(refits)
-    assert (chosen and chosen[2]) == expected
-
-
-@pytest.mark.parametrize("refits, expected", [
-    # (qualifies, gain, label, channels): a better refit that fails blocks only candidates
-    # acting on a channel it acts on (the peer's dev-06 with a lag injected on T_stator: a
-    # P1 fixture term fitting better and failing its tests blocked the lag)
-    ([(False, 37.4, "fixture", {"P1"}), (True, 21.5, "lag", {"T_stator"})], "lag"),
-    ([(False, 30.0, "fixture", {"P1"}), (True, 17.0, "mount", set(CHANNELS))], None),
-    ([(False, 30.0, "fixture", {"P1"}), (True, 20.0, "mount", set(CHANNELS)),
-      (True, 10.0, "lag", {"T2"})], None),  # mount, blocked, still blocks what it covers
-    ([(True, 30.0, "lag", {"T1"}), (True, 40.0, "fixture", {"P1"})], "fixture"),
-])
-def test_a_failing_refit_blocks_only_candidates_on_its_channels(refits, expected):
-    chosen = choose_refit(refits, lambda r: r[3])
-    assert (chosen and chosen[2]) == expected
-
-
-@pytest.mark.parametrize("front, rear, named", [
-    # 95 % intervals of the front and rear coefficients [1/K]: the loop's preload must be
-    # carried by the rigidly preloaded front set (the peer's loaded control with a spec
-    # further off: front [0, 0.016], rear [0.016, 0.068], a misfit, not a preload)
-    ((0.0, 0.0156), (0.0161, 0.0684), False),
-    ((0.5, 1.4), (0.1, 0.6), True),  # the peer's preload run: front 0.96, rear 0.35
-    ((0.05, 0.4), (0.0, 0.3), True),  # the rear set floating: front alone
-    ((float("nan"), float("nan")), (0.1, 0.2), False),  # unresolved: not named
-])
-def test_a_preload_is_named_only_on_the_front_set(front, rear, named):
-    from compare.fit.calibrate import Fit, front_set_carries
-
-    fit = Fit(("bearing_preload",), None, {}, [], {"k_preload_1_K": front,
-              "k_preload_rear_1_K": rear}, np.eye(2), {}, 0.0, 1, 1.0, {}, {})
-    assert front_set_carries(fit, "bearing_preload") is named
-    assert front_set_carries(fit, "mount_conduction")  # no other effect is judged so
 
 
 def test_resample_leaves_gaps_empty():
@@ -268,7 +205,7 @@ def test_synth_then_fit_end_to_end(tmp_path, capsys):
     # adequacy's own threshold (compare.fit.adequacy.MISSING_PATH_W_K)
     seat = {p["name"]: p["value"] for p in rep["parameters"]}["G_seat_W_K"]
     assert seat < 1.0 and ad["missing_paths"] == [], seat
-    assert "Base model:" in (out / "report.html").read_text()
+    assert "The base model" in (out / "report.html").read_text()
     assert (out / "report.html").exists() and (out / "fit_channels.png").exists()
 
 
@@ -279,14 +216,14 @@ MATRIX_MISSED = {
     "axial scale joined the base (2026-11-26; found only then: this matrix had not been run "
     "with it): the mount's refit gains 26 in log-posterior but brings h_air only from +3.7 to "
     "+2.3 prior sd (1.96 asked for plausibility) and 16-18 % of the validation excess (25 % "
-    "asked); the same with and without the friction exponent (docs/fit.md)",
+    "asked); the same with and without the friction exponent (docs/fit-history.md)",
 }
 
 
 def _matrix_cases() -> list:
     return [pytest.param(e, s, marks=[pytest.mark.xfail(strict=True, reason=MATRIX_MISSED[e, s])]
                          if (e, s) in MATRIX_MISSED else [], id=f"{e}-{s}")
-            for s in (11, 12) for e in [*sorted(EFFECTS), "clean", "electronics_drift"]]
+            for s in (11, 12) for e in [*sorted(LIBRARY), "clean", "electronics_drift"]]
 
 
 @pytest.mark.slow
@@ -311,7 +248,7 @@ def test_fit_names_the_injected_effect(tmp_path, effect, seed):
         assert named == [effect]
         # RMS within the tolerances (the max is not asserted: with centrifugal_shortening P1
         # jumps by ~3 µm at a speed step, and the 60 s model grid against the bench's
-        # irregular samples leaves a spike of up to ~2 µm there, docs/fit.md)
+        # irregular samples leaves a spike of up to ~2 µm there, docs/fit-history.md)
         for c, e in rep["error_after"]["validation"].items():
             assert e["rmse"] <= (1.5 if c == "P1" else 1.0), (c, e)
 
@@ -388,30 +325,6 @@ def test_prior_penalty_and_plausibility(setup):
     assert cal.implausible(fit, 0.01) == []
 
 
-def test_selection_names_an_effect_the_base_would_hide(setup):
-    """coolant_dynamics (R = 0.008 K/W) in data from the grey box itself: without it the
-    jacket film factor absorbs most of it; with priors around the spec's values the
-    selection names it (needed by the validation error or by plausibility) and the
-    parameters return near the spec."""
-    spec, _, inp = setup
-    truth = GreyBox(spec, DRIVES["spl2782"], inp, effects=("coolant_dynamics",))
-    out = truth.simulate({"R_adv_K_W": 0.008})
-    rng = np.random.default_rng(5)
-    vals = {c: out[c] + rng.normal(0, 0.05e-6 if c == "P1" else 0.05, len(inp.grid_s))
-            for c in CHANNELS}
-    cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
-    free_fit = cal.fit()
-    cal.set_prior({k: p.default for k, p in cal.gb.parameters().items()}, free_fit)
-    base = cal.fit(start=free_fit.theta)
-    sel = forward_selection(cal, ["coolant_dynamics", "fixture_expansion", "windage_loss"],
-                            base=base)
-    assert [s.effect for s in sel.steps] == ["coolant_dynamics"]
-    # the estimate within 25 % of the truth (noise 0.05 K, one seed; seeds 5 and 6 give
-    # 0.0079 and 0.0080 K/W)
-    assert abs(sel.final.theta["R_adv_K_W"] - 0.008) < 0.002
-    assert cal.implausible(sel.final, 0.01) == []
-
-
 def test_anderson_solves_a_slow_linear_fixed_point():
     """x = A x + b with contraction 0.95 (plain iteration: ~300 steps to 1e-6): Anderson
     acceleration reaches the exact solution to 1e-8 in a handful of evaluations."""
@@ -443,7 +356,9 @@ def test_synth_coolant_feedback_is_converged(setup):
     ref = ReferenceModel(spec, 0)
     T0 = float(case.T_ambient_K(0.0))
     R = 0.008
-    res, Tm, _ = _fixed_point(ref, case, "coolant_dynamics", {"R_adv_K_W": R}, 600.0, T0)
+    coolant = LIBRARY["coolant_dynamics"]
+    feedback = coolant.feedback(ref.thermal, spec, {"R_adv_K_W": R})
+    res, (Tm,), _ = _fixed_point(ref, case, [feedback], 600.0, T0)
     th = ref.thermal
     g = np.sum([TWO_PI * s.h_W_m2K(0.0) * b for s, _, b in th.op.films
                 if s.T_ref == "coolant"], axis=0)
@@ -477,10 +392,11 @@ def test_blocked_windows_partition_the_run_and_spread_the_validation():
 
 def test_cross_validation_of_the_true_model_is_at_the_noise(setup):
     """Data from the grey box itself with 0.05 K and 0.1 µm of white noise: every held-out
-    block of the true model's cross-validation is predicted to within the noise (pooled RMS
-    below 1.3 times its sd: 5 refits of 8 parameters leave far less than that), and a model
-    with f0 held at half its true value is not."""
-    from compare.fit.calibrate import cross_validate
+    block of the true model's cross-validation (compare.fit.linear: one Gauss-Newton step per
+    fold from the fit) is predicted to within the noise (pooled RMS below 1.3 times its sd:
+    5 refits of 8 parameters leave far less than that), and a model with f0 held at half its
+    true value is not."""
+    from compare.fit.linear import local
 
     spec, _, inp = setup
     out = GreyBox(spec, DRIVES["spl2782"], inp).simulate({"f0": 0.4})
@@ -489,68 +405,12 @@ def test_cross_validation_of_the_true_model_is_at_the_noise(setup):
     vals = {c: out[c] + rng.normal(0, sd[c], len(inp.grid_s)) for c in CHANNELS}
     cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
     fit = cal.fit(start={"f0": 0.4})
-    cv = cross_validate(cal, fit, blocks=4)
-    assert cv["blocks"] == 4 and len(cv["folds"]) == 4
+    cv = local(cal, fit).cross_validation_report(4)
+    assert cv["blocks"] == 4
     for c in CHANNELS:
         scale = 1e6 if c == "P1" else 1.0
         assert cv["pooled"][c]["rmse"] < 1.3 * sd[c] * scale, (c, cv["pooled"][c])
         assert cv["pooled"][c]["n"] == len(inp.grid_s)
     wrong = cal.fit(free=["h_air"], start={"f0": 0.2})
-    cv_wrong = cross_validate(cal, wrong, blocks=4)
+    cv_wrong = local(cal, wrong).cross_validation_report(4)
     assert cv_wrong["pooled"]["T1"]["rmse"] > 3 * sd["T1"]
-
-
-def _event(effect: str, channel: str, z: float, p: float):
-    from compare.fit.events import EventTest
-
-    return EventTest(effect, channel, 1.0, 0.1, z, p, 8, "-", "constructed", reference=1.5)
-
-
-def test_a_lag_on_p1_and_a_centrifugal_jump_are_rivals():
-    """Both are read from P1's shape at the speed steps: when both events are significant
-    the weaker goes to the loop; either alone is taken from its event."""
-    from compare.fit.calibrate import _event_judged
-
-    both = {"centrifugal_shortening": _event("centrifugal_shortening", "P1", 2.5, 0.006),
-            "sensor_lag(P1)": _event("sensor_lag", "P1", 4.7, 1e-6),
-            "sensor_lag(T1)": _event("sensor_lag", "T1", -3.0, 1.0)}
-    judged, cands = _event_judged(both, list(EFFECTS), 0.01)
-    assert "centrifugal_shortening" not in judged and "centrifugal_shortening" not in cands
-    assert {"sensor_lag(P1)", "sensor_lag(T1)"} <= judged
-    alone = {k: v for k, v in both.items() if k != "sensor_lag(P1)"}
-    judged, cands = _event_judged(alone, list(EFFECTS), 0.01)
-    assert "centrifugal_shortening" in cands
-    # a lag on another channel is no rival of the jump
-    other = dict(alone, **{"sensor_lag(T2)": _event("sensor_lag", "T2", 6.0, 1e-9)})
-    judged, cands = _event_judged(other, list(EFFECTS), 0.01)
-    assert {"centrifugal_shortening", "sensor_lag(T2)"} <= set(cands)
-
-
-def test_restoring_plausibility_lowers_the_cross_validated_gain_asked():
-    from compare.fit.calibrate import cv_gain_asked
-
-    crit = 2.576  # two-sided 1 %
-    # the synthetic mount of docs/fit.md: h_air +4.2 -> +0.3 sd, h_rotating 2.7 -> 1.6,
-    # rotor_share stays out
-    before = {"rotor_share": 2.9, "h_air": 4.2, "h_rotating": 2.7, "f0": -1.4}
-    after = {"rotor_share": 2.8, "h_air": 0.3, "h_rotating": 1.6, "f0": -1.1}
-    assert cv_gain_asked(0.25, before, after, crit) == 0.125
-    # nudged just across the 1 % line, not back within 1.96: nothing restored
-    assert cv_gain_asked(0.25, {"h_air": 2.60}, {"h_air": 2.55}, crit) == 0.25
-    # left where it was, or traded for another implausible parameter (windage on the mount
-    # runs left h_air where it was)
-    assert cv_gain_asked(0.25, {"h_air": 2.6, "contact": 0.0}, {"h_air": 2.6, "contact": 0.0},
-                         crit) == 0.25
-    assert cv_gain_asked(0.25, {"h_air": 2.6, "contact": 0.0}, {"h_air": 0.0, "contact": 3.0},
-                         crit) == 0.25
-    # a plausible base has nothing to restore
-    assert cv_gain_asked(0.25, {"h_air": 1.0}, {"h_air": 0.0}, crit) == 0.25
-
-
-def test_gains_are_judged_on_the_effects_own_channels():
-    from compare.fit.calibrate import own_channels
-
-    assert own_channels("fixture_expansion") == ("P1",)
-    assert own_channels("centrifugal_shortening") == ("P1",)
-    assert own_channels("sensor_lag", "T_stator") == ("T_stator",)
-    assert set(own_channels("mount_conduction")) == set(CHANNELS)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from compare.fit.inject import first_order_lag, inject
+from compare.fit.inject import first_order_lag, inject, injectable
 from spindle.commented_csv import split_commented_csv
 
 HEADER = "time_s,speed_rpm,power_kW,T_env_C,T_coolant_C,T1_C,T2_C,T_stator_C,P1_um"
@@ -64,6 +64,12 @@ def test_sensor_lag_delays_one_channel_only():
     assert np.array_equal(_col(out, "T1_C"), _col(text, "T1_C"))
     # a constant channel through a lag stays constant (its scatter was 0: no noise added)
     assert np.allclose(_col(out, "T_stator_C"), 22.0)
+
+
+def test_the_injectable_effects_are_the_libraries_measurement_effects():
+    """The library's effects that act on the measurement alone, read from the effects
+    themselves (compare.fit.effects), not from a list in the injector."""
+    assert set(injectable()) == {"centrifugal_shortening", "fixture_expansion", "sensor_lag"}
 
 
 def test_physics_effects_and_missing_parameters_are_refused():

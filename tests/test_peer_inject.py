@@ -3,7 +3,7 @@
 truth is known exactly. Right: the injected effect (and for a lag, its channel) named alone.
 
 Slow: one fit of 10-20 s per case. ``python benchmarks/bench_peerinject.py`` prints the whole
-table (18 cases; docs/fit.md); the cases here are the ones each of the loop's rules was
+table (18 cases; docs/fit-history.md); the cases here are the ones each of the loop's rules was
 changed for (the rule in the comment), plus one per effect kind on the loaded control. The
 case still missed (a 1200 s lag on T_stator of the loaded dev-09) is marked xfail(strict),
 so that a fix shows up.
@@ -46,7 +46,8 @@ def _fit(control: str, effect: str, params: tuple, channel: str | None) -> list[
     import tempfile
 
     from compare.fit.inject import inject
-    from compare.fit.run import named_effects, run_fit
+    from compare.fit.report import named_effects
+    from compare.fit.run import run_fit
     from spindle.spec_reader import load_spec
 
     text = inject((PEER_RUNS / f"{control}.csv").read_text(encoding="utf-8"), effect,

@@ -125,7 +125,7 @@ def test_a_held_input_switching_at_a_step_end_acts_from_there_on(spec_from, thet
     the step that ends there (a zero-order hold of the step's own value, as the lumped model
     integrates it). Read at the step's end instead, every switch acted one step early: on a
     bench's 60 s grid that put the stator 4 K ahead of the data at a speed step
-    (docs/fit.md). Up to t the run equals the one without the source (to round-off); the
+    (docs/fit-history.md). Up to t the run equals the one without the source (to round-off); the
     step after t warms by about q dt / C."""
     dt, t_on, q = 10.0, 50.0, 1.0  # s, s, W (TAU is 333 s)
 

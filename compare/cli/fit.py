@@ -44,7 +44,8 @@ def _base_extra(names: list[str] | None) -> tuple[str, ...] | None:
 
 @with_progress("fit")
 def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
-    from compare.fit.run import report_summary_text, run_fit, save_report
+    from compare.fit.report import save_report, summary_text
+    from compare.fit.run import run_fit
     from spindle.outputs import output_dir, safe_name
     from spindle.spec_reader import load_spec
 
@@ -65,13 +66,14 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
     with output_dir(out, inputs=[spec.path, args.run], force=args.force) as tmp, progress.pictures():
         save_report(rep, tmp, pictures=not args.no_pictures)
     progress.done()
-    print(report_summary_text(rep))
+    print(summary_text(rep))
     print(f"wrote {out}/report.json, {out}/report.html")
     return 0
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from compare.fit.greybox import DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS
+    from compare.fit.effects import LIBRARY
+    from compare.fit.params import DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS
 
     """Add the command's sub-parser."""
     fp = subparsers.add_parser("fit", help="fit a bench run: calibrate, diagnose the residual, add the "
@@ -90,11 +92,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "this many blocks held out in turn, the model refitted without it and "
                     "simulated over it (default 5; 0: none)")
     fp.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
-                    help="level of the likelihood-ratio test for adding an effect (0.01)")
+                    help="the level of every test: an effect's likelihood-ratio test, the "
+                    "signature tests, the competitor's (divided by its hypotheses) and the "
+                    "plausible range of the base parameters (default 0.01)")
     fp.add_argument("--min-gain", type=number(0.0, 100.0), default=25.0,
-                    help="an effect must remove at least this share [%%] of the validation "
-                    "error above the floor (lumped-model error against the FEM and sensor "
-                    "noise) (default 25)")
+                    help="an effect judged by the open-loop fit must remove at least this "
+                    "share [%%] of the blocked cross-validated error above the noise floor on "
+                    "its channels (default 25)")
     fp.add_argument("--fem-level", type=number(0, 4, integer=True), default=0,
                     help="FEM reference level that anchors the model on the run's inputs "
                     "(default 0; docs/fit.md)")
@@ -116,7 +120,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     f"(default: {' '.join(DEFAULT_BASE_EXTRA)} with --model lumped; "
                     "docs/fit.md)")
     fp.add_argument("--nodes", type=NODE_COUNT, default=11, help="lumped model nodes (default 11)")
-    fp.add_argument("--candidates", nargs="+", help="candidate effects (default: all)")
+    fp.add_argument("--candidates", nargs="+", choices=list(LIBRARY), metavar="EFFECT",
+                    help="candidate effects (default: the whole library: "
+                    f"{', '.join(LIBRARY)})")
     add_no_pictures(fp)
     add_quiet(fp)
     fp.set_defaults(func=_cmd_fit)

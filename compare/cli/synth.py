@@ -1,4 +1,4 @@
-"""``spindle-verify synth``: a synthetic bench run from the FEM reference with one effect injected."""
+"""``spindle-verify synth``: a synthetic bench run from the FEM reference with effects injected."""
 
 from __future__ import annotations
 
@@ -15,20 +15,24 @@ if TYPE_CHECKING:
 
 @with_progress("synth")
 def _cmd_synth(args: argparse.Namespace, progress: Progress) -> int:
-    from compare.fit.greybox import EFFECTS
-    from compare.fit.synth import OUTSIDE, synth
+    from compare.fit.effects import LIBRARY
+    from compare.fit.outside import OUTSIDE
+    from compare.fit.synth import synth
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
-    known = [*EFFECTS, "clean", *OUTSIDE]
-    if args.effect not in known:
-        raise InputError("command line", "--effect", f"unknown effect '{args.effect}'",
+    known = [*LIBRARY, "clean", *OUTSIDE]
+    bad = [e for e in args.effect if e not in known]
+    if bad:
+        raise InputError("command line", "--effect", f"unknown effect '{bad[0]}'",
                          f"use one of {', '.join(known)}")
     out = Path(args.out)
     if out.suffix.lower() != ".csv":
         raise InputError(str(out), "--out", "is not a .csv file name", "give e.g. run.csv")
-    progress.stage(f"FEM level {args.level} run of '{args.cycle}' with the effect '{args.effect}'")
-    truth = synth(spec, args.cycle, args.effect, args.seed, out, level=args.level,
+    progress.stage(f"FEM level {args.level} run of '{args.cycle}' with "
+                   f"{' and '.join(args.effect)}")
+    effects = args.effect[0] if len(args.effect) == 1 else args.effect
+    truth = synth(spec, args.cycle, effects, args.seed, out, level=args.level,
                   mismatch=args.mismatch)
     progress.done()
     print(f"wrote {out} and {out.with_suffix('.truth.json')} (effect {truth['effect']}, "
@@ -40,8 +44,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the command's sub-parser."""
     sy = subparsers.add_parser("synth", help="a synthetic bench run from the FEM reference with one "
                         "effect injected; the truth goes to RUN.truth.json")
-    from compare.fit.greybox import EFFECTS
-    from compare.fit.synth import OUTSIDE
+    from compare.fit.effects import LIBRARY
+    from compare.fit.outside import OUTSIDE
 
     sy.add_argument("--spec", default="spl2782",
                     help="the spindle the data come from: a shipped name or a spec file "
@@ -51,9 +55,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          "random-ramped-load (non-monotonic steps up to 6000 rpm drawn from the "
                          "seed; the last ramps the load within each speed step, as a loaded "
                          "bench run does) (default spl-16h)")
-    sy.add_argument("--effect", default="clean", metavar="EFFECT",
-                    help="effect to inject: clean (none, the default), one of the fit's "
-                         f"library ({', '.join(EFFECTS)}) or one outside it "
+    sy.add_argument("--effect", default=["clean"], nargs="+", metavar="EFFECT",
+                    help="effects to inject, together: clean (none, the default), the fit's "
+                         f"library ({', '.join(LIBRARY)}) or causes outside it "
                          f"({', '.join(OUTSIDE)}, which fit should report unexplained)")
     sy.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0,
                     help="random seed: the effect's magnitude, the noise and sampling, and "

@@ -1,4 +1,4 @@
-"""Verdicts on the calibrated base model before any effect is named (docs/fit.md, issue 13 §4-5).
+"""Verdicts on the calibrated base model before any effect is named (docs/fit-history.md, issue 13 §4-5).
 
 - :func:`base_adequacy`: how well the calibrated base model alone explains the run (open-loop
   RMS per channel against the paper's tolerances, 1 K and 1.5 µm), which base parameters
@@ -14,13 +14,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
-#: |z| beyond which a base parameter is outside its prior range (two-sided 1 %)
-IMPLAUSIBLE_Z = 2.576
-
-#: conductances [W/K] the spec does not have (base extras whose spec value is 0) and the
-#: value above which the run is said to need them: 1 W/K moves a bearing ring carrying 30-60 W
-#: of friction by several kelvin, far above the sensors' resolution
-MISSING_PATH_W_K = {"G_seat_W_K": 1.0}
+#: conductances the spec does not have (base extras whose spec value is 0): the run is said
+#: to need one above Criteria.missing_path_W_K
+MISSING_PATHS = ("G_seat_W_K",)
 
 #: where in the spec (or drive file) each base parameter lives: what to look at when the
 #: calibration drives it out of its prior range
@@ -53,21 +49,22 @@ WHERE_IN_SPEC = {
                    "lengths",
 }
 
-#: a calibrated value within this fraction of its range's width from a bound is "at" it
-AT_BOUND_REL = 1e-3
-
 
 def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
                   theta: Mapping[str, float], spec_values: Mapping[str, float],
                   prior_z: Mapping[str, float] | None,
-                  bounds: Mapping[str, tuple[float, float]] | None = None) -> dict:
+                  bounds: Mapping[str, tuple[float, float]] | None = None,
+                  criteria=None) -> dict:
     """The base-adequacy verdict of a calibrated base model.
 
     ``errors``: :meth:`compare.fit.calibrate.Calibrator.errors` of the base fit (per window
     and channel, with ``rmse_w``, the RMS in units of the channel's tolerance); ``theta`` its
     parameters; ``spec_values`` the spec's values (prior centres); ``prior_z`` the parameters'
     distances from them in prior standard deviations (empty without priors); ``bounds`` the
-    parameters' ranges (lo, hi), to say which ran to a bound.
+    parameters' ranges (lo, hi), to say which ran to a bound (a bound that is the spec's own
+    value is no advice: a path the spec lacks calibrated to nothing); ``criteria``
+    (compare.fit.criteria.Criteria; default the defaults) gives the plausible range (at its
+    alpha), the bound's width and the least missing conductance.
 
     Returns ``{"adequate": bool, "channels": {c: {window: rmse_w}}, "inadequate_channels":
     [...], "moved": [{name, spec, calibrated, z}], "implausible": [...], "at_bound": [...],
@@ -78,6 +75,10 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     A channel is inadequate when its open-loop RMS exceeds its tolerance on either window.
     The statement is a clause to follow a subject ("the base model ...").
     """
+    from compare.fit.criteria import Criteria
+
+    criteria = criteria or Criteria()
+    z_crit = criteria.implausible_z()
     channels: dict[str, dict[str, float]] = {}
     bad: list[tuple[str, str, float]] = []
     for window in ("fit", "validation"):
@@ -91,16 +92,19 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     moved = [{"name": k, "spec": float(spec_values[k]), "calibrated": float(theta[k]),
               "z": float(z[k]) if k in z else None}
              for k in spec_values if k in theta]
-    implausible = sorted((k for k, v in z.items() if abs(v) > IMPLAUSIBLE_Z),
-                         key=lambda k: -abs(z[k]))
+    implausible = sorted((k for k, v in z.items() if abs(v) > z_crit), key=lambda k: -abs(z[k]))
     # paths the spec lacks (no prior: the spec's value is 0) that the run needed
-    missing = [k for k, floor in MISSING_PATH_W_K.items()
-               if k in theta and float(theta[k]) > floor]
+    missing = [k for k in MISSING_PATHS
+               if k in theta and float(theta[k]) > criteria.missing_path_W_K]
     at_bound = []
     for k, (lo, hi) in (bounds or {}).items():
         if k in theta and k not in implausible and k in spec_values:
-            tol = AT_BOUND_REL * (hi - lo)
-            if float(theta[k]) <= lo + tol or float(theta[k]) >= hi - tol:
+            tol = criteria.at_bound_rel * (hi - lo)
+            v, spec = float(theta[k]), float(spec_values[k])
+            on_lo, on_hi = v <= lo + tol, v >= hi - tol
+            # a bound that is the spec's own value (a conductance the spec lacks, at 0) is
+            # where the calibration says "not needed": no advice
+            if (on_lo and abs(spec - lo) > tol) or (on_hi and abs(spec - hi) > tol):
                 at_bound.append(k)
     worst: dict[str, tuple[str, float]] = {}
     for c, window, r in bad:
@@ -112,9 +116,9 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
             f"{c} by {r:.1f} times its tolerance (open-loop RMS, {w} window)"
             for c, (w, r) in sorted(worst.items(), key=lambda kv: -kv[1][1])))
     if implausible:
-        parts.append("to fit the run, " + "; ".join(
-            f"{k} moved to {theta[k]:.3g} (spec {spec_values[k]:.3g}, {z[k]:+.1f} prior sd): "
-            f"look at {WHERE_IN_SPEC.get(k, 'its value in the spec')}" for k in implausible))
+        parts.append("needs implausible values to fit the run: " + "; ".join(
+            f"{k} {theta[k]:.3g} (the spec's {spec_values[k]:.3g}, {z[k]:+.1f} prior sd; look "
+            f"at {WHERE_IN_SPEC.get(k, 'its value in the spec')})" for k in implausible))
     adequate = not worst and not implausible
     statement = ("explains the run within the tolerances with every base parameter inside its "
                  "prior range" if adequate else "; ".join(parts))
@@ -162,18 +166,3 @@ def extrapolation_warnings(grid_s: np.ndarray, speed_rpm: np.ndarray,
                    f"{100 * share:.0f} % of the validation window and never occur in the fit "
                    "window")
     return out
-
-
-def verdict_text(base: dict, final: dict, effects: list[str]) -> str:
-    """One paragraph: the base model's verdict, then, if effects were named, the verdict with
-    them; where the model stays inadequate, what to look at in the spec."""
-    text = f"The calibrated base model {base['statement']}."
-    if effects:
-        names = ", ".join(effects)
-        text += (f" With {names}: the model {final['statement']}." if not final["adequate"]
-                 else f" With {names} the model explains the run within the tolerances with "
-                 "every base parameter inside its prior range.")
-    if not final["adequate"]:
-        text += (" The model is inadequate for this run: an effect is named only against this "
-                 "misfit, so correct the spec where a parameter left its range first.")
-    return text

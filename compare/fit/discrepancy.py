@@ -29,7 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from compare.fit.greybox import GreyBox, Inputs, base_params, default_theta
+from compare.fit.greybox import GreyBox, Inputs
+from compare.fit.params import base_params, default_theta
 from spindle.loads import LoadCase, TimeSeries
 from spindle.spec import Spec
 

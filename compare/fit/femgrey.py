@@ -4,7 +4,7 @@
 this model instead of the anchored lumped one, so the calibrated values carry the FEM's
 sensitivities, not the 11-node model's (compare.fit.run). It has the interface
 :class:`compare.fit.Calibrator` uses from :class:`compare.fit.greybox.GreyBox` (``spec``,
-``drive``, ``inputs``, ``nodes``, ``effects``, ``lag_channel``, ``_cache``, ``discrepancy``,
+``drive``, ``inputs``, ``nodes``, ``effects``, ``_cache``, ``discrepancy``,
 ``parameters()``, ``variant()``, ``simulate()``), for the base parameters only: the candidate
 effects live in the lumped model (``variant`` with an effect raises).
 
@@ -37,7 +37,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from compare.fit.greybox import BASE_PARAMS, GreyBox, Inputs, Param, base_params, film_groups
+from compare.fit.greybox import GreyBox, Inputs, film_groups
+from compare.fit.params import BASE_PARAMS, Param, base_params
 from spindle.drive import Drive
 from spindle.spec import Spec
 
@@ -58,7 +59,6 @@ class FemGreyBox:
     nodes: int = 11  # the lumped model whose _sources supplies the heat (same power balance)
     level: int = 0
     effects: tuple[str, ...] = ()
-    lag_channel: str | None = None
     _cache: dict = field(default_factory=dict, repr=False)
     #: per channel, added to every simulation (as in GreyBox; None here in fitrun)
     discrepancy: dict[str, np.ndarray] | None = field(default=None, repr=False)
@@ -66,16 +66,14 @@ class FemGreyBox:
     progress: Callable[[str], None] | None = field(default=None, repr=False)
 
     def __post_init__(self):
-        if self.effects or self.lag_channel:
-            raise ValueError(_NO_EFFECTS.format(effects=", ".join(self.effects)
-                                                or f"sensor_lag({self.lag_channel})"))
+        if self.effects:
+            raise ValueError(_NO_EFFECTS.format(effects=", ".join(self.effects)))
 
     # ------------------------------------------------------------------ interface
-    def variant(self, effects: tuple[str, ...], lag_channel: str | None = None) -> FemGreyBox:
+    def variant(self, effects: tuple[str, ...]) -> FemGreyBox:
         """The same model; any effect raises (FEM calibration is of the base parameters)."""
-        if tuple(effects) or lag_channel:
-            raise ValueError(_NO_EFFECTS.format(effects=", ".join(effects) or
-                                                f"sensor_lag({lag_channel})"))
+        if tuple(effects):
+            raise ValueError(_NO_EFFECTS.format(effects=", ".join(effects)))
         return self
 
     def parameters(self) -> dict[str, Param]:

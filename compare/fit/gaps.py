@@ -4,7 +4,7 @@ A bench that stops logging for a while (a 20 min gap in ``synth``'s runs, 9 min 
 may come back at another speed. The inputs then say nothing about when it changed, and a
 zero-order hold of the last speed puts the change at the gap's end: up to the whole gap late.
 On a 6000 -> 1600 rpm change in a 20 min gap that left the stator 10 K, the rings 1.5 K off
-the data right after the gap and pulled the calibrated jacket film to its bound (docs/fit.md).
+the data right after the gap and pulled the calibrated jacket film to its bound (docs/fit-history.md).
 
 The switch time is a nuisance parameter of the inputs, so it is estimated like one: for each
 such gap, every grid point inside it is tried as the switch (the old speed and power before,
@@ -22,15 +22,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from compare.fit.criteria import Criteria
 from compare.fit.greybox import Inputs
 from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
 
-#: a gap is a stretch without any row longer than this many grid steps
-MIN_GAP_STEPS = 2.0
-#: the window after a gap [s] whose fit decides the switch time
-JUDGE_S = 3600.0
-#: the window [s] over which the power before and after a gap is averaged
-LEVEL_S = 300.0
+#: the criteria of the gaps (gap_min_steps, gap_judge_s, gap_level_s) when none are given
+_DEFAULT = Criteria()
 
 
 @dataclass(frozen=True)
@@ -46,10 +43,10 @@ class GapSwitch:
 
 def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.ndarray,
                      grid_s: np.ndarray, band_rpm: float = SPEED_BAND_RPM,
-                     band_rel: float = SPEED_BAND_REL
+                     band_rel: float = SPEED_BAND_REL, criteria: Criteria = _DEFAULT
                      ) -> list[tuple[float, float, float, float]]:
     """(start, end, speed before, speed after) of each stretch without any row (``t_rows_s``,
-    every row's time) longer than MIN_GAP_STEPS grid steps across which the speed changed
+    every row's time) longer than ``criteria.gap_min_steps`` grid steps across which the speed changed
     beyond the drive's scatter band (max(``band_rpm``, ``band_rel`` x speed)). The speed
     before is the last valid sample at or before the gap, after it the first one at or after
     its end (``t_speed_s``, ``speed_rpm``: the valid speed samples). A speed logged only on
@@ -57,7 +54,7 @@ def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.
     sample that logs it."""
     step = float(np.median(np.diff(grid_s)))
     out = []
-    for i in np.where(np.diff(t_rows_s) > MIN_GAP_STEPS * step)[0]:
+    for i in np.where(np.diff(t_rows_s) > criteria.gap_min_steps * step)[0]:
         start, end = float(t_rows_s[i]), float(t_rows_s[i + 1])
         k = int(np.searchsorted(t_speed_s, start, side="right")) - 1
         j = int(np.searchsorted(t_speed_s, end, side="left"))
@@ -76,7 +73,7 @@ def _level(t_s: np.ndarray, y: np.ndarray, t0: float, t1: float) -> float:
 
 def place_switches(inputs: Inputs, t_rows_s: np.ndarray, t_speed_s: np.ndarray,
                    speed_rpm: np.ndarray, t_power_s: np.ndarray, power_kW: np.ndarray,
-                   misfit: Callable[[Inputs, float], float]
+                   misfit: Callable[[Inputs, float], float], criteria: Criteria = _DEFAULT
                    ) -> tuple[Inputs, list[GapSwitch]]:
     """``inputs`` with the speed and power inside each gap with a change set to the old
     operating point up to the best switch time and the new one after it, and the switches.
@@ -84,13 +81,14 @@ def place_switches(inputs: Inputs, t_rows_s: np.ndarray, t_speed_s: np.ndarray,
     the window after the gap for these inputs (compare.fit.run builds it)."""
     grid = inputs.grid_s
     switches = []
-    for start, end, before, after in gaps_with_change(t_rows_s, t_speed_s, speed_rpm, grid):
+    for start, end, before, after in gaps_with_change(t_rows_s, t_speed_s, speed_rpm, grid,
+                                                      criteria=criteria):
         # the grid intervals the gap touches; the switch falls on one of their edges
         inside = np.where((grid[1:] > start) & (grid[:-1] < end))[0]
         if len(inside) == 0:
             continue
-        p_before = _level(t_power_s, power_kW, start - LEVEL_S, start)
-        p_after = _level(t_power_s, power_kW, end, end + LEVEL_S)
+        p_before = _level(t_power_s, power_kW, start - criteria.gap_level_s, start)
+        p_after = _level(t_power_s, power_kW, end, end + criteria.gap_level_s)
         best = None
         for s in range(int(inside[0]), int(inside[-1]) + 2):
             speed, power = inputs.speed_rpm.copy(), inputs.power_kW.copy()

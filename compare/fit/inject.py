@@ -3,14 +3,11 @@ this project did not make).
 
 A peer's control run (../shared/bench-runs, truth ``none``) carries the base misfit of a real
 spindle that the spec describes only approximately: this project's model did not make it.
-Three library effects act on the measurement alone, so adding them to such a run gives a run
-whose truth is known exactly and whose every other detail stays the peer's:
-
-- ``centrifugal_shortening``: P1 drops by c (n / 1000 rpm)^2 at once;
-- ``fixture_expansion``: P1 moves by k (T_env - T_env at the start);
-- ``sensor_lag``: one channel reads through a first-order lag of time constant tau; the lag
-  also smooths the channel's noise, so noise of the size the channel had (its sample-to-sample
-  scatter) is added back after it.
+The library's effects that act on the measurement alone (``measurement_only``: a centrifugal
+jump, a fixture's term, a sensor's lag) can be added to such a run through their own
+``measure`` hook, giving a run whose truth is known exactly and whose every other detail stays
+the peer's. A lag also smooths the channel's noise, so noise of the size the channel had (its
+sample-to-sample scatter) is added back after it.
 
 Injected values are rounded to the decimals the column was logged with (the bench's
 quantisation), empty cells stay empty, and a comment line records what was injected. Units:
@@ -26,14 +23,19 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from compare.fit.effects import LIBRARY
 from lumped.elastic import first_order_lag as lumped_lag
 from spindle.commented_csv import split_commented_csv
+from spindle.tolerances import edge_absolute
+from spindle.units import ZERO_C_K
 
-#: the effects this module injects, with their parameter names
-INJECTABLE = {"centrifugal_shortening": ("c_cf_um_krpm2",),
-              "fixture_expansion": ("k_fix_um_K",),
-              "sensor_lag": ("tau_s",)}
+#: the channels a lag may be injected on
 LAG_CHANNELS = ("T1", "T2", "T_stator", "P1")
+
+
+def injectable() -> list[str]:
+    """The library's effects that act on the measurement alone."""
+    return [name for name, e in LIBRARY.items() if e.measurement_only]
 
 
 def _column(header: list[str], name: str) -> int:
@@ -77,43 +79,46 @@ def first_order_lag(t_s: np.ndarray, x: np.ndarray, tau_s: float) -> np.ndarray:
 
 def inject(text: str, effect: str, params: Mapping[str, float], channel: str | None = None,
            seed: int = 0) -> str:
-    """``text`` (a bench CSV) with ``effect`` injected at ``params`` (names as
-    compare.fit.greybox.EFFECTS; ``channel`` for ``sensor_lag``). Returns the new CSV text."""
-    if effect not in INJECTABLE:
+    """``text`` (a bench CSV) with ``effect`` injected at ``params`` (the effect's parameter
+    names; ``channel`` for a per-channel effect). Returns the new CSV text."""
+    e = LIBRARY.get(effect)
+    if e is None or not e.measurement_only:
         raise ValueError(f"{effect!r} acts on the physics, not only on the measurement; "
-                         f"injectable: {', '.join(INJECTABLE)}")
-    missing = [p for p in INJECTABLE[effect] if p not in params]
+                         f"injectable: {', '.join(injectable())}")
+    missing = [p.name for p in e.params if p.name not in params]
     if missing:
         raise ValueError(f"{effect} needs {', '.join(missing)}")
+    if e.per_channel and channel not in LAG_CHANNELS:
+        raise ValueError(f"{effect} needs a channel: one of {', '.join(LAG_CHANNELS)}")
     doc = split_commented_csv(text)
     header, rows = doc.rows[0], [list(r) for r in doc.rows[1:]]
     t = _floats(rows, _column(header, "time"))
-    if effect == "sensor_lag":
-        if channel not in LAG_CHANNELS:
-            raise ValueError(f"sensor_lag needs a channel: one of {', '.join(LAG_CHANNELS)}")
-        j = _column(header, channel)
+    cols = {"speed_rpm": _floats(rows, _column(header, "speed")),
+            "T_env_K": _floats(rows, _column(header, "T_env")) + ZERO_C_K}
+    for c in LAG_CHANNELS:
+        j = _column(header, c)
+        scale, off, _ = edge_absolute(c)
+        cols[c] = (_floats(rows, j) + off) / scale
+    new = e.measure(t, cols, params, channel)
+    changed = [c for c in LAG_CHANNELS if new[c] is not cols[c]]
+    rng = np.random.default_rng(seed)
+    for c in changed:
+        j = _column(header, c)
         x = _floats(rows, j)
-        ok = np.isfinite(x)
-        scatter = float(np.nanstd(np.diff(x[ok])) / math.sqrt(2.0)) if ok.sum() > 2 else 0.0
-        rng = np.random.default_rng(seed)
-        new = first_order_lag(t, x, float(params["tau_s"])) + rng.normal(0.0, scatter, len(x))
-        what = f"sensor_lag on {channel}, tau_s = {params['tau_s']:g}"
-    else:
-        j = _column(header, "P1")
-        x = _floats(rows, j)
-        if effect == "centrifugal_shortening":
-            n = np.nan_to_num(_floats(rows, _column(header, "speed")))
-            new = x - float(params["c_cf_um_krpm2"]) * (n / 1000.0) ** 2
-            what = f"centrifugal_shortening, c_cf_um_krpm2 = {params['c_cf_um_krpm2']:g}"
-        else:
-            env = _floats(rows, _column(header, "T_env"))
-            env0 = env[np.isfinite(env)][0]
-            new = x + float(params["k_fix_um_K"]) * np.where(np.isfinite(env), env - env0, 0.0)
-            what = f"fixture_expansion, k_fix_um_K = {params['k_fix_um_K']:g}"
-    d = _decimals(rows, j)
-    for i, r in enumerate(rows):
-        if np.isfinite(x[i]) and np.isfinite(new[i]):
-            r[j] = f"{new[i]:.{d}f}"
+        scale, off, _ = edge_absolute(c)
+        y = new[c] * scale - off
+        if e.per_channel:
+            # a lag smooths the channel's noise too: noise of the size the channel had (its
+            # sample-to-sample scatter) is added back after it
+            ok = np.isfinite(x)
+            scatter = float(np.nanstd(np.diff(x[ok])) / math.sqrt(2.0)) if ok.sum() > 2 else 0.0
+            y = y + rng.normal(0.0, scatter, len(x))
+        d = _decimals(rows, j)
+        for i, r in enumerate(rows):
+            if np.isfinite(x[i]) and np.isfinite(y[i]):
+                r[j] = f"{y[i]:.{d}f}"
+    what = f"{effect}" + (f" on {channel}" if channel else "") + ", " + ", ".join(
+        f"{k} = {v:g}" for k, v in params.items())
     out = io.StringIO()
     header_line = doc.line_no[0]
     for _ln, c in doc.comments:

@@ -514,37 +514,3 @@ def plot_cumulated_periodogram(ax: Any, r: Any, alpha: float = 0.05, dt_s: float
     ax.set_ylabel("cumulated periodogram [-]")
     ax.legend(loc="lower right")
     return ax
-
-
-def plot_ccf(ax: Any, r: Any, x: Any, max_lag: int, alpha: float = 0.05, dt_s: float = 1.0,
-             label: str = "") -> Any:
-    """Draw the cross-correlation of a residual with ``x`` (lag [s], > 0: residual follows x)
-    and its pointwise band. Returns ``ax``."""
-    lags, cc, half = cross_correlation(r, x, max_lag, alpha)
-    ax.plot(lags * dt_s, cc, color="C0", lw=1.0, label=label or None)
-    for s in (-1, 1):
-        ax.axhline(s * half, color="C3", ls="--", lw=0.9)
-    ax.axvline(0.0, color="k", lw=0.5)
-    ax.set_xlabel("lag [s] (> 0: residual follows the signal)")
-    ax.set_ylabel("cross-correlation [-]")
-    return ax
-
-
-def diagnostics_figure(residuals: Mapping[str, Any], dt_s: float, nlags: int = 50,
-                       alpha: float = 0.01) -> Any:
-    """A figure with one row per channel: the residual over time [h], its ACF and its cumulated
-    periodogram at ``alpha``. Returns the matplotlib Figure (the caller saves and closes it)."""
-    from spindle.plots import pyplot
-
-    plt = pyplot()
-    fig, axes = plt.subplots(len(residuals), 3, figsize=(13, 3.2 * len(residuals)), squeeze=False,
-                             layout="constrained")
-    for row, (name, r) in zip(axes, residuals.items(), strict=True):
-        a = _as_series(r)
-        row[0].plot(np.arange(a.size) * dt_s / 3600, a, lw=0.8)
-        row[0].axhline(0.0, color="k", lw=0.5)
-        row[0].set_xlabel("time [h]")
-        row[0].set_ylabel(f"residual {name}")
-        plot_acf(row[1], a, min(nlags, a.size - 1), alpha, dt_s)
-        plot_cumulated_periodogram(row[2], a, alpha, dt_s)
-    return fig

@@ -1,162 +1,53 @@
-"""Synthetic bench runs from the FEM reference, with one effect injected (issue 6 §5).
+"""Synthetic bench runs from the FEM reference, with effects injected (issue 6 §5).
 
 ``spindle-verify synth --cycle spl-16h --effect NAME --seed S --out RUN.csv`` solves the FEM
-reference (not the lumped model the fit uses) over the cycle with the effect built into the
-physics or the measurement, then samples it the way a bench logs: irregular times (about 1 Hz),
-sensor noise and quantisation, a gap, empty cells, comment metadata and an extra column, in
-the bench format (../shared/bench-format.md). The truth (effect, its parameters, the seed) goes
-to ``RUN.truth.json`` beside the CSV; ``fit`` never reads it.
+reference (not the lumped model the fit uses) over the cycle with the effects built into the
+physics or the measurement, then samples it the way a bench logs: irregular times (about
+1 Hz), sensor noise and quantisation, a gap, empty cells, comment metadata and an extra
+column, in the bench format (../shared/bench-format.md). The truth (effects, their
+parameters, the seed) goes to ``RUN.truth.json`` beside the CSV; ``fit`` never reads it.
 
-How each effect enters the reference:
-
-- ``centrifugal_shortening``: the FEM's own centrifugal load (rho omega^2 r on the rotating
-  parts), scaled by a factor (the spl2782 shaft at 4300 rpm shortens only 0.26 µm; the scale
-  stands for a more compliant rotor so that the effect is worth detecting);
-- ``bearing_preload``: bearing heat times (1 + k (T_inner - T_outer)) from the FEM's own ring
-  temperatures, by fixed-point iteration; the extra friction is a torque the motor supplies,
-  so the logged electrical power carries it too;
-- ``fixture_expansion``: P1 + k (T_env - T_env(0));
-- ``coolant_dynamics``: coolant temperature = supply + R Q_coolant(t) from the FEM's own heat
-  into the coolant, by fixed-point iteration;
-- ``sensor_lag``: a first-order lag on T1 or P1;
-- ``windage_loss``: c (n / 1000)^3 W more into the rotor, a drag the motor supplies (the
-  logged electrical power carries it, as a bench's does);
-- ``mount_conduction``: a conductance G from the housing's front face to ambient;
-- ``clean``: none; ``electronics_drift`` (outside the library, for the tests): a slow
-  sinusoidal drift of the P1 electronics.
+Each effect enters through its own hooks (compare.fit.effects.base.Effect): the spindle (a
+mount's conductance), the load case (windage's heat, and the drag the logged power carries),
+a feedback from the FEM's own temperatures solved to a fixed point (a preload's friction, the
+coolant's warming), or the measurement (a centrifugal jump, a fixture's term, a lag). Several
+effects can be injected together; causes outside the library (compare.fit.outside) use the
+same hooks.
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import replace
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 
-from compare.fit.greybox import EFFECTS
-from lumped.elastic import first_order_lag
-from spindle.loads import LoadCase, SpeedTable, TimeSeries
+from compare.fit.effects import LIBRARY
+from compare.fit.outside import OUTSIDE
+from spindle.loads import LoadCase
 from spindle.spec import Spec
 from spindle.tolerances import edge_absolute
 from spindle.units import RPM_TO_RAD_S, ZERO_C_K
 
-OUTSIDE = ("electronics_drift",)
 #: noise (standard deviation) and quantisation of the bench channels
 NOISE = {"T1_C": (0.03, 0.01), "T2_C": (0.03, 0.01), "T_stator_C": (0.1, 0.1),
          "P1_um": (0.05, 0.1), "T_env_C": (0.05, 0.01), "T_coolant_C": (0.02, 0.01)}
 
 
+def kind_of(name: str):
+    """The effect (library) or the cause outside it of a synthetic run's ``name``."""
+    if name in LIBRARY:
+        return LIBRARY[name]
+    if name in OUTSIDE:
+        return OUTSIDE[name]
+    raise ValueError(f"unknown effect {name!r}: use {', '.join([*LIBRARY, 'clean', *OUTSIDE])}")
+
+
 def draw_truth(effect: str, rng: np.random.Generator) -> dict:
-    """The injected effect's parameters for this seed: magnitudes a bench could show, above
-    what `fit` can tell apart on the spl-16h cycle (docs/fit.md, detection limits). Below
-    them an effect is real but indistinguishable from the base parameters or a neighbour:
-    bearing_preload below about 0.08 1/K (ring differences of 1-2 K on this no-load cycle
-    make it less than 15 % more bearing heat, which windage_loss or f0 imitate)."""
-    if effect == "centrifugal_shortening":
-        return {"scale": float(rng.uniform(8.0, 15.0))}
-    if effect == "bearing_preload":
-        k = float(rng.uniform(0.10, 0.20))  # both bearing sets alike
-        return {"k_preload_1_K": k, "k_preload_rear_1_K": k}
-    if effect == "fixture_expansion":
-        return {"k_fix_um_K": float(rng.choice([-1, 1]) * rng.uniform(0.8, 2.0))}
-    if effect == "coolant_dynamics":
-        return {"R_adv_K_W": float(rng.uniform(0.002, 0.005))}
-    if effect == "sensor_lag":
-        return {"channel": str(rng.choice(["T1", "P1"])), "tau_s": float(rng.uniform(400, 900))}
-    if effect == "windage_loss":
-        return {"c_w_W_krpm3": float(rng.uniform(0.6, 1.5))}
-    if effect == "mount_conduction":
-        return {"G_mount_W_K": float(rng.uniform(2.0, 5.0))}
-    if effect == "electronics_drift":
-        return {"amplitude_um": float(rng.uniform(1.0, 2.0)), "period_h": 5.0}
-    return {}
-
-
-def _with_mount(spec: Spec, G_W_K: float) -> Spec:
-    """The housing's front-face film raised by G / A (A its area)."""
-    from spindle.faces import exposed_faces, surface_faces
-
-    faces = exposed_faces(spec)
-    front = [s for s in spec.surfaces if s.side == "front" and s.h_W_m2K is not None
-             and any(spec.part(p).role == "housing" for p in s.parts)]
-    if not front:
-        raise ValueError("mount_conduction needs a convective front face of the housing")
-    s = front[0]
-    area = sum(f.area_m2 for f in surface_faces(s, faces, spec))
-    h = SpeedTable(s.h_W_m2K.speed_rpm, tuple(v + G_W_K / area for v in s.h_W_m2K.values))
-    surfaces = tuple(replace(x, h_W_m2K=h) if x is s else x for x in spec.surfaces)
-    return replace(spec, surfaces=surfaces)
-
-
-def reference_run(spec: Spec, case: LoadCase, effect: str, truth: dict, level: int = 1,
-                  dt_s: float = 60.0) -> tuple[np.ndarray, dict[str, np.ndarray], dict]:
-    """Times [s] and the channels T1, T2, T_stator [K], P1 [m] of the FEM with the effect, and
-    the parts that follow the speed at once, by channel, as functions of the sample times [m]
-    (the centrifugal shortening; added by :func:`bench_rows` at the bench's own times). The
-    key ``"drag_W"`` of the latter, when present, is the extra mechanical power [W] the motor
-    supplies against the effect (windage, the preload's extra friction), which the logged
-    electrical power carries."""
-    from reference import ReferenceModel
-
-    T0 = float(case.T_ambient_K(0.0))
-    if effect == "mount_conduction":
-        spec = _with_mount(spec, truth["G_mount_W_K"])
-    if effect == "windage_loss":
-        rotor = [h.name for h in spec.heat_sources if h.part and spec.part(h.part).role == "rotor"]
-        src = case.sources[rotor[0]]
-        t = np.asarray(src.time_s)
-        extra = truth["c_w_W_krpm3"] * (np.asarray(case.speed_rpm(t + 1e-6)) / 1000.0) ** 3
-        case = case.with_sources({rotor[0]: TimeSeries(tuple(t), tuple(np.asarray(src.values)
-                                                                       + extra),
-                                                       src.interpolation)})
-    ref = ReferenceModel(spec, level)
-    instant = {}
-    if effect == "windage_loss":
-        instant["drag_W"] = lambda ts: truth["c_w_W_krpm3"] * (
-            np.asarray(case.speed_rpm(ts), dtype=float) / 1000.0) ** 3
-    if effect in ("coolant_dynamics", "bearing_preload"):
-        res, x, tx = _fixed_point(ref, case, effect, truth, dt_s, T0)
-        if effect == "bearing_preload":
-            bearings = _bearing_sources(spec)
-            extra = sum(np.asarray(case.sources[h.name](tx)) * _k_preload(spec, h, truth) * dT
-                        for h, dT in zip(bearings, np.split(x, len(bearings)), strict=True))
-            instant["drag_W"] = lambda ts, tx=tx, extra=extra: np.interp(ts, tx, extra)
-    else:
-        res = ref.transient(case, dt_s, T0=T0)
-    ch = {n: res.sensor(n) for n in ("T1", "T2", "T_stator") if n in res.names}
-    ch["P1"] = res.growth_m["P1"].copy()
-    if effect == "centrifugal_shortening":
-        # the FEM's centrifugal part, scaled, follows the speed at once: it is evaluated at the
-        # bench's own sample times (bench_rows), not interpolated from the model grid, where
-        # it would ramp over a whole time step after every speed step
-        scale = truth["scale"]
-        instant["P1"] = lambda ts: scale * ref.centrifugal_m(case, ts, "P1")
-    t = res.times_s
-    if effect == "fixture_expansion":
-        env = np.asarray(case.T_ambient_K(t))
-        ch["P1"] = ch["P1"] + truth["k_fix_um_K"] * 1e-6 * (env - env[0])
-    if effect == "sensor_lag":
-        ch[truth["channel"]] = first_order_lag(t, ch[truth["channel"]], truth["tau_s"])
-    if effect == "electronics_drift":
-        ch["P1"] = ch["P1"] + truth["amplitude_um"] * 1e-6 * np.sin(
-            2 * np.pi * t / (truth["period_h"] * 3600.0))
-    return t, ch, instant
-
-
-def _bearing_sources(spec: Spec) -> list:
-    """The spec's bearing heat sources, in the order the preload's fixed point stacks their
-    ring differences."""
-    return [h for h in spec.heat_sources
-            if h.part and spec.part(h.part).role in ("front_bearing", "rear_bearing")]
-
-
-def _k_preload(spec: Spec, source, truth: dict) -> float:
-    """The injected preload coefficient [1/K] of a bearing heat source (a truth written before
-    the rear coefficient existed holds one for both)."""
-    if spec.part(source.part).role == "rear_bearing":
-        return truth.get("k_preload_rear_1_K", truth["k_preload_1_K"])
-    return truth["k_preload_1_K"]
+    """The injected effect's parameters for this seed (its :meth:`Effect.draw`): magnitudes a
+    bench could show. ``clean``: none."""
+    return {} if effect == "clean" else kind_of(effect).draw(rng)
 
 
 def _anderson(G, x0: np.ndarray, tol: float, max_iter: int = 25, memory: int = 5
@@ -187,63 +78,74 @@ def _anderson(G, x0: np.ndarray, tol: float, max_iter: int = 25, memory: int = 5
                        f"{float(np.max(np.abs(f))):.3g} after {max_iter} FEM runs")
 
 
-def _fixed_point(ref, case: LoadCase, effect: str, truth: dict, dt_s: float, T0: float,
+def _fixed_point(ref, case: LoadCase, feedbacks: list, dt_s: float, T0: float,
                  tol_K: float = 1e-4):
-    """(result, fed-back input [K], its times [s]): the transient with the effect's
-    feedback from the FEM's own temperatures, solved to ``tol_K`` [K] on the fed-back input
-    (the coolant's mean temperature, or each bearing's inner-outer ring difference)."""
+    """(result, the fed-back series, their grid): the transient with every feedback from the
+    FEM's own temperatures (compare.fit.effects.base.Feedback), solved to ``tol_K`` [K] on the
+    fed-back series together."""
     th = ref.thermal
-    spec = th.spec
-    if effect == "coolant_dynamics":
-        from reference.thermal import TWO_PI
-
-        # coolant films do not depend on speed (Dittus-Boelter on the flow)
-        rows = [TWO_PI * s.h_W_m2K(0.0) * b for s, _, b in th.op.films if s.T_ref == "coolant"]
-        g = np.sum(rows, axis=0)
-        functionals = {"coolant_bT": g}
-    else:
-        pts, names = [], []
-        for p in spec.parts:
-            if p.role not in ("front_bearing", "rear_bearing"):
-                continue
-            for sec in p.sections:
-                if sec.name in ("inner_ring", "outer_ring"):
-                    z = 0.5 * (sec.z_start + sec.z_end)
-                    pts.append((z, 0.5 * float(sec.r_in(z) + sec.r_out(z))))
-                    names.append(f"{p.name}.{sec.name}")
-        P = th.probe_matrix(np.array(pts).T).toarray()
-        functionals = {n: P[i] for i, n in enumerate(names)}
-    bearings = _bearing_sources(spec)
+    functionals = {k: v for fb in feedbacks for k, v in fb.functionals.items()}
     first = th.solve_transient(case, dt_s, 1.0, T0, 0, None, functionals)
-    t = first.times_s  # inputs below are given on this grid, so it stays the grid
+    t = first.times_s  # the inputs below are given on this grid, so it stays the grid
+    sizes = []
 
-    def with_input(x: np.ndarray) -> LoadCase:
-        if effect == "coolant_dynamics":  # x: the coolant's mean temperature [K]
-            return replace(case, T_coolant_K=TimeSeries(tuple(t), tuple(x)))
-        parts = np.split(x, len(bearings))  # x: each bearing's ring difference [K]
-        return case.with_sources({
-            h.name: TimeSeries(tuple(t), tuple(np.asarray(case.sources[h.name](t))
-                                               * (1 + _k_preload(spec, h, truth) * dT)))
-            for h, dT in zip(bearings, parts, strict=True)})
+    def apply(x: np.ndarray) -> LoadCase:
+        out = case
+        for fb, part in zip(feedbacks, np.split(x, np.cumsum(sizes)[:-1]), strict=True):
+            out = fb.apply(out, part, t)
+        return out
 
     def G(x: np.ndarray) -> np.ndarray:
-        res = th.solve_transient(with_input(x), dt_s, 1.0, T0, 0, None, functionals)
-        if effect == "coolant_dynamics":
-            # the films see the mean coolant temperature Tm, with sum g (T - Tm) = (Tm - Ts) / R
-            # (Ts the supply): Tm = (Ts + R g.T) / (1 + R sum g)
-            Ts = np.asarray(case.T_coolant_K(t))
-            R, Gs = truth["R_adv_K_W"], float(functionals["coolant_bT"].sum())
-            return (Ts + R * res.functionals["coolant_bT"]) / (1.0 + R * Gs)
-        return np.concatenate([res.functionals[f"{h.part}.inner_ring"]
-                               - res.functionals[f"{h.part}.outer_ring"] for h in bearings])
+        res = th.solve_transient(apply(x), dt_s, 1.0, T0, 0, None, functionals)
+        return np.concatenate([fb.update(res.functionals, case, t) for fb in feedbacks])
 
-    if effect == "coolant_dynamics":
-        x0 = np.asarray(case.T_coolant_K(t), dtype=float)
+    starts = [fb.start(first.functionals, case, t) for fb in feedbacks]
+    sizes = [len(s) for s in starts]
+    x, _, _ = _anderson(G, np.concatenate(starts), tol_K)
+    parts = np.split(x, np.cumsum(sizes)[:-1])
+    return ref.transient(apply(x), dt_s, T0=T0), parts, t
+
+
+def reference_run(spec: Spec, case: LoadCase, injected: Sequence[tuple[str, dict]],
+                  level: int = 1, dt_s: float = 60.0
+                  ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, Callable]]:
+    """Times [s] and the channels T1, T2, T_stator [K], P1 [m] of the FEM with the effects
+    ``injected`` (name, truth parameters), and the instantaneous additions evaluated at the
+    bench's own sample times: ``power_W`` (what the motor supplies against an effect: the
+    logged electrical power carries it), a channel's name [K; m], or a logged input
+    (``T_coolant``, ``T_env`` [K])."""
+    from reference import ReferenceModel
+
+    kinds = [(kind_of(n), truth) for n, truth in injected]
+    T0 = float(case.T_ambient_K(0.0))
+    instant: dict[str, Callable] = {}
+
+    def add(name: str, f: Callable) -> None:
+        old = instant.get(name)
+        instant[name] = f if old is None else (lambda ts, a=old, b=f: a(ts) + b(ts))
+
+    for k, truth in kinds:
+        spec = k.synth_spec(spec, truth)
+    for k, truth in kinds:
+        case, more = k.synth_case(case, spec, truth)
+        for name, f in more.items():
+            add(name, f)
+    ref = ReferenceModel(spec, level)
+    feedbacks = [fb for k, truth in kinds if (fb := k.feedback(ref.thermal, spec, truth))]
+    if feedbacks:
+        res, xs, tx = _fixed_point(ref, case, feedbacks, dt_s, T0)
+        for fb, x in zip(feedbacks, xs, strict=True):
+            for name, f in fb.instant.items():
+                add(name, lambda ts, f=f, x=x: f(ts, case, tx, x))
     else:
-        x0 = np.concatenate([first.functionals[f"{h.part}.inner_ring"]
-                             - first.functionals[f"{h.part}.outer_ring"] for h in bearings])
-    x, _, _ = _anderson(G, x0, tol_K)
-    return ref.transient(with_input(x), dt_s, T0=T0), x, t
+        res = ref.transient(case, dt_s, T0=T0)
+    ch = {n: res.sensor(n) for n in ("T1", "T2", "T_stator") if n in res.names}
+    ch["P1"] = res.growth_m["P1"].copy()
+    t = res.times_s
+    for k, truth in kinds:
+        for name, f in k.synth_measure(t, ch, case, truth, ref).items():
+            add(name, f)
+    return t, ch, instant
 
 
 def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, power_W,
@@ -251,29 +153,29 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
                instant: dict | None = None) -> tuple[list[str], np.ndarray]:
     """Sample like a bench: irregular times, a 20 min gap, noise, quantisation, empty cells.
     ``torque_Nm(t)``: the process load torque [N m], logged as ``load_torque_Nm`` (None: a
-    no-load run, no such column, as the bench format has it). ``instant``: parts of channels
-    evaluated at the sample times rather than interpolated from ``t_model``
-    (:func:`reference_run`)."""
+    no-load run, no such column, as the bench format has it). ``instant``: additions evaluated
+    at the sample times rather than interpolated from ``t_model`` (:func:`reference_run`)."""
+    instant = instant or {}
     dur = float(t_model[-1])
     n = int(dur * rate_hz * 1.05) + 10
     t = np.cumsum(rng.uniform(0.5, 1.5, n) / rate_hz)
     t = t[t < dur]
     gap0 = rng.uniform(0.3, 0.5) * dur  # a logging gap of 20 min
     t = t[(t < gap0) | (t > gap0 + 1200.0)]
+
+    def plus(name: str, v: np.ndarray) -> np.ndarray:
+        return v + instant[name](t) if name in instant else v
+
     cols: dict[str, np.ndarray] = {"time_s": t}
     cols["speed_rpm"] = np.asarray(case.speed_rpm(t), dtype=float)
-    p_W = np.asarray(power_W(t), dtype=float)
-    if instant and "drag_W" in instant:
-        p_W = p_W + instant["drag_W"](t)
+    p_W = plus("power_W", np.asarray(power_W(t), dtype=float))
     cols["power_kW"] = p_W / 1e3 * (1 + rng.normal(0, 0.01, len(t)))
     if torque_Nm is not None:
         cols["load_torque_Nm"] = np.asarray(torque_Nm(t), dtype=float)
-    cols["T_env_C"] = np.asarray(case.T_ambient_K(t)) - ZERO_C_K
-    cols["T_coolant_C"] = np.asarray(case.T_coolant_K(t)) - ZERO_C_K
+    cols["T_env_C"] = plus("T_env", np.asarray(case.T_ambient_K(t))) - ZERO_C_K
+    cols["T_coolant_C"] = plus("T_coolant", np.asarray(case.T_coolant_K(t))) - ZERO_C_K
     for name, y in ch.items():
-        v = np.interp(t, t_model, y)
-        if instant and name in instant:
-            v = v + instant[name](t)
+        v = plus(name, np.interp(t, t_model, y))
         scale, off, _ = edge_absolute(name)
         cols[f"{name}_um" if name == "P1" else f"{name}_C"] = v * scale - off
     cols["P1_um"] = cols["P1_um"] - cols["P1_um"][0]
@@ -289,25 +191,36 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
     return header, data
 
 
-def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, level: int = 1,
-          dt_s: float = 60.0, mismatch: bool = False) -> dict:
+def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, out_csv: Path,
+          level: int = 1, dt_s: float = 60.0, mismatch: bool = False,
+          truths: dict[str, dict] | None = None) -> dict:
     """Write the synthetic run and its truth sidecar; returns the truth.
 
+    ``effect``: ``clean``, an effect of the library, a cause outside it (compare.fit.outside),
+    or several of them (a list: injected together). Their sizes are drawn from the seed
+    (each kind's ``draw``) unless ``truths`` gives them (name -> parameters).
     ``cycle_name``: a shipped cycle or cycle file, or ``random`` / ``random-loaded`` /
-    ``random-ramped-load`` (a cycle drawn from the seed,
-    :func:`spindle.cycles.drawn_cycle`). ``mismatch``: the data
-    come from a spindle that differs from ``spec`` (:func:`compare.fit.mismatch.draw_mismatch`,
-    drawn from the seed; its FEM level replaces ``level``), recorded in the truth."""
+    ``random-ramped-load`` (a cycle drawn from the seed, :func:`spindle.cycles.drawn_cycle`).
+    ``mismatch``: the data come from a spindle that differs from ``spec``
+    (:func:`compare.fit.mismatch.draw_mismatch`, drawn from the seed; its FEM level replaces
+    ``level``), recorded in the truth."""
     from compare.fit.mismatch import draw_mismatch
     from spindle.cycle_files import load_cycle
     from spindle.cycles import RANDOM_CYCLES, drawn_cycle
     from spindle.drive import cycle_load_case, drive_for
     from spindle.outputs import atomic_write
 
-    if effect not in (*EFFECTS, "clean", *OUTSIDE):
-        raise ValueError(effect)
+    names = [effect] if isinstance(effect, str) else list(effect)
+    names = [n for n in names if n != "clean"]
+    for n in names:
+        kind_of(n)
     rng = np.random.default_rng(seed)
-    truth = {"effect": effect, "parameters": draw_truth(effect, rng), "seed": seed,
+    params = {n: (truths or {}).get(n) or draw_truth(n, rng) for n in names}
+    if len(names) == 1:
+        effect_field, param_field = names[0], params[names[0]]
+    else:  # clean (no parameters), or several effects (parameters by effect)
+        effect_field, param_field = (names or "clean"), params
+    truth = {"effect": effect_field, "parameters": param_field, "seed": seed,
              "cycle": cycle_name, "fem_level": level, "spec": spec.name}
     # the mismatch and the random cycle have streams of their own, so that a seed's effect
     # and bench sampling stay what they were without them
@@ -321,7 +234,8 @@ def synth(spec: Spec, cycle_name: str, effect: str, seed: int, out_csv: Path, le
         truth["mismatch"] = mm.to_dict()
         truth["fem_level"] = level
     case = cycle_load_case(spec, cycle, drive)
-    t_model, ch, instant = reference_run(spec, case, effect, truth["parameters"], level, dt_s)
+    t_model, ch, instant = reference_run(spec, case, [(n, params[n]) for n in names], level,
+                                         dt_s)
     # electrical power: losses plus mechanical output, per step (no-load cycles: losses)
     starts = np.asarray(cycle.boundaries_s[:-1])
     p_el = []

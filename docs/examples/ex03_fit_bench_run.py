@@ -21,7 +21,8 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from compare.fit.run import run_fit, save_report
+from compare.fit.report import save_report
+from compare.fit.run import run_fit
 from compare.fit.synth import synth
 from spindle.spec_reader import load_spec
 
@@ -38,8 +39,8 @@ def main(out: Path, run: Path | None = None, candidates: Sequence[str] | None = 
     report = run_fit(run, spec, candidates=list(candidates) if candidates else None)
     doc = report.to_dict()
 
-    print(doc["base_adequacy"]["verdict"])
-    print("effects named:", ", ".join(e["name"] for e in doc["effects"]) or "none")
+    print(doc["verdict"]["summary"])  # the verdict first, as `spindle-verify fit` prints it
+    print(f"The base model {doc['base_adequacy']['statement']}.")
     for e in doc["effects"]:
         print(f"  {e['name']}: " + ", ".join(f"{k} = {v:.3g}" for k, v in e["parameters"].items()))
     truth = run.with_suffix(".truth.json")

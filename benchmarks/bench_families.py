@@ -1,0 +1,332 @@
+"""How ``fit`` generalises: rates with confidence intervals over runs drawn from families,
+not verdicts on named runs (issue 32 §7).
+
+    python benchmarks/bench_families.py [--runs-per-family 50] [--families effect clean ...]
+                                        [--workers 2] [--cache DIR] [--json OUT.json]
+                                        [--peers ../shared/bench-runs ../shared/bench-runs-2]
+                                        [--reports DIR] [--summary FILE] [--synth-only]
+
+Families (each run drawn from its seed: the spindle's mismatch to the spec, the cycle, the
+effect and its size, the noise and sampling; ``synth --mismatch``):
+
+- ``effect``: one effect of the library, drawn uniformly, on a drawn cycle (random, loaded,
+  or ramped load);
+- ``clean``: none;
+- ``outside``: one cause outside the library (compare.fit.outside), drawn uniformly;
+- ``two``: two different effects of the library together;
+- ``peers``: the peer's runs in the folders of ``--peers`` (a fixed set, each fitted once).
+
+The synthetic runs are kept in ``--cache`` (default benchmarks/.families-cache, ignored by
+git) and fitted again on the next call: they do not depend on the fit. Prints per family the
+share of runs with the right verdict, and the issue's rates with 95 % Wilson intervals: the
+true effect named first, nothing named on clean runs, ``unexplained`` and nothing named on
+runs outside the library, a false second effect, a wrong effect named on any run, and the
+validation RMS within the tolerances where the verdict names an effect or says the base is
+adequate; then the fit's time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from verdicts import fit_outcome, judge_verdict, named_text, run_verdicts
+
+import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
+
+ROOT = Path(__file__).resolve().parents[1]
+CYCLES = ("random", "random-loaded", "random-ramped-load")
+FAMILIES = ("effect", "clean", "outside", "two")
+
+
+@dataclass(frozen=True)
+class FamilyRun:
+    family: str
+    seed: int
+    cache: str
+    spec: str = "spl2782"
+    path: str | None = None  # a peer's run (family "peers")
+    truth: object = None  # a peer's truth
+    reports: str | None = None  # a folder for each run's report.json (--reports)
+    criteria: tuple = ()  # (name, value) pairs set in compare.fit.criteria.Criteria
+
+    @property
+    def label(self) -> str:
+        return Path(self.path).stem if self.path else f"{self.family}-{self.seed}"
+
+
+def draw(family: str, seed: int) -> tuple[list[str], str]:
+    """The effects (or cause outside the library) and the cycle of a family's run ``seed``,
+    from a stream of its own (the run's other draws are synth's)."""
+    import numpy as np
+
+    from compare.fit.effects import LIBRARY
+    from compare.fit.outside import OUTSIDE
+
+    rng = np.random.default_rng([seed, 7, FAMILIES.index(family)])
+    cycle = str(rng.choice(CYCLES))
+    if family == "effect":
+        return [str(rng.choice(list(LIBRARY)))], cycle
+    if family == "outside":
+        return [str(rng.choice(list(OUTSIDE)))], cycle
+    if family == "two":
+        return [str(x) for x in rng.choice(list(LIBRARY), size=2, replace=False)], cycle
+    return ["clean"], cycle
+
+
+def one(case: FamilyRun, synth_only: bool = False) -> dict:
+    """Synthesise the run (or reuse it from the cache), fit it, judge the verdict."""
+    from compare.fit.run import run_fit
+    from compare.fit.synth import synth
+    from spindle.spec_reader import load_spec
+    from spindle.tolerances import channel_tolerance, edge_scale
+
+    spec = load_spec(case.spec)
+    t0 = time.perf_counter()
+    if case.path:
+        run, truth = Path(case.path), case.truth
+    else:
+        effects, cycle = draw(case.family, case.seed)
+        run = Path(case.cache) / f"{case.family}-{case.seed}.csv"
+        sidecar = run.with_suffix(".truth.json")
+        if not (run.exists() and sidecar.exists()):
+            synth(spec, cycle, effects if len(effects) > 1 else effects[0], case.seed, run,
+                  mismatch=True)
+        doc = json.loads(sidecar.read_text(encoding="utf-8"))
+        truth = doc["effect"]
+        if case.family == "outside":
+            truth = "unexplained"
+        elif truth == "clean":
+            truth = None
+    t_synth = time.perf_counter() - t0
+    if synth_only:
+        return {"family": case.family, "run": case.label, "truth": truth, "synth_s": t_synth}
+    from compare.fit.criteria import Criteria
+
+    rep = run_fit(run, spec, criteria=Criteria().with_options(**dict(case.criteria)))
+    doc = rep.to_dict()
+    if case.reports:
+        from spindle.outputs import atomic_write, jsonable
+
+        atomic_write(Path(case.reports) / f"{case.label}.json",
+                     lambda tmp: tmp.write_text(json.dumps(jsonable(doc), indent=1),
+                                                encoding="utf-8"))
+    out = fit_outcome(doc)
+    verdict = judge_verdict(truth, out["named_plain"], out["unexplained"])
+    rms_ok = all(v <= channel_tolerance(c) * edge_scale(c)
+                 for c, v in out["validation_rmse"].items())
+    return {"family": case.family, "run": case.label, "truth": truth,
+            "named": out["named"], "verdict": out["verdict"],
+            "unexplained": out["unexplained"], **verdict,
+            "rms_within_tolerance": rms_ok, "validation_rmse": out["validation_rmse"],
+            "fit_s": rep.runtime_s, "synth_s": t_synth}
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float, float]:
+    """(share, lower, upper) of k in n with the Wilson score interval (95 % at z = 1.96)."""
+    if n == 0:
+        return math.nan, math.nan, math.nan
+    p = k / n
+    d = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / d
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return p, max(c - h, 0.0), min(c + h, 1.0)
+
+
+def rate_line(label: str, rows: list[dict], hit, of=lambda r: True) -> str:
+    pool = [r for r in rows if of(r)]
+    k = sum(bool(hit(r)) for r in pool)
+    p, lo, hi = wilson(k, len(pool))
+    return (f"  {label:58} {k:3d} of {len(pool):3d}  {100 * p:5.1f} %  "
+            f"[{100 * lo:5.1f}, {100 * hi:5.1f}]")
+
+
+def summary(rows: list[dict]) -> list[str]:
+    """The rates of the issue, pooled and per family (module docstring)."""
+    families = [f for f in (*FAMILIES, "peers") if any(r["family"] == f for r in rows)]
+
+    def rate(label: str, hit, of) -> list[str]:
+        if not any(of(r) for r in rows):
+            return []
+        lines = [rate_line(label, rows, hit, of)]
+        if len(families) > 1:
+            lines += [rate_line(f"  ... {f}", rows, hit, lambda r, f=f: of(r) and
+                                r["family"] == f) for f in families
+                      if any(of(r) and r["family"] == f for r in rows)]
+        return lines
+
+    out = ["rates (95 % Wilson intervals):"]
+    out += rate("true effect named first (runs with an effect)", lambda r: r["first"],
+                lambda r: r["kind"] in ("effect", "effects"))
+    out += rate("nothing named on clean runs", lambda r: not r["named"],
+                lambda r: r["kind"] == "control")
+    out += rate("'unexplained' on clean runs (a false alarm)", lambda r: r["unexplained"],
+                lambda r: r["kind"] == "control")
+    out += rate("unexplained, nothing named (runs outside the library)", lambda r: r["right"],
+                lambda r: r["kind"] == "outside")
+    out += rate("a false second effect (after a right first)", lambda r: r["false_second"],
+                lambda r: bool(r["first"]))
+    out += rate("a wrong effect named (any run)", lambda r: r["wrong"], lambda r: True)
+    out += rate("validation RMS within the tolerances (named or adequate)",
+                lambda r: r["rms_within_tolerance"],
+                lambda r: r["verdict"] in ("named", "base adequate"))
+    out += rate("both effects named (two-effect runs)", lambda r: r["right"],
+                lambda r: r["kind"] == "effects")
+    out += rate("the verdict right as a whole", lambda r: r["right"], lambda r: True)
+    names = sorted({r["truth"] for r in rows if r["kind"] == "effect"})
+    for name in names:
+        out.append(rate_line(f"  {name} named alone", rows, lambda r: r["right"],
+                             lambda r, n=name: r["truth"] == n))
+    import numpy as np
+
+    from spindle.tolerances import edge_unit
+
+    for f in families:
+        runs = [r for r in rows if r["family"] == f]
+        medians = {c: float(np.median([r["validation_rmse"][c] for r in runs]))
+                   for c in runs[0]["validation_rmse"]}
+        out.append(f"  validation RMS after, median over {f}: " + ", ".join(
+            f"{c} {v:.2f} {edge_unit(c, ascii=True)}" for c, v in medians.items()))
+    times = sorted(r["fit_s"] for r in rows)
+    if times:
+        out.append(f"fit time: median {times[len(times) // 2]:.0f} s, max {times[-1]:.0f} s "
+                   f"over {len(times)} runs")
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs-per-family", type=int, default=50)
+    ap.add_argument("--first-seed", type=int, default=1,
+                    help="the first seed of each family (default 1; the held-out tests use "
+                    "others)")
+    ap.add_argument("--families", nargs="+", default=[*FAMILIES, "peers"],
+                    choices=[*FAMILIES, "peers"])
+    ap.add_argument("--peers", nargs="*", type=Path,
+                    default=[ROOT.parent / "shared" / "bench-runs",
+                             ROOT.parent / "shared" / "bench-runs-2"])
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".families-cache")
+    ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
+    ap.add_argument("--summary", type=Path,
+                    help="also write the rates to this text file (docs/figures/fit-families.txt "
+                    "is this file, which docs/fit.md quotes)")
+    ap.add_argument("--criterion", action="append", default=[], metavar="NAME=VALUE",
+                    help="set an entry of compare.fit.criteria.Criteria for every fit, e.g. "
+                    "open_loop_material_change=false (repeatable): a rule's trade, measured")
+    ap.add_argument("--rows", type=Path,
+                    help="print (and --summary) the rates of rows saved by --json, fitting "
+                    "nothing")
+    ap.add_argument("--reports", type=Path,
+                    help="also keep each run's report.json in this folder (named by run)")
+    ap.add_argument("--synth-only", action="store_true",
+                    help="only synthesise the drawn runs into the cache (no fits)")
+    args = ap.parse_args(argv)
+    if args.rows:
+        try:
+            rows = json.loads(args.rows.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as e:
+            print(f"error: --rows {args.rows}: {e}; give a file written by --json")
+            raise SystemExit(2) from None
+        return _report(rows, args, argv)
+    if args.runs_per_family < 1:
+        ap.error("--runs-per-family: at least 1")
+    args.cache.mkdir(parents=True, exist_ok=True)
+    criteria = _criteria(ap, args.criterion)
+    reports = None
+    if args.reports:
+        args.reports.mkdir(parents=True, exist_ok=True)
+        reports = str(args.reports)
+    cases = [FamilyRun(f, s, str(args.cache), reports=reports, criteria=criteria)
+             for f in args.families
+             if f in FAMILIES
+             for s in range(args.first_seed, args.first_seed + args.runs_per_family)]
+    if "peers" in args.families:
+        from verdicts import read_truth
+
+        for folder in args.peers:
+            if not (folder / "truth.json").is_file():
+                print(f"note: {folder}/truth.json not found; its runs are left out")
+                continue
+            truth = read_truth(folder)
+            cases += [FamilyRun("peers", 0, str(args.cache), path=str(folder / f"{k}.csv"),
+                                truth=v.get("truth"), reports=reports, criteria=criteria)
+                      for k, v in sorted(truth.items())]
+
+    if args.synth_only:
+        import functools
+
+        from compare.executor import run_cases, stderr_progress
+
+        drawn = [c for c in cases if not c.path]
+        done = run_cases(functools.partial(one, synth_only=True), drawn,
+                         workers=args.workers, progress=stderr_progress())
+        failed = [o for o in done if o.error]
+        for o in failed:
+            print(f"{o.label} failed: {o.error}")
+        print(f"synthesised {len(done) - len(failed)} of {len(drawn)} runs into {args.cache}")
+        return
+
+    def line(r: dict) -> str:
+        return (f"{r['family']:8} {r['run']:14} {str(r['truth'])[:40]:40} "
+                f"{named_text(r['named'], r['unexplained'])[:44]:44} "
+                f"{'yes' if r['right'] else 'NO ':3} {r['fit_s']:5.0f}")
+
+    rows = run_verdicts(one, cases, workers=args.workers, line=line, json_path=args.json,
+                        group=lambda r: r["family"],
+                        header=f"{'family':8} {'run':14} {'truth':40} {'named':44} ok      s")
+    _report(rows, args, argv)
+
+
+def _criteria(ap: argparse.ArgumentParser, items: list[str]) -> tuple:
+    """``--criterion NAME=VALUE`` as (name, value) pairs, each value of its entry's type."""
+    from dataclasses import fields
+
+    from compare.fit.criteria import Criteria
+
+    kinds = {f.name: type(f.default) for f in fields(Criteria)}
+    out = []
+    for item in items:
+        name, _, text = item.partition("=")
+        if name not in kinds or kinds[name] not in (bool, int, float) or not text:
+            ap.error(f"--criterion {item}: give NAME=VALUE with NAME a number or switch of "
+                     "compare/fit/criteria.py")
+        if kinds[name] is bool:
+            if text.lower() not in ("true", "false"):
+                ap.error(f"--criterion {item}: {name} is true or false")
+            out.append((name, text.lower() == "true"))
+        else:
+            try:
+                out.append((name, kinds[name](text)))
+            except ValueError:
+                ap.error(f"--criterion {item}: {name} is a number")
+    return tuple(out)
+
+
+def _report(rows: list[dict], args, argv: list[str] | None) -> None:
+    """Print the rates of ``rows`` and write them to ``--summary``."""
+    lines = summary(rows)
+    print("\n".join(lines))
+    if args.summary:
+        from spindle.outputs import atomic_write
+
+        runs = {f: sum(r["family"] == f for r in rows) for f in (*FAMILIES, "peers")}
+        command = f"python benchmarks/bench_families.py {' '.join(argv or sys.argv[1:])}"
+        if args.rows:  # the rates of rows a fitting call saved with --json
+            drawn = max((n for f, n in runs.items() if f != "peers"), default=0)
+            options = "".join(f" --criterion {c}" for c in args.criterion)
+            command = (f"python benchmarks/bench_families.py --runs-per-family {drawn}"
+                       f"{options} --json ROWS; python benchmarks/bench_families.py --rows "
+                       f"ROWS --summary {args.summary}")
+        head = [command, "runs: " + ", ".join(f"{f} {n}" for f, n in runs.items() if n)]
+        text = "\n".join(head + lines) + "\n"
+        atomic_write(args.summary, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+if __name__ == "__main__":
+    main()

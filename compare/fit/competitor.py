@@ -1,0 +1,282 @@
+""""Something else": the hypothesis that competes with the library's effects.
+
+The library's effects are laws of the run's inputs that hold for the whole run: the same speed,
+load, room and coolant give the same extra signal whenever they occur. Something that happens
+at one time during a run (a sensor re-seated, a filter clogging, a converter derating, grease
+running in, a door opened) is none of them. The competitor is that, in the same likelihood,
+with a freedom comparable to an effect's (an amplitude, a start and an end):
+
+- **an unexplained heat** q [W] into one part of the spindle (one of each role a motor
+  spindle's heat passes through: ``Criteria.competitor_masses``, spread over the part's masses
+  by their capacity) during a window [t0, t1) (:class:`WindowHeat`);
+- **an offset** d [tolerances] on one channel during a window (:class:`WindowOffset`): what a
+  sensor or its electronics does.
+
+Windows lie on a grid of ``Criteria.competitor_step_s``. :func:`scan` fits every hypothesis by
+linear least squares on a residual (the model's response to a heat is linear in it; the
+responses to a heat in each block are computed once, :func:`block_responses`) and ranks them
+by the likelihood they add; the best few are then fitted jointly with the base parameters by
+one Gauss-Newton step (:func:`joint_gain`, compare.fit.linear), as the effects are.
+Its significance counts every hypothesis the scan tried (Bonferroni).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from compare.fit.effects import Effect, hypothesis
+from compare.fit.params import Param
+
+#: the name every competitor hypothesis's label starts with (a report reads it)
+NAME = "something_else"
+#: largest heat [W] the competitor may put in a part: the SPL2782's losses at full power
+#: are 5 kW; an unexplained heat of 2 kW in one part would melt it
+Q_MAX_W = 2000.0
+#: largest offset [tolerances]: ten tolerances, beyond which a sensor is broken, not off
+D_MAX_TOL = 10.0
+
+
+def _window(inputs, t0_s: float, t1_s: float) -> np.ndarray:
+    """1 on the intervals of ``inputs`` whose middle lies in [t0, t1), else 0."""
+    g = inputs.grid_s
+    mid = 0.5 * (g[1:] + g[:-1])
+    return ((mid >= t0_s) & (mid < t1_s)).astype(float)
+
+
+class WindowHeat(Effect):
+    """An unexplained heat into the first part of ``role`` during [t0, t1) [s]."""
+
+    channels = ("T1", "T2", "T_stator", "P1")
+
+    def __init__(self, role: str, t0_s: float, t1_s: float, series: np.ndarray | None = None):
+        self.role, self.t0_s, self.t1_s = role, float(t0_s), float(t1_s)
+        self.name = f"{NAME}[heat into the {role}, {t0_s / 3600:.1f}-{t1_s / 3600:.1f} h]"
+        self.explanation = (f"a heat of q into the {role} from {t0_s / 3600:.1f} h to "
+                            f"{t1_s / 3600:.1f} h that no effect of the library explains")
+        self.params = (Param("q_else_W", "W", 0.0, -Q_MAX_W, Q_MAX_W,
+                             "unexplained heat into the part during the window", log=False),)
+        self.series = series  # per interval [W per W of q]; None: the window
+
+    def extend_network(self, net, spec, power_measured):
+        from lumped.blocks import PrescribedHeatFlow
+
+        parts = [p for p in net.parts.values() if p.part.role == self.role]
+        masses = parts[0].masses
+        total = sum(m.block.C_J_K for m in masses)
+        for m in masses:
+            q = net.network.add(PrescribedHeatFlow(f"source:{NAME}:{m.name}", source=NAME,
+                                                   share=m.block.C_J_K / total))
+            net.network.connect(m.block.port, q.port)
+
+    def heat(self, sources_W, theta, inputs):
+        shape = self.series if self.series is not None else _window(inputs, self.t0_s, self.t1_s)
+        return {**sources_W, NAME: theta["q_else_W"] * shape}
+
+
+class WindowOffset(Effect):
+    """An offset d [tolerances] on ``channel`` as measured during [t0, t1) [s]."""
+
+    def __init__(self, channel: str, t0_s: float, t1_s: float):
+        self.channel, self.t0_s, self.t1_s = channel, float(t0_s), float(t1_s)
+        self.channels = (channel,)
+        self.name = f"{NAME}[offset of {channel}, {t0_s / 3600:.1f}-{t1_s / 3600:.1f} h]"
+        self.explanation = (f"{channel} reads off by d from {t0_s / 3600:.1f} h to "
+                            f"{t1_s / 3600:.1f} h, as a sensor or its electronics can")
+        self.params = (Param("d_else_tol", "tolerances", 0.0, -D_MAX_TOL, D_MAX_TOL,
+                             "offset of the channel during the window", log=False),)
+
+    def as_measured(self, out, theta, inputs, channel):
+        from spindle.tolerances import channel_tolerance
+
+        g = inputs.grid_s
+        on = ((g >= self.t0_s) & (g < self.t1_s)).astype(float)
+        out = dict(out)
+        out[self.channel] = out[self.channel] + theta["d_else_tol"] * channel_tolerance(
+            self.channel) * on
+        return out
+
+
+@dataclass(frozen=True)
+class Hypothesis:
+    """One hypothesis of the scan: kind ("heat" or "offset"), where (a role or a channel), the
+    window [s], its amplitude (W, or tolerances) and the likelihood it adds (the concentrated
+    log-likelihood gain over the model it was scanned on, counted in effective samples), the
+    largest change it makes in a channel [tolerances], and how many hypotheses the scan
+    tried."""
+
+    kind: str
+    where: str
+    t0_s: float
+    t1_s: float
+    amplitude: float
+    gain: float
+    peak: float
+    tried: int
+
+    def effect(self) -> Effect:
+        if self.kind == "heat":
+            return WindowHeat(self.where, self.t0_s, self.t1_s)
+        return WindowOffset(self.where, self.t0_s, self.t1_s)
+
+    def text(self) -> str:
+        span = f"{self.t0_s / 3600:.1f}-{self.t1_s / 3600:.1f} h"
+        if self.kind == "heat":
+            return f"a heat of {self.amplitude:+.0f} W into the {self.where}, {span}"
+        return f"{self.where} off by {self.amplitude:+.2f} tolerances, {span}"
+
+
+def _roles(spec, criteria) -> list[str]:
+    have = {p.role for p in spec.parts}
+    return [r for r in criteria.competitor_masses if r in have]
+
+
+def block_edges(grid_s: np.ndarray, step_s: float) -> np.ndarray:
+    """The edges [s] of the scan's blocks over the run."""
+    t0, t1 = float(grid_s[0]), float(grid_s[-1])
+    n = max(int(math.ceil((t1 - t0) / step_s)), 1)
+    return t0 + step_s * np.arange(n + 1)
+
+
+def block_responses(gb, theta: dict[str, float], effects: tuple[str, ...], role: str,
+                    edges: np.ndarray, channels) -> np.ndarray:
+    """(blocks, channels, grid points): each channel's response [K; m for P1] to 1 W into the
+    first part of ``role`` during each block, of the model ``gb`` with ``effects`` at
+    ``theta`` (linear in the heat: the model with the block's heat minus the model without)."""
+    probe = WindowHeat(role, 0.0, 0.0)
+    probe.name = f"{NAME}[probe {role}]"
+    lab = hypothesis(probe)
+    model = gb.variant((*effects, lab))
+    th = {**theta, "q_else_W": 1.0}
+    g = gb.inputs.grid_s
+    mid = 0.5 * (g[1:] + g[:-1])
+    probe.series = np.zeros(len(mid))
+    base = model.simulate(th)
+    out = np.empty((len(edges) - 1, len(channels), len(g)))
+    for b in range(len(edges) - 1):
+        probe.series = ((mid >= edges[b]) & (mid < edges[b + 1])).astype(float)
+        y = model.simulate(th)
+        for j, c in enumerate(channels):
+            out[b, j] = y[c] - base[c]
+    probe.series = None
+    return out
+
+
+@dataclass
+class Regressors:
+    """The competitor's hypotheses as residual columns over a calibrator's residual rows
+    (compare.fit.linear.residual_rows): per role, each block's heat column (rows, blocks);
+    per channel, each block's indicator column; and the blocks' edges [s]."""
+
+    edges: np.ndarray
+    heat: dict[str, np.ndarray]
+    offset: dict[str, np.ndarray]
+
+    def column(self, h: Hypothesis) -> np.ndarray:
+        a = int(np.searchsorted(self.edges, h.t0_s + 1e-6)) if h.t0_s > self.edges[0] else 0
+        b = int(np.searchsorted(self.edges, h.t1_s - 1e-6))
+        table = self.heat[h.where] if h.kind == "heat" else self.offset[h.where]
+        return table[:, a:b].sum(axis=1)
+
+
+def regressors(cal, fit, criteria) -> Regressors:
+    """The competitor's columns (:class:`Regressors`) for ``cal``'s residual rows; the heat
+    responses are computed once per calibrator (at the first fit asked: the base), as the
+    linearization's other columns hold the base parameters fixed."""
+    from compare.fit.linear import residual_rows
+    from spindle.tolerances import channel_tolerance
+
+    memo = cal.memo.get("competitor")
+    if memo is not None:
+        return memo
+    channels = list(cal.channels)
+    _, ch, pt, _ = residual_rows(cal, fit.model)
+    edges = block_edges(cal.measured.grid_s, criteria.competitor_step_s)
+    tol = np.array([channel_tolerance(c) for c in channels])
+    heat = {}
+    for role in _roles(cal.gb.spec, criteria):
+        resp = block_responses(cal.gb, fit.theta, fit.effects, role, edges, channels)
+        # the residual falls by the response: measured minus model
+        heat[role] = -(resp[:, ch, pt] / tol[ch]).T
+    g = cal.measured.grid_s
+    block = np.clip(np.searchsorted(edges, g[pt], side="right") - 1, 0, len(edges) - 2)
+    offset = {}
+    for j, c in enumerate(channels):
+        cols = np.zeros((len(pt), len(edges) - 1))
+        m = ch == j
+        cols[np.flatnonzero(m), block[m]] = -1.0
+        offset[c] = cols
+    reg = Regressors(edges, heat, offset)
+    cal.memo["competitor"] = reg
+    return reg
+
+
+def scan(reg: Regressors, r: np.ndarray, channel: np.ndarray, rows: np.ndarray,
+         shrink: float, top: int = 5) -> tuple[list[Hypothesis], int]:
+    """The ``top`` best hypotheses on the residual ``r`` over ``rows`` (each fitted alone by
+    linear least squares, its gain the concentrated log-likelihood gain per channel times
+    ``shrink``, the effective samples' share), and how many hypotheses were tried."""
+    nb = len(reg.edges) - 1
+    chans = np.unique(channel[rows])
+    n = np.array([np.sum(rows & (channel == c)) for c in chans], dtype=float)
+    rss0 = np.array([float(np.sum(r[rows & (channel == c)] ** 2)) for c in chans])
+    w = n / np.maximum(rss0, 1e-300)  # inverse residual variance per channel
+    i_lo, i_hi = np.triu_indices(nb)
+    found: list[Hypothesis] = []
+    tried = 0
+    for kind, table in (("heat", reg.heat), ("offset", reg.offset)):
+        for where, X in table.items():
+            num = np.empty((nb, len(chans)))
+            gram = np.empty((nb, nb, len(chans)))
+            for j, c in enumerate(chans):
+                m = rows & (channel == c)
+                Xm = X[m]
+                num[:, j] = Xm.T @ r[m]
+                gram[:, :, j] = Xm.T @ Xm
+            P = np.concatenate([np.zeros((1, len(chans))), np.cumsum(num, axis=0)])
+            num_w = P[i_hi + 1] - P[i_lo]  # (windows, channels)
+            C = np.pad(np.cumsum(np.cumsum(gram, axis=0), axis=1), ((1, 0), (1, 0), (0, 0)))
+            den_w = C[i_hi + 1, i_hi + 1] - C[i_lo, i_hi + 1] - C[i_hi + 1, i_lo] + C[i_lo, i_lo]
+            tot_den = den_w @ w
+            ok = tot_den > 1e-12 * max(float(tot_den.max()), 1e-300)
+            beta = np.where(ok, -(num_w @ w) / np.where(ok, tot_den, 1.0), 0.0)
+            rss1 = rss0[None, :] + 2 * beta[:, None] * num_w + beta[:, None] ** 2 * den_w
+            rss1 = np.maximum(rss1, 1e-12 * np.maximum(rss0, 1e-300)[None, :])
+            gain = 0.5 * shrink * (n[None, :] * np.log(np.maximum(rss0, 1e-300)[None, :]
+                                                       / rss1)).sum(axis=1)
+            gain = np.where(ok, gain, -np.inf)
+            tried += int(ok.sum())
+            for k in np.argsort(-gain)[:top]:
+                if not np.isfinite(gain[k]):
+                    continue
+                a, b = int(i_lo[k]), int(i_hi[k])
+                col = X[:, a:b + 1].sum(axis=1)
+                peak = float(np.max(np.abs(beta[k] * col))) if len(col) else 0.0
+                found.append(Hypothesis(kind, where, float(reg.edges[a]),
+                                        float(reg.edges[b + 1]), float(beta[k]),
+                                        float(gain[k]), peak, 0))
+    found.sort(key=lambda h: -h.gain)
+    return [Hypothesis(h.kind, h.where, h.t0_s, h.t1_s, h.amplitude, h.gain, h.peak, tried)
+            for h in found[:top]], tried
+
+
+#: the bounds of the competitor's amplitudes in a joint step (W of heat; tolerances of offset)
+BOUNDS = {"heat": (-Q_MAX_W, Q_MAX_W), "offset": (-D_MAX_TOL, D_MAX_TOL)}
+
+
+def joint_gain(loc, reg: Regressors, hypotheses: list[Hypothesis]
+               ) -> tuple[float, Hypothesis | None]:
+    """The best of ``hypotheses`` fitted jointly with the base parameters by one step of the
+    linearized model ``loc`` (compare.fit.linear.Local) over the fit window: (its
+    log-posterior gain, the hypothesis with its joint amplitude)."""
+    best, best_h = -math.inf, None
+    for h in hypotheses:
+        col = reg.column(h)[:, None]
+        gain, delta = loc.gain(col, [BOUNDS[h.kind]])
+        if gain > best:
+            best = gain
+            best_h = Hypothesis(h.kind, h.where, h.t0_s, h.t1_s, float(delta[-1]), gain,
+                                float(np.max(np.abs(delta[-1] * col))), h.tried)
+    return best, best_h

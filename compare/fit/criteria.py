@@ -1,0 +1,236 @@
+"""Every threshold, window and level the fit's rules use, in one table: :class:`Criteria`.
+
+Each entry has its value, its unit and its reason: a statistical argument, a physical bound,
+a sensor's resolution or a computing budget. ``fit``'s options (``--alpha``, ``--min-gain``,
+``--cv-blocks``) set the entries of the same names, and every rule that reads them reads them
+here; the report lists the table it ran with (:meth:`Criteria.table`) and, for each
+candidate, which named criteria it passed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields, replace
+
+from compare.fit.signatures import OnsetScale
+from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
+
+
+def _c(value, unit: str, reason: str):
+    return field(default=value, metadata={"unit": unit, "reason": reason})
+
+
+@dataclass(frozen=True)
+class Criteria:
+    """The criteria of one fit (module docstring). Frozen: derive another with
+    :meth:`with_options`."""
+
+    # ---------------------------------------------------------------- statistics
+    alpha: float = _c(
+        0.01, "-", "the level of every test: an effect's likelihood-ratio test, each "
+        "signature test, the competitor's scan (divided by the number of its hypotheses) and "
+        "the plausible range of a base parameter (two-sided). At 1 % per test, the about ten "
+        "candidates of a run give a false one in under 10 % of clean runs before the other "
+        "criteria")
+    material_peak: float = _c(
+        0.5, "tolerances", "an effect (or the competitor) is named only if at its estimate it "
+        "moves one of its channels by half a tolerance at its peak: a smaller term cannot take "
+        "a compensation that meets the tolerances out of them, so naming it helps no user")
+    open_loop_material_change: bool = _c(
+        True, "-", "an effect named by the open loop must also change the fitted model's "
+        "prediction (the effect and the base's re-adjustment together) by material_peak on "
+        "one of its channels: the open loop's only evidence is that prediction, and an effect "
+        "the base re-adjusts around to within half a tolerance changes no compensation built "
+        "on the model. The signature route keeps its own evidence")
+    cv_blocks: int = _c(
+        5, "blocks", "blocked cross-validation: each fifth of the run held out in turn; five "
+        "blocks of a 16 h run are about 3 h, longer than the slowest time constant (the "
+        "housing's, 1-2 h), so a held-out block is not predicted from its neighbours' state")
+    cv_gain: float = _c(
+        0.25, "-", "an effect judged by the open-loop fit (no signature test applies) must "
+        "remove this share of the blocked cross-validated error above the noise floor on its "
+        "channels: a law of the inputs predicts the blocks it was not fitted on. A quarter is "
+        "five times the scatter of the folds' own refits (a few % on a run with nothing to "
+        "find)")
+    open_loop_needs_plausible_base: bool = _c(
+        False, "-", "True: an effect is named by the open loop only where, with it, the base "
+        "parameters are jointly plausible (their squared prior z summed within the chi-square "
+        "quantile at alpha, one degree of freedom each), since a base that needs implausible "
+        "values has a form in doubt. Off by default: on 83 drawn and peer runs (docs/fit.md) "
+        "it kept 3 right names and no wrong one from the first round; a base far from its "
+        "spec is common, and the cross-validation and the competitor already guard the "
+        "attribution")
+    signature_must_agree: bool = _c(
+        True, "-", "where an effect's signature test applies to the run and is not "
+        "significant at alpha, the effect is not named by either route: its own test could "
+        "look for it and did not find it, so the open loop's attribution of a misfit to it is "
+        "a guess. The open loop names only effects whose test does not apply to the run (or "
+        "that have none). Weak evidence then ends in 'nothing named' rather than a name "
+        "(False: a silent test vetoes only where its interval excludes the fitted size)")
+    competitor_step_s: float = _c(
+        1800.0, "s", "the time grid of the competitor's windows: half an hour resolves an "
+        "event of a few hours, and a 16 h run gives 32 blocks, 528 windows")
+    competitor_masses: tuple[str, ...] = _c(
+        ("stator", "rotor", "front_bearing", "rear_bearing", "housing", "cooling_sleeve"),
+        "part roles", "where the competitor may put an unexplained heat: one mass of each "
+        "role a motor spindle's heat passes through (the first of the role found)")
+
+    speed_bin_rel: float = _c(
+        0.05, "-", "the grey box evaluates its speed-dependent conductances (films, bearings) "
+        "at the interval's speed rounded to a geometric grid of 5 % steps: the films follow "
+        "n^0.5-0.8, so they move by at most 4 %, a tenth of their prior sd; a ramp logged on "
+        "change then needs a few dozen sets of modes, not one per interval. The heat sources "
+        "take the exact speed; a feedback whose heat enters the matrices (a preload's) takes "
+        "its heat on the same grid, which moves its term by at most 2.5 %")
+
+    # ---------------------------------------------------------------- base model
+    at_bound_rel: float = _c(
+        1e-3, "of the range", "a calibrated value within this share of its range from a "
+        "bound is reported as on the bound")
+    missing_path_W_K: float = _c(
+        1.0, "W/K", "a conductance the spec lacks (G_seat_W_K) is reported as needed above "
+        "1 W/K: that moves a bearing ring carrying 30-60 W of friction by several kelvin, far "
+        "above the sensors' resolution")
+    refit_nfev: int = _c(
+        20, "evaluations", "computing budget of the refit of the candidate that joins the "
+        "model, which starts from its Gauss-Newton fit and converges in a few iterations")
+    fem_max_nfev: int = _c(
+        12, "evaluations", "computing budget of --model fem with priors (each evaluation of the "
+        "Jacobian costs six FEM runs; the data cost is flat to 0.1 % by then)")
+    fem_free_nfev: int = _c(
+        5, "evaluations", "computing budget of --model fem without priors (it only sets the "
+        "data's weight against the priors and the noise floor)")
+
+    # ---------------------------------------------------------------- input timing
+    gap_min_steps: float = _c(
+        2.0, "grid steps", "a stretch without any logged row longer than two grid steps is a "
+        "logging gap (a bench logging on change writes at least a heartbeat per step)")
+    gap_judge_s: float = _c(
+        3600.0, "s", "an operating change inside a logging gap is placed where the model fits "
+        "the hour after the gap best: long against the rings' settling, short against the run")
+    gap_level_s: float = _c(
+        300.0, "s", "the speed and power levels either side of a gap are read over five "
+        "minutes of samples")
+
+    # ---------------------------------------------------------------- signatures: steps
+    step_rpm: float = _c(
+        200.0, "rpm", "a speed change between two samples larger than this is a step: ten "
+        "times a drive's speed scatter (20 rpm) and a tenth of the smallest step of a test "
+        "cycle")
+    moving_rpm: float = _c(
+        300.0, "rpm", "below this a spindle stands: its bearing and motor heat is nil")
+    no_load_Nm: float = _c(
+        0.5, "N m", "a segment turns without load up to this process torque (a load cell's "
+        "zero drift)")
+    speed_band_rpm: float = _c(
+        SPEED_BAND_RPM, "rpm", "a logged speed within max(20 rpm, 1 %) of the current step "
+        "belongs to it: a drive's scatter around its set speed (spindle.bench_inputs)")
+    speed_band_rel: float = _c(SPEED_BAND_REL, "-", "as speed_band_rpm")
+    jump_before_s: tuple[float, float] = _c(
+        (-180.0, -10.0), "s from a step", "the line before a speed step for P1's jump: three "
+        "minutes, short against the thermal response, the ramp's last 10 s left out")
+    jump_after_s: tuple[float, float] = _c(
+        (10.0, 80.0), "s from a step", "the line after it: the drive's ramp (10 s) left out, "
+        "70 s before the heat arrives at the nose")
+    jump_se_floor_um: float = _c(
+        0.02, "um", "the least standard error of a jump: a line through quantised samples "
+        "can fit them exactly, and a fifth of P1's 0.1 um resolution is what it resolves")
+    onset_scales: tuple[OnsetScale, ...] = _c(
+        (OnsetScale("2 min / 4 min", (-300.0, -10.0), (10.0, 120.0), (120.0, 360.0)),
+         OnsetScale("6.5 min / 13 min", (-600.0, -10.0), (10.0, 400.0), (400.0, 1200.0))),
+        "s from a step", "the onset is read at two time scales: minutes (a lag of a few "
+        "minutes; the temperatures' noise is small) and a quarter of an hour (a lag of ten to "
+        "twenty minutes, and a channel as coarsely logged as P1)")
+    concave_ratio: float = _c(
+        1.15, "-", "the model's onset ratio above which a channel is expected to respond at "
+        "once (a concave onset): the ratio of a first-order response's slope change over "
+        "the two windows is 1.3 and falls to 1 for a ramp; 1.15 is half-way")
+    lag_grid_s: tuple[float, ...] = _c(
+        (0.0, 15.0, 30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1800.0, 3600.0), "s",
+        "the lag time constants the onset ratio is mapped over, doubling up to the library's "
+        "bound")
+
+    # ---------------------------------------------------------------- signatures: power
+    drift_min_segment_s: float = _c(
+        1800.0, "s", "a no-load segment is read for a drift when it lasts half an hour: the "
+        "ring difference settles in 10-20 min")
+    drift_min_segments: int = _c(
+        3, "segments", "the preload coefficient is regressed through the origin on the "
+        "segments' drifts: three give its standard error two degrees of freedom")
+    drift_early_s: tuple[float, float] = _c(
+        (120.0, 360.0), "s from the start", "the early power of a segment: after the drive's "
+        "ramp and its first averaging, before the rings have warmed")
+    drift_late_s: float = _c(
+        900.0, "s", "the late power: the segment's last quarter of an hour")
+    window_min_samples: int = _c(
+        3, "samples", "a window's mean power carries the standard error of its own samples' "
+        "scatter: three samples give it two degrees of freedom (an on-change log holds a "
+        "few samples in minutes)")
+    power_resolution_W: float = _c(
+        0.05, "W", "the least standard error of a mean power: a drive's power reading resolves "
+        "about 0.1 W")
+    level_min_s: float = _c(
+        600.0, "s", "a no-load segment gives a power level when it lasts ten minutes (its "
+        "second half settled)")
+    level_rpm: float = _c(50.0, "rpm", "no-load segments within 50 rpm are one speed level")
+    min_levels: int = _c(
+        5, "levels", "the n^3 term is read from at least five speed levels: four terms are "
+        "fitted (n, n^(5/3), n^2, n^3), so one degree of freedom is left for the scatter")
+    min_speed_span: float = _c(
+        3.0, "-", "the levels must span a factor 3 in speed, or n^2 and n^3 cannot be told "
+        "apart")
+
+    # ---------------------------------------------------------------- signatures: load
+    load_plateau_min_s: float = _c(
+        1800.0, "s", "a loaded constant-speed plateau is read when it lasts half an hour")
+    load_settle_s: float = _c(
+        900.0, "s", "after a speed change the rings settle to the new bearing heat for a "
+        "quarter of an hour (their time constant, 5-10 min, three times over)")
+    load_block_s: float = _c(
+        300.0, "s", "the residual is averaged over five-minute blocks: short against the "
+        "motor's thermal response, long against the logging")
+    load_span_Nm: float = _c(
+        5.0, "N m", "the process torque must vary by 5 N m within a plateau: 100-500 W of "
+        "motor loss, a response of tenths of a kelvin at the rings")
+    load_min_plateaus: int = _c(
+        4, "plateaus", "the jackknife over the plateaus needs four for its standard error")
+    load_probe_R_K_W: float = _c(
+        0.002, "K/W", "the probe coolant resistance of the sensitivity (the model is linear in "
+        "it to first order; a tenth of the library range's upper end)")
+    max_path_correlation: float = _c(
+        0.8, "-", "the coolant's and the rotor's paths to the rings are told apart only where "
+        "their regressors correlate at most 0.8: a variance inflation 1 / (1 - r^2) of 2.8, "
+        "beyond which the two estimates trade")
+
+    # ---------------------------------------------------------------- derived
+    def implausible_z(self) -> float:
+        """The prior |z| beyond which a base parameter is implausible: two-sided at alpha."""
+        from scipy.stats import norm
+
+        return float(norm.isf(self.alpha / 2))
+
+    def with_options(self, **values) -> Criteria:
+        """These criteria with some entries set (None leaves an entry as it is)."""
+        return replace(self, **{k: v for k, v in values.items() if v is not None})
+
+    def table(self) -> list[dict]:
+        """Every entry: name, value, unit, reason (the report's criteria table)."""
+        out = []
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, tuple) and v and isinstance(v[0], OnsetScale):
+                v = [s.name for s in v]
+            out.append({"name": f.name, "value": v, "unit": f.metadata["unit"],
+                        "reason": f.metadata["reason"]})
+        out.append({"name": "implausible_z", "value": round(self.implausible_z(), 3),
+                    "unit": "prior sd", "reason": "derived: two-sided normal quantile at "
+                    "alpha, so the verdict's plausible range and the selection agree"})
+        return out
+
+
+def chi2_threshold(alpha: float, df: int, tests: int = 1) -> float:
+    """The chi-square quantile at level ``alpha`` / ``tests`` (Bonferroni) with ``df``
+    degrees of freedom."""
+    from scipy.stats import chi2
+
+    return float(chi2.isf(alpha / max(tests, 1), df)) if alpha > 0 else math.inf

@@ -1,0 +1,153 @@
+"""What an effect of the library is: a plug-in that the grey box, the selection, the synthetic
+runs and the report use through these hooks alone.
+
+An :class:`Effect` declares
+
+- its parameters (:class:`compare.fit.params.Param`: unit, neutral value, bounds, source),
+  whose neutral values give the base model, so the base is nested in the extended one;
+- how it enters the grey box: options of the lumped network, blocks it adds, conductances of
+  the edges it owns, heat it adds to the sources, what it does to P1 or to a channel as
+  measured;
+- its signature test on the raw samples, where it has one (:meth:`Effect.signature`);
+- how it enters a synthetic run (the spec, the load case, a feedback from the FEM's own
+  temperatures, or the measurement) and how to draw its size;
+- the hint the verdict gives when it is named.
+
+An effect that acts on one sensor (a lag) is ``per_channel``: it is tried on each measured
+channel, and its candidate label names the channel, ``sensor_lag(T2)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from compare.fit.params import Param
+
+if TYPE_CHECKING:
+    from spindle.loads import LoadCase
+    from spindle.spec import Spec
+
+CHANNELS = ("T1", "T2", "T_stator", "P1")
+
+
+@dataclass(frozen=True)
+class Feedback:
+    """How a synthetic run feeds an effect back from the FEM's own temperatures: the linear
+    read-outs of the temperature field it needs (name -> row over the field), the input it
+    changes as a function ``apply(case, x, t)`` of the fed-back series x on the grid t, the map
+    ``update(readings, case, t) -> x`` from the read-outs of a run to x, and x of a run
+    without the feedback, ``start(readings, case, t)``."""
+
+    functionals: dict[str, np.ndarray]
+    apply: Callable[[LoadCase, np.ndarray, np.ndarray], LoadCase]
+    update: Callable[[dict[str, np.ndarray], LoadCase, np.ndarray], np.ndarray]
+    start: Callable[[dict[str, np.ndarray], LoadCase, np.ndarray], np.ndarray]
+    #: instantaneous additions to the bench's channels from the fed-back x (name -> f(ts, t, x))
+    instant: dict[str, Callable] = field(default_factory=dict)
+
+
+class Effect:
+    """A candidate effect (the module docstring); subclasses set the attributes and override
+    the hooks they need. Every hook's default leaves the model as it is."""
+
+    name: str = ""
+    explanation: str = ""
+    params: tuple[Param, ...] = ()
+    #: the channels its signature shapes (the selection judges it on these)
+    channels: tuple[str, ...] = CHANNELS
+    #: one candidate per measured channel (its label names the channel)
+    per_channel: bool = False
+    #: parameters that change the system's matrices (the engine caches systems by them, and
+    #: configures the effect's flows for them before every use)
+    in_conductance: tuple[str, ...] = ()
+    #: what the verdict says to look at in the spindle or its spec when the effect is named
+    hint: str = ""
+    #: acts on the measurement alone (a recorded run can carry it injected: compare.fit.inject)
+    measurement_only: bool = False
+
+    # ------------------------------------------------------------------ the grey box
+    def network_options(self) -> dict[str, Any]:
+        """Keyword options of lumped.build.build_network this effect needs."""
+        return {}
+
+    def extend_network(self, net, spec: Spec, power_measured: bool) -> Any:
+        """Add blocks to the lumped network ``net`` (lumped.build.LumpedNetwork); returns a
+        handle the other hooks get back (None by default)."""
+        return None
+
+    def edge_conductances(self, theta: Mapping[str, float]) -> dict[str, float]:
+        """Conductance [W/K] of the network edges this effect owns, by edge name."""
+        return {}
+
+    def configure(self, handle: Any, theta: Mapping[str, float]) -> None:
+        """Set the coefficients of the flows in ``handle`` for a parameter set."""
+
+    def heat(self, sources_W: dict[str, np.ndarray], theta: Mapping[str, float],
+             inputs) -> dict[str, np.ndarray]:
+        """The heat sources [W per interval], with this effect's heat."""
+        return sources_W
+
+    def p1(self, p1_m: np.ndarray, theta: Mapping[str, float], inputs) -> np.ndarray:
+        """P1 [m] at the grid points with this effect's read-out (before it is zeroed)."""
+        return p1_m
+
+    def as_measured(self, out: dict[str, np.ndarray], theta: Mapping[str, float], inputs,
+                    channel: str | None) -> dict[str, np.ndarray]:
+        """The channels as the sensors read them (after the FEM anchor): a lag acts here."""
+        return out
+
+    # ------------------------------------------------------------------ evidence
+    def signature(self, ctx) -> dict:
+        """Its signature tests on the raw samples (compare.fit.signatures.Context): label ->
+        compare.fit.signatures.EventTest. None by default: the open-loop fit alone judges."""
+        return {}
+
+    # ------------------------------------------------------------------ synthetic runs
+    def draw(self, rng: np.random.Generator) -> dict:
+        """The effect's parameters for a synthetic run (a size a bench could show)."""
+        return {}
+
+    def synth_spec(self, spec: Spec, truth: Mapping[str, Any]) -> Spec:
+        """The spindle of a synthetic run with the effect built in."""
+        return spec
+
+    def synth_case(self, case: LoadCase, spec: Spec, truth: Mapping[str, Any]
+                   ) -> tuple[LoadCase, dict[str, Callable]]:
+        """The load case with the effect, and instantaneous additions to what the bench logs
+        (``power_W``: power the motor supplies against it; a channel's name; ``T_coolant``,
+        ``T_env``), evaluated at its sample times."""
+        return case, {}
+
+    def feedback(self, thermal, spec: Spec, truth: Mapping[str, Any]) -> Feedback | None:
+        """The effect's feedback from the FEM's temperatures (None: it has none)."""
+        return None
+
+    def synth_measure(self, t_s: np.ndarray, channels: dict[str, np.ndarray], case: LoadCase,
+                      truth: Mapping[str, Any], reference) -> dict[str, Callable]:
+        """Change the model's channels [K; m for P1, on the grid ``t_s``] as the measurement
+        reads them (in place); returns instantaneous additions evaluated at the bench's own
+        sample times (name -> f(times))."""
+        return {}
+
+    def measure(self, t_s: np.ndarray, columns: dict[str, np.ndarray],
+                truth: Mapping[str, Any], channel: str | None) -> dict[str, np.ndarray]:
+        """A recorded run's columns (SI: ``speed_rpm``, ``T_env_K``, the channels in K, P1 in
+        m) with this measurement-side effect injected (``measurement_only`` effects)."""
+        raise NotImplementedError(f"{self.name} acts on the physics, not on the measurement")
+
+
+def label(effect: str, channel: str | None = None) -> str:
+    """A candidate's label: the effect's name, with the channel of a per-channel effect."""
+    return f"{effect}({channel})" if channel else effect
+
+
+def parse_label(text: str) -> tuple[str, str | None]:
+    """(effect name, channel or None) of a candidate label."""
+    if text.endswith(")") and "(" in text:
+        name, channel = text[:-1].split("(", 1)
+        return name, channel
+    return text, None

@@ -1,0 +1,304 @@
+"""The calibrated model linearized at a fit: what the selection asks of a fit many times (a
+candidate's screen, the competitor's joint fit, blocked cross-validation, the refit to the
+whole run) answered by one Gauss-Newton step on the Jacobian instead of a nonlinear refit.
+
+At a fit the residual (measured minus model, in tolerances) over every valid sample of the run
+is r(z) ~ r0 + J (z - z0), z the free parameters on their fitted scale (compare.fit.calibrate).
+A step minimises the sum of squares over chosen rows plus the priors' terms, within the
+parameters' bounds (scipy.optimize.lsq_linear), exactly as the nonlinear fit would to first
+order; extra columns (an effect's parameters at their neutral value, a window's heat) join the
+same step. One Jacobian costs one simulation per free parameter.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from compare.fit.calibrate import TOLERANCE, Calibrator, Fit, _bounds_z, _to_z
+from compare.fit.effects import effect_of
+
+#: the step of the finite differences on the fitted scale (as the nonlinear fit's)
+STEP = 1e-4
+
+
+@dataclass
+class Local:
+    """The model of ``fit`` linearized (module docstring): the residual rows of every
+    channel's valid samples over the whole run, their channel and grid index, which lie in the
+    fit window, the Jacobian of the free parameters, and what the priors add."""
+
+    cal: Calibrator
+    fit: Fit
+    channel: np.ndarray  # per row: index into cal.channels
+    point: np.ndarray  # per row: index into the grid
+    in_fit: np.ndarray  # per row: in the fit window
+    r0: np.ndarray
+    J: np.ndarray  # (rows, free)
+    z0: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    prior_rows: np.ndarray  # (free,) prior_scale / sd, 0 where no prior
+    prior_z: np.ndarray  # (free,) prior centre on the fitted scale (z0 where none)
+
+    def _system(self, rows: np.ndarray, extra: np.ndarray | None):
+        A = self.J[rows]
+        if extra is not None:
+            A = np.hstack([A, extra[rows]])
+        k = A.shape[1]
+        kb = self.J.shape[1]
+        P = np.zeros((kb, k))
+        P[:, :kb] = np.diag(self.prior_rows)
+        bp = -self.prior_rows * (self.z0 - self.prior_z)
+        keep = self.prior_rows > 0
+        return np.vstack([A, P[keep]]), np.concatenate([-self.r0[rows], bp[keep]])
+
+    def step(self, rows: np.ndarray, extra: np.ndarray | None = None,
+             extra_bounds: Sequence[tuple[float, float]] = ()) -> np.ndarray:
+        """The step over ``rows`` (boolean mask) with ``extra`` columns (rows, m) bounded by
+        ``extra_bounds``: the change of the free parameters' z, then the extra amplitudes."""
+        from scipy.optimize import lsq_linear
+
+        A, b = self._system(rows, extra)
+        lo = np.concatenate([self.lo - self.z0, [a for a, _ in extra_bounds]])
+        hi = np.concatenate([self.hi - self.z0, [c for _, c in extra_bounds]])
+        # a parameter sitting on a bound can only move inside
+        lo, hi = np.minimum(lo, 0.0), np.maximum(hi, 0.0)
+        if A.shape[1] == 0:
+            return np.zeros(0)
+        return lsq_linear(A, b, bounds=(lo, hi), method="bvls" if A.shape[1] < 30 else "trf",
+                          lsmr_tol="auto").x
+
+    def residual(self, delta: np.ndarray, extra: np.ndarray | None = None) -> np.ndarray:
+        """The residual of every row after ``delta`` (free parameters, then extras)."""
+        kb = self.J.shape[1]
+        r = self.r0 + self.J @ delta[:kb]
+        if extra is not None and len(delta) > kb:
+            r = r + extra @ delta[kb:]
+        return r
+
+    def penalty(self, delta: np.ndarray) -> float:
+        kb = self.J.shape[1]
+        t = self.prior_rows * (self.z0 + delta[:kb] - self.prior_z)
+        return 0.5 * float(t @ t)
+
+    def prior_z_after(self, delta: np.ndarray) -> np.ndarray:
+        """Each free base parameter's distance from its prior centre [prior sd] after the
+        step ``delta`` (0 where it has no prior)."""
+        kb = self.J.shape[1]
+        sd = np.array([self.cal.gb.variant(self.fit.effects).parameters()[k].prior_sd or 0.0
+                       for k in self.fit.free])
+        t = np.where(self.prior_rows > 0, (self.z0 + delta[:kb] - self.prior_z), 0.0)
+        return np.divide(t, sd, out=np.zeros_like(t), where=sd > 0)
+
+    def loglik(self, r: np.ndarray, rows: np.ndarray) -> float:
+        """The concentrated log-likelihood of residual ``r`` over ``rows`` (as
+        compare.fit.calibrate.Calibrator.loglik)."""
+        total = 0.0
+        for c in range(len(self.cal.channels)):
+            m = rows & (self.channel == c)
+            if m.any():
+                total += -0.5 * m.sum() * math.log(max(float(np.mean(r[m] ** 2)), 1e-300))
+        return total
+
+    def gain(self, extra: np.ndarray | None = None,
+             extra_bounds: Sequence[tuple[float, float]] = ()) -> tuple[float, np.ndarray]:
+        """(log-posterior gain over the fit window of the step with ``extra``, counted in the
+        fit's effective samples, the likelihood of compare.fit.calibrate; the step)."""
+        rows = self.in_fit
+        delta = self.step(rows, extra, extra_bounds)
+        r1 = self.residual(delta, extra)
+        l0 = self.loglik(self.r0, rows)
+        l1 = self.loglik(r1, rows)
+        shrink = self.fit.n_eff / max(self.fit.n, 1)
+        return (l1 - l0) * shrink - (self.penalty(delta) - self.penalty(np.zeros_like(delta))
+                                     ), delta
+
+    def held_out(self, blocks: int) -> np.ndarray:
+        """Blocked cross-validation, one step per fold: each of ``blocks`` equal blocks of the
+        run held out, the step fitted on the rest (every window); the residual of every row
+        where its block was held out [tolerances]."""
+        meas = self.cal.measured
+        edges = np.linspace(meas.grid_s[0], meas.grid_s[-1], blocks + 1)
+        block = np.clip(np.searchsorted(edges, meas.grid_s[self.point], side="right") - 1, 0,
+                        blocks - 1)
+        held = np.empty_like(self.r0)
+        for b in range(blocks):
+            out = block == b
+            delta = self.step(~out)
+            held[out] = self.residual(delta)[out]
+        return held
+
+    def cross_validate(self, blocks: int) -> dict[str, float]:
+        """Per channel, the RMS of the held-out residual [tolerances] (:meth:`held_out`)."""
+        held = self.held_out(blocks)
+        return {c: float(np.sqrt(np.mean(held[self.channel == j] ** 2)))
+                for j, c in enumerate(self.cal.channels) if (self.channel == j).any()}
+
+    def cross_validation_report(self, blocks: int) -> dict:
+        """:meth:`held_out` pooled per channel as the report shows it: RMS, max, bias (the
+        channel's unit at the edges), the share within the tolerance."""
+        from spindle.tolerances import edge_scale, edge_unit
+
+        held = self.held_out(blocks)
+        pooled = {}
+        for j, c in enumerate(self.cal.channels):
+            d = held[self.channel == j]
+            if len(d):
+                scale = TOLERANCE[c] * edge_scale(c)
+                pooled[c] = {"rmse": float(np.sqrt(np.mean(d * d))) * scale,
+                             "max": float(np.max(np.abs(d))) * scale,
+                             "bias": float(np.mean(d)) * scale,
+                             "unit": edge_unit(c, ascii=True),
+                             "within_tolerance": float(np.mean(np.abs(d) <= 1.0)),
+                             "n": int(len(d))}
+        return {"blocks": blocks, "method": "one Gauss-Newton step per fold", "pooled": pooled}
+
+
+def residual_rows(cal: Calibrator, model: dict[str, np.ndarray]
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(residual [tolerances], channel index, grid index, in the fit window) of every valid
+    sample of the run, channel after channel."""
+    meas = cal.measured
+    fit_points = meas.fit_points()
+    r, ch, pt, f = [], [], [], []
+    for j, c in enumerate(cal.channels):
+        idx = np.flatnonzero(meas.mask(c, "all"))
+        r.append((meas.values[c][idx] - model[c][idx]) / TOLERANCE[c])
+        ch.append(np.full(len(idx), j))
+        pt.append(idx)
+        f.append(fit_points[idx])
+    return np.concatenate(r), np.concatenate(ch), np.concatenate(pt), np.concatenate(f)
+
+
+def local(cal: Calibrator, fit: Fit) -> Local:
+    """The model of ``fit`` linearized at its parameters (one simulation per free parameter)."""
+    gb = cal.gb.variant(fit.effects)
+    params = gb.parameters()
+    free = list(fit.free)
+    r0, ch, pt, in_fit = residual_rows(cal, fit.model)
+    z0 = np.array([_to_z(params[k], fit.theta[k]) for k in free])
+    lo = np.array([_bounds_z(params[k])[0] for k in free])
+    hi = np.array([_bounds_z(params[k])[1] for k in free])
+    J = np.empty((len(r0), len(free)))
+    for i, k in enumerate(free):
+        # step inside the bounds (a parameter on its upper bound steps down)
+        h = STEP if z0[i] + STEP <= hi[i] else -STEP
+        th = dict(fit.theta)
+        th[k] = _from_z_safe(params[k], z0[i] + h)
+        r1 = residual_rows(cal, gb.simulate(th))[0]
+        J[:, i] = (r1 - r0) / h
+    prior_rows = np.zeros(len(free))
+    prior_z = z0.copy()
+    for i, k in enumerate(free):
+        p = params[k]
+        if cal.prior and p.prior_sd and k in cal.prior:
+            prior_rows[i] = cal.prior_scale / p.prior_sd
+            prior_z[i] = _to_z(p, cal.prior[k])
+    return Local(cal, fit, ch, pt, in_fit, r0, J, z0, lo, hi, prior_rows, prior_z)
+
+
+def _from_z_safe(p, z: float) -> float:
+    from compare.fit.calibrate import _from_z
+
+    return _from_z(p, z)
+
+
+@dataclass
+class EffectFit:
+    """An effect fitted to the linearized model: its parameters on the fitted scale ``z``
+    (and in their units, ``values``), the base parameters' step, the residual of every row,
+    the effect's own columns at its estimate, and the log-posterior gain over the fit window
+    (counted in the current fit's effective samples)."""
+
+    label: str
+    z: np.ndarray
+    values: dict[str, float]
+    delta: np.ndarray
+    residual: np.ndarray
+    columns: np.ndarray
+    gain: float
+    shift: np.ndarray  # what the effect alone moves every row by [tolerances]
+
+
+def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
+               iterations: int = 6) -> EffectFit:
+    """The effect ``label`` fitted jointly with the base parameters on the linearized model
+    ``loc``: the base parameters enter through the Jacobian, the effect's own parameters
+    exactly (the model is simulated at their value, and their columns taken there), by a
+    few Gauss-Newton iterations within their bounds. ``start``: the effect's parameters to
+    start from (default: a tenth into their range). Costs one simulation per iteration and
+    parameter, and one more per iteration."""
+    from compare.fit.calibrate import _from_z
+
+    cal, fit = loc.cal, loc.fit
+    gb = cal.gb.variant(fit.effects + (label,))
+    params = effect_of(label).params
+    lo = np.array([_bounds_z(p)[0] for p in params])
+    hi = np.array([_bounds_z(p)[1] for p in params])
+    z_n = np.array([_to_z(p, p.default) for p in params])
+    z = np.array([_to_z(p, (start or {}).get(p.name, p.lo + 0.1 * (p.hi - p.lo)
+                                                 if p.lo >= 0 else 0.1 * p.hi))
+                  for p in params])
+    z = np.clip(z, lo, hi)
+    rows = loc.in_fit
+    kb = loc.J.shape[1]
+
+    def at(zv: np.ndarray) -> np.ndarray:
+        th = dict(fit.theta)
+        th.update({p.name: _from_z(p, float(v)) for p, v in zip(params, zv, strict=True)})
+        return residual_rows(cal, gb.simulate(th))[0]
+
+    r_neutral = at(z_n)
+    best = None
+    for _ in range(iterations):
+        r_z = at(z)
+        cols = np.empty((len(r_z), len(params)))
+        for i in range(len(params)):
+            h = STEP if z[i] + STEP <= hi[i] else -STEP
+            zz = z.copy()
+            zz[i] += h
+            cols[:, i] = (at(zz) - r_z) / h
+        # the base parameters' step from the current model and the effect's from z
+        shifted = Local(cal, fit, loc.channel, loc.point, loc.in_fit, r_z, loc.J, loc.z0,
+                        loc.lo, loc.hi, loc.prior_rows, loc.prior_z)
+        step = shifted.step(rows, cols, list(zip(lo - z, hi - z, strict=True)))
+        r1 = shifted.residual(step, cols)
+        shrink = fit.n_eff / max(fit.n, 1)
+        gain = ((loc.loglik(r1, rows) - loc.loglik(loc.r0, rows)) * shrink
+                - (loc.penalty(step[:kb]) - loc.penalty(np.zeros(kb))))
+        if best is None or gain > best[0]:
+            best = (gain, z.copy(), step[:kb].copy(), r1, cols, r_z)
+        z_new = np.clip(z + step[kb:], lo, hi)
+        if np.max(np.abs(z_new - z)) < 1e-4 * np.max(hi - lo):
+            break
+        z = z_new
+    gain, z, delta, r1, cols, r_z = best
+    values = {p.name: _from_z(p, float(v)) for p, v in zip(params, z, strict=True)}
+    return EffectFit(label, z, values, delta, r1, cols, float(gain), r_z - r_neutral)
+
+
+def effect_held_out(loc: Local, ef: EffectFit, blocks: int) -> dict[str, float]:
+    """Blocked cross-validation of the model with the effect fitted as ``ef``, one
+    Gauss-Newton step per fold on the base parameters and the effect's (its columns at its
+    estimate): per channel, the RMS of the held-out residual [tolerances]."""
+    around = Local(loc.cal, loc.fit, loc.channel, loc.point, loc.in_fit,
+                   ef.residual, loc.J, loc.z0 + ef.delta, loc.lo, loc.hi, loc.prior_rows,
+                   loc.prior_z)
+    meas = loc.cal.measured
+    edges = np.linspace(meas.grid_s[0], meas.grid_s[-1], blocks + 1)
+    block = np.clip(np.searchsorted(edges, meas.grid_s[loc.point], side="right") - 1, 0,
+                    blocks - 1)
+    params = effect_of(ef.label).params
+    lo = np.array([_bounds_z(p)[0] for p in params]) - ef.z
+    hi = np.array([_bounds_z(p)[1] for p in params]) - ef.z
+    held = np.empty_like(ef.residual)
+    for b in range(blocks):
+        out = block == b
+        step = around.step(~out, ef.columns, list(zip(lo, hi, strict=True)))
+        held[out] = around.residual(step, ef.columns)[out]
+    return {c: float(np.sqrt(np.mean(held[loc.channel == j] ** 2)))
+            for j, c in enumerate(loc.cal.channels) if (loc.channel == j).any()}

@@ -1,0 +1,382 @@
+"""The fit's report: ``report.json`` (format :data:`REPORT_FORMAT`), ``report.html`` and its
+pictures, and the text ``fit`` prints. Each begins with the verdict: the effects named, with
+their values and intervals and the error before and after per channel against the
+tolerances, or "nothing named, base adequate", "nothing named, base inadequate", or
+"unexplained" and where. The evidence follows: every candidate's criteria, the signature
+tests, the adequacy of the base model, the cross-validation, the parameters."""
+
+from __future__ import annotations
+
+import html
+import math
+from collections.abc import Sequence
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from compare.fit.calibrate import TOLERANCE, Fit, at_bound, parameters_table
+from compare.fit.effects import effect_of, parse_label
+from compare.fit.params import BASE_PARAMS, base_params, default_theta
+from compare.report import html_figure, html_page, html_table
+from spindle.drive import drive_for
+from spindle.outputs import jsonable
+from spindle.tolerances import edge_absolute, edge_scale, edge_unit
+
+REPORT_FORMAT = "spindle-verify-fit/2"
+
+
+def p_text(p: float | None) -> str:
+    """A p-value as people read it (one below double precision's range is not 0)."""
+    if p is None or not math.isfinite(p):
+        return "n/a"
+    return "p < 1e-300" if p < 1e-300 else f"p = {p:.2g}"
+
+
+def _errors(fit: Fit) -> dict:
+    out = {}
+    for window, chans in fit.errors.items():
+        out[window] = {}
+        for c, e in chans.items():
+            if not e.get("n"):
+                continue
+            unit = edge_unit(c, ascii=True)
+            out[window][c] = {"rmse": e[f"rmse_{unit}"], "max": e[f"max_{unit}"],
+                              "bias": e[f"bias_{unit}"], "unit": unit, "rmse_tolerances":
+                              e["rmse_w"], "within_tolerance": e["within_tolerance"],
+                              "n": e["n"]}
+    return out
+
+
+def _effect_entry(rep, step) -> dict:
+    """One named effect: its parameters at the final fit, intervals, units, evidence and the
+    criteria it passed."""
+    final = rep.selection.final
+    j = step.judgement
+    lab = step.label
+    name, channel = parse_label(lab)
+    e = effect_of(lab)
+    params: dict = {p.name: final.theta[p.name] for p in e.params}
+    if channel:
+        params["channel"] = channel
+    test = rep.signatures.get(lab)
+    return {"name": name, "label": lab, "channel": channel, "parameters": params,
+            "confidence_intervals": {p.name: list(final.ci95[p.name]) for p in e.params},
+            "units": {p.name: p.unit for p in e.params},
+            "p_value": j.p_value, "lr": j.lr, "gain": j.gain, "peak_tolerances": j.peak,
+            "evidence": test.to_dict() if test is not None and test.applies else None,
+            "criteria": j.criteria, "route": j.route, "explanation": e.explanation,
+            "hint": e.hint,
+            "at_bound": at_bound(final, lab, rep.criteria.at_bound_rel),
+            "validation_rms_before": step.before.validation_score(),
+            "validation_rms_after": step.fit.validation_score()}
+
+
+def verdict_kind(rep) -> str:
+    """"named", "unexplained", "base adequate" or "base inadequate"."""
+    sel = rep.selection
+    if sel.steps:
+        return "named"
+    if sel.verdict is not None and sel.verdict.unexplained:
+        return "unexplained"
+    val = sel.final.errors["validation"]
+    ok = all(e["rmse_w"] <= 1.0 for e in val.values() if e.get("n"))
+    return "base adequate" if ok else "base inadequate"
+
+
+def _change_text(doc: dict) -> str:
+    """The validation error before and after per channel, against the tolerances."""
+    before = doc["error_before"].get("validation", {})
+    after = doc["error_after"].get("validation", {})
+    parts = []
+    for c, a in after.items():
+        b = before.get(c, a)
+        tol = TOLERANCE[c] * edge_scale(c)
+        parts.append(f"{c} {b['rmse']:.2f} -> {a['rmse']:.2f} {edge_unit(c)} "
+                     f"(tolerance {tol:g})")
+    return ", ".join(parts)
+
+
+def verdict_lines(doc: dict) -> list[str]:
+    """The verdict in sentences: what was found, then the error before and after."""
+    v = doc["verdict"]
+    lines = []
+    if v["kind"] == "named":
+        for e in doc["effects"]:
+            vals = "; ".join(
+                f"{k} = {x:.3g} {e['units'].get(k, '')} (95 %: {ci[0]:.3g} to {ci[1]:.3g})"
+                for k, x in e["parameters"].items() if isinstance(x, int | float)
+                for ci in [e["confidence_intervals"].get(k, (math.nan, math.nan))])
+            ev = e["evidence"]
+            how = (f"its signature in the raw samples (z = {ev['z']:.1f}, {p_text(ev['p_value'])})"
+                   if e["route"] == "signature" else
+                   f"the open-loop fit ({p_text(e['p_value'])}): it predicts held-out blocks and "
+                   "explains the run better than something else and than every other effect")
+            lines.append(f"Named: {e['label']}, {vals}. Evidence: {how}.")
+        if v["unexplained"]:
+            lines.append(f"Something else remains: {v['where']}.")
+    elif v["kind"] == "unexplained":
+        lines.append("Unexplained: no effect of the library explains this run, and something "
+                     f"else does: {v['where']}.")
+    elif v["kind"] == "base adequate":
+        lines.append("Nothing named, base adequate: the calibrated base model explains the run "
+                     "within the tolerances.")
+    else:
+        lines.append("Nothing named, base inadequate: the calibrated base model misses the "
+                     "tolerances, and neither an effect of the library nor something at one "
+                     "time of the run explains the misfit; look at the spec (below).")
+    lines.append(f"Validation error before -> after: {_change_text(doc)}.")
+    return lines
+
+
+def report_dict(rep) -> dict:
+    """The JSON document of a :class:`compare.fit.run.FitReport` (module docstring)."""
+    sel = rep.selection
+    final = sel.final
+    effects = [_effect_entry(rep, st) for st in sel.steps]
+    verdict = sel.verdict.to_dict() if sel.verdict is not None else {"unexplained": False}
+    doc = {
+        "format": REPORT_FORMAT, "run": str(rep.run.path), "spec": rep.spec.name,
+        "channels": rep.channels,
+        "verdict": {"kind": verdict_kind(rep), "named": [e["label"] for e in effects],
+                    "unexplained": bool(verdict["unexplained"]), "where": verdict.get("where")},
+        "effects": effects,
+        "something_else": verdict,
+        "unexplained": {"unexplained": bool(verdict["unexplained"]),
+                        "description": verdict.get("where") or ""},
+        "error_before": _errors(sel.base), "error_after": _errors(final),
+        "candidates": [j.to_dict() for j in sel.judged],
+        "signatures": {k: t.to_dict() for k, t in rep.signatures.items()},
+        "criteria": rep.criteria.table(),
+        "run_summary": rep.run.summary(),
+        "windows": {"blocks": rep.measured.blocks,
+                    "fit": [[a, b] for a, b, w in rep.measured.spans() if w == "fit"],
+                    "validation": [[a, b] for a, b, w in rep.measured.spans()
+                                   if w == "validation"]},
+        "cross_validation": rep.cross_validation,
+        "tolerances": {"temperature_K": TOLERANCE["T1"], "growth_um": TOLERANCE["P1"] * 1e6},
+        "alpha": rep.criteria.alpha,
+        "calibration_model": rep.calibration_model,
+        "fem_calibration": rep.fem_calibration,
+        "base_adequacy": rep.base_adequacy,
+        "warnings": rep.warnings,
+        "gap_switches": [asdict(g) for g in rep.gap_switches],
+        "parameters": parameters_table(final),
+        "parameters_before": parameters_table(sel.base),
+        "parameters_prior_z": rep.prior_z,
+        "correlation": {"names": final.free, "matrix": final.correlation.tolist()},
+        "not_identifiable": [k for k, ok in final.identifiable.items() if not ok],
+        "fem_anchor": None if rep.anchor is None else {
+            "fem_level": rep.anchor.fem_level,
+            "prior_centre": default_theta(base_params(drive_for(rep.spec))),
+            "anchored_at": rep.anchor.theta_ref,
+            "prior_sd": {k: p.prior_sd for k, p in BASE_PARAMS.items()},
+            "fem_minus_lumped_rms": rep.anchor.rms,
+            "validation_floor": rep.floor},
+        "diagnostics_before": rep.diagnostics_before.to_dict(),
+        "diagnostics_after": rep.diagnostics_after.to_dict(),
+        "runtime_s": rep.runtime_s}
+    doc["verdict"]["summary"] = " ".join(verdict_lines(doc))
+    return jsonable(doc)
+
+
+def summary_text(rep) -> str:
+    """What ``fit`` prints: the verdict first, then the run, the adequacy of the base model,
+    warnings and the cross-validated error."""
+    doc = rep.to_dict()
+    lines = verdict_lines(doc)
+    lines.append(f"{rep.run.path}: {len(rep.run.time_s)} rows, {rep.run.duration_s / 3600:.2f} "
+                 f"h, channels {', '.join(rep.channels)}; calibrated on the "
+                 f"{rep.calibration_model} model; {rep.runtime_s:.1f} s")
+    ad = doc.get("base_adequacy")
+    if ad:
+        lines.append(f"The base model {ad['statement']}.")
+    lines += [f"Warning: {w}." for w in doc.get("warnings") or []]
+    for key, label in (("base", "before"), ("final", "after")):
+        pooled = (doc.get("cross_validation") or {}).get(key, {}).get("pooled")
+        if pooled:
+            lines.append(f"Cross-validated error {label} ({doc['cross_validation'][key]['blocks']}"
+                         " blocks, each held out): " + ", ".join(
+                             f"{c} {e['rmse']:.2f} {edge_unit(c)}" for c, e in pooled.items())
+                         + ".")
+    bad = doc["not_identifiable"]
+    if bad:
+        lines.append(f"Not identifiable from this run: {', '.join(bad)}.")
+    return "\n".join(lines)
+
+
+def named_effects(doc: dict) -> list[str]:
+    """The effects a report names, by label (a lag with its channel, ``sensor_lag(T1)``)."""
+    return [e["label"] for e in doc["effects"]]
+
+
+def selection_trace(doc: dict) -> dict:
+    """What a benchmark keeps of a report to see why an effect was named or not: the
+    signature tests (estimate, z, p), each judged candidate's criteria and figures, the
+    competitor on the final model and the calibrated parameters."""
+    return {"signatures": {k: {f: v.get(f) for f in ("estimate", "se", "z", "p_value")}
+                           for k, v in doc.get("signatures", {}).items()},
+            "candidates": doc.get("candidates", []),
+            "something_else": doc.get("something_else"),
+            "parameters": {p["name"]: p["value"] for p in doc.get("parameters", [])}}
+
+
+# ---------------------------------------------------------------------- files
+def save_report(rep, out: Path, pictures: bool = True) -> list[Path]:
+    from spindle.outputs import atomic_write, write_json
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = rep.to_dict()
+    write_json(out / "report.json", doc)
+    files = [out / "report.json"]
+    pngs: list[tuple[str, str]] = []
+    if pictures:
+        pngs = _pictures(rep, out)
+        files += [out / name for name, _ in pngs]
+    atomic_write(out / "report.html", lambda tmp: tmp.write_text(_html(rep, doc, out, pngs),
+                                                                   "utf-8"))
+    files.append(out / "report.html")
+    return files
+
+
+def _pictures(rep, out: Path) -> list[tuple[str, str]]:
+    from compare.fit.residuals import plot_acf, plot_cumulated_periodogram
+    from spindle.outputs import atomic_write
+    from spindle.plots import pyplot
+
+    plt = pyplot()
+    g = rep.measured.grid_s / 3600
+    sel = rep.selection
+    made = []
+    n = len(rep.channels)
+    fig, axes = plt.subplots(n, 2, figsize=(13, 2.8 * n), layout="constrained", squeeze=False)
+    for i, c in enumerate(rep.channels):
+        scale, off, unit = edge_absolute(c)
+        tol = TOLERANCE[c] * scale
+        meas = rep.measured.values[c] * scale - off
+        for j, (fit, label) in enumerate(((sel.base, "before"), (sel.final, "after"))):
+            ax = axes[i, j]
+            model = fit.model[c] * scale - off
+            ax.fill_between(g, model - tol, model + tol, color="tab:blue", alpha=0.15,
+                            label=f"model ±{tol:g} {unit}")
+            ax.plot(g, model, color="tab:blue", ls="--", lw=1, label="model")
+            ax.plot(g, meas, color="black", lw=0.8, label="measured")
+            for a, b, w in rep.measured.spans():
+                if w == "validation":
+                    ax.axvspan(a / 3600, b / 3600, color="tab:orange", alpha=0.08, lw=0)
+            ax.set_ylabel(f"{c} [{unit}]")
+            ax.set_title(f"{c} {label}" + (f" (with {', '.join(fit.effects)})" if fit.effects
+                                            else " (base model)"), fontsize=9)
+            ax.grid(alpha=0.3)
+            if i == 0:
+                ax.legend(fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [h] (shaded: validation window)")
+    atomic_write(out / "fit_channels.png", lambda tmp: fig.savefig(tmp, dpi=110))
+    plt.close(fig)
+    made.append(("fit_channels.png", "measured against the model, before and after, with the "
+                 "tolerance bands (paper Fig. 13)"))
+    fig, axes = plt.subplots(n, 3, figsize=(14, 2.6 * n), layout="constrained", squeeze=False)
+    dt = float(np.median(np.diff(rep.measured.grid_s)))
+    for i, c in enumerate(rep.channels):
+        rb = (rep.measured.values[c] - sel.base.model[c]) / TOLERANCE[c]
+        ra = (rep.measured.values[c] - sel.final.model[c]) / TOLERANCE[c]
+        ax = axes[i, 0]
+        ax.plot(g, rb, lw=0.8, color="C0", label="before")
+        ax.plot(g, ra, lw=0.8, color="C1", label="after")
+        ax.axhspan(-1, 1, color="0.9")
+        ax.set_ylabel(f"{c} residual / tol")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+        first = True
+        for r, colour, label in ((rb, "C0", "before"), (ra, "C1", "after")):
+            if (~np.isnan(r)).sum() > 20:
+                plot_acf(axes[i, 1], r, 40, 0.01, dt, color=colour, label=label, band=first)
+                plot_cumulated_periodogram(axes[i, 2], r, 0.01, dt, color=colour, label=label,
+                                           band=first)
+                first = False
+        axes[i, 1].legend(fontsize=7, loc="upper right")
+        axes[i, 2].legend(fontsize=7, loc="lower right")
+        axes[i, 1].set_title(f"{c}: ACF (before, after)", fontsize=9)
+        axes[i, 2].set_title(f"{c}: cumulated periodogram (before, after)", fontsize=9)
+    atomic_write(out / "fit_residuals.png", lambda tmp: fig.savefig(tmp, dpi=110))
+    plt.close(fig)
+    made.append(("fit_residuals.png", "residuals before and after (in tolerance units), their "
+                 "autocorrelation and cumulated periodograms"))
+    return made
+
+
+def _criteria_html(doc: dict) -> str:
+    """Every judged candidate and each named criterion's outcome."""
+    rows = []
+    names = ("significant", "material", "signature", "predicts", "beats_something_else",
+             "distinct", "base_plausible")
+    for c in doc.get("candidates", []):
+        crit = c["criteria"]
+        rows.append([c["candidate"], c["round"], f"{c['gain']:.1f}", p_text(c["p_value"]),
+                     f"{c['peak_tolerances']:.2f}",
+                     *["—" if crit.get(k) is None else ("pass" if crit[k] else "FAIL")
+                       for k in names], c.get("route") or "no"])
+    return ("<h2>Candidates and criteria</h2><p>Each candidate refitted with the base "
+            "parameters, round by round, and the criteria it passed (— not asked). A "
+            "candidate qualifies when it is significant and material and shows that it is "
+            "this effect by its signature or by every open-loop criterion "
+            "(compare.fit.select).</p>"
+            + html_table(["candidate", "round", "gain", "p", "peak [tol]", *names,
+                          "qualifies by"], rows, ["s"] * 13))
+
+
+def _signatures_html(doc: dict) -> str:
+    rows = []
+    for label, t in (doc.get("signatures") or {}).items():
+        applies = t["p_value"] is not None and math.isfinite(t["p_value"])
+        rows.append([label, t["channel"],
+                     f"{t['estimate']:.4g} ± {t['se']:.2g}" if applies else "",
+                     t["unit"], f"{t['z']:.1f}" if applies else "", p_text(t["p_value"]),
+                     t["meaning"]])
+    if not rows:
+        return ""
+    return ("<h2>Signature tests (raw samples)</h2>"
+            + html_table(["test", "channel", "estimate ± se", "unit", "z", "p", "what it reads"],
+                         rows, ["s"] * 7))
+
+
+def _html(rep, doc: dict, out: Path, pngs: Sequence[tuple[str, str]]) -> str:
+    def err_table(block: dict) -> str:
+        rows = [[window, c, e["rmse"], e["max"], e["bias"], e["unit"],
+                 100 * e["within_tolerance"]]
+                for window in ("fit", "validation") for c, e in block.get(window, {}).items()]
+        return html_table(["window", "channel", "RMSE", "max", "bias", "unit",
+                           "within tolerance [%]"], rows,
+                          ["s", "s", ".3f", ".3f", "+.3f", "s", ".1f"])
+
+    params = html_table(
+        ["name", "value", "95 %", "unit", "identifiable", "meaning"],
+        [[p["name"], p["value"], f"{p['ci95'][0]:.4g} .. {p['ci95'][1]:.4g}", p["unit"],
+          "yes" if p["identifiable"] else "NO", p["meaning"]] for p in doc["parameters"]],
+        ["s", ".4g", "s", "s", "s", "s"])
+    ad = doc.get("base_adequacy") or {}
+    crit = html_table(["criterion", "value", "unit", "reason"],
+                      [[c["name"], str(c["value"]), c["unit"], c["reason"]]
+                       for c in doc["criteria"]], ["s"] * 4)
+    warns = "".join(f"<li>{html.escape(w)}</li>" for w in doc.get("warnings") or [])
+    return html_page("spindle-verify fit", [
+        f"<h1>Fit of {html.escape(str(rep.run.path))} to {html.escape(rep.spec.name)}</h1>",
+        "".join(f"<p><b>{html.escape(line)}</b></p>" for line in verdict_lines(doc)),
+        (f"<p><b>Warnings</b></p><ul>{warns}</ul>" if warns else ""),
+        "<h2>Error before and after</h2>" + err_table(doc["error_before"])
+        + err_table(doc["error_after"]),
+        *[html_figure(out / n, c) for n, c in pngs[:1]],
+        _criteria_html(doc),
+        _signatures_html(doc),
+        f"<h2>The base model</h2><p>The calibrated base model "
+        f"{html.escape(ad.get('statement', ''))}.</p>",
+        "<h2>Calibrated parameters (95 % intervals)</h2>" + params,
+        *[html_figure(out / n, c) for n, c in pngs[1:]],
+        f"<p>Channels {', '.join(rep.channels)}; calibration model: "
+        f"<b>{html.escape(rep.calibration_model)}</b>"
+        + (" (the base parameters calibrated on the FEM reference itself, the effects "
+           "selected on the lumped model anchored there)" if rep.calibration_model == "fem"
+           else "") + f"; {rep.runtime_s:.1f} s.</p>",
+        "<details><summary>The criteria of this fit</summary>" + crit + "</details>"])

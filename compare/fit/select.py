@@ -1,0 +1,347 @@
+"""Which effects a bench run supports: forward selection against "something else".
+
+Each round linearizes the current model in its base parameters (compare.fit.linear) and fits
+every candidate of the library not yet in it jointly with them: the base parameters through
+the Jacobian, the candidate's own exactly, by a few Gauss-Newton iterations
+(compare.fit.linear.fit_effect). The competitor (compare.fit.competitor: an unexplained heat
+or offset in a window of the run) is fitted the same way. Each candidate is judged by the
+named criteria of :class:`compare.fit.criteria.Criteria`; the one that joins the model is
+then refitted to convergence. Every candidate must be
+
+- ``material``: at its estimate it moves one of its channels by ``material_peak`` tolerances;
+- ``significant``: its likelihood-ratio test against the current model at ``alpha``
+  (the likelihood of compare.fit.calibrate), or, on the signature route, ``jointly_significant``:
+  Fisher's combination of that test and the signature's is (a base that absorbs part of an
+  effect its signature shows leaves the fit a small gain);
+
+and then show that it is *this* effect, by one of two routes:
+
+- **its signature** (``signature``): its test on the raw samples, where one applies, is
+  significant at ``alpha``: evidence no misfit of the base model, no other effect and no
+  window of something else can give. Where the test applies and is not significant, the
+  effect does not qualify by either route (``Criteria.signature_must_agree``; switched off,
+  only where the test's (1 - alpha) interval excludes the fitted size);
+- **the open loop**, where no signature test applies to the run, all of:
+
+  - ``predicts``: it lowers the blocked cross-validated error above the noise floor on its
+    channels by ``cv_gain`` (a law of the inputs predicts the blocks it was not fitted on;
+    something at one time does not);
+  - ``beats_something_else``: its gain, less half ln(n_eff) per parameter (BIC), is at
+    least the competitor's best, less the same for its three (amplitude, start, end);
+  - ``changes_prediction`` (``Criteria.open_loop_material_change``): the fitted model's
+    prediction, with the base re-adjusted around the effect, moves by ``material_peak`` on
+    one of its channels;
+  - ``distinct``: its penalised gain exceeds that of every other candidate acting on one of
+    its channels by half the chi-square quantile of one degree of freedom at ``alpha``
+    (3.3 at 1 %): two effects that explain the run alike are a guess, not a finding;
+  - ``base_plausible`` (only with ``Criteria.open_loop_needs_plausible_base``, off by
+    default): with the candidate, the base parameters are jointly plausible: the
+    sum of their squared prior z is within the chi-square quantile at ``alpha`` with one
+    degree of freedom per parameter with a prior (the test of a Gaussian prior's consistency;
+    a parameter-by-parameter test at ``alpha`` would fail one of ten parameters of a right
+    model one time in ten). The open loop attributes what the base model misses to the
+    effect; where the base still needs implausible values beside it, the base's form is in
+    doubt and so is that attribution.
+
+A qualifying candidate joins the model if it adds the most likelihood among those that
+qualify, and the next round judges the rest against the model that holds it (a second effect
+earns its place against the first, not against the base). The selection stops when none
+qualifies. Then the final model is stepped to the whole run (a model calibrated on the fit
+window misses the validation window by its extrapolation, which a window there would take up)
+and the competitor scanned on it: where it is significant (its likelihood-ratio test at
+``alpha`` divided by the number of hypotheses the scan tried) and material, the verdict says
+``unexplained`` and where.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from compare.fit.calibrate import Calibrator, Fit, _from_z, _to_z
+from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan
+from compare.fit.criteria import Criteria, chi2_threshold
+from compare.fit.effects import effect_of, parse_label
+from compare.fit.linear import Local, effect_held_out, fit_effect, local
+
+
+@dataclass
+class Judgement:
+    """One candidate in one round: its refit and each named criterion's outcome (None where
+    the criterion was not asked), and the route it qualified by ("signature", "open loop")
+    or None."""
+
+    label: str
+    round: int
+    fit: Fit | None  # the nonlinear refit, made for the candidate that joins the model
+    gain: float
+    lr: float
+    p_value: float
+    peak: float
+    criteria: dict[str, bool | None]
+    figures: dict[str, float | None] = field(default_factory=dict)
+
+    @property
+    def route(self) -> str | None:
+        c = self.criteria
+        if not c["material"] or c["signature"] is False:
+            return None
+        if c["signature"] and (c["significant"] or c.get("jointly_significant")):
+            return "signature"
+        if not c["significant"]:
+            return None
+        open_loop = ("predicts", "beats_something_else", "distinct")
+        optional = ("changes_prediction", "base_plausible")  # None: switched off
+        ok = all(c.get(k) for k in open_loop) and all(c.get(k) is not False for k in optional)
+        return "open loop" if ok else None
+
+    @property
+    def qualifies(self) -> bool:
+        return self.route is not None
+
+    def to_dict(self) -> dict:
+        return {"candidate": self.label, "round": self.round, "gain": self.gain,
+                "lr": self.lr, "p_value": self.p_value, "peak_tolerances": self.peak,
+                "criteria": self.criteria, "route": self.route, "qualifies": self.qualifies,
+                **self.figures}
+
+
+@dataclass
+class Step:
+    """One accepted effect: its judgement and the model before it."""
+
+    judgement: Judgement
+    before: Fit
+
+    @property
+    def label(self) -> str:
+        return self.judgement.label
+
+    @property
+    def fit(self) -> Fit:
+        return self.judgement.fit
+
+
+@dataclass
+class Verdict:
+    """What the run says beyond the named effects: the competitor on the final model (its
+    best hypothesis, the likelihood-ratio statistic, the threshold it had to pass) and
+    whether that makes the run ``unexplained``."""
+
+    hypothesis: Hypothesis | None
+    lr: float
+    threshold: float
+    unexplained: bool
+
+    def to_dict(self) -> dict:
+        h = self.hypothesis
+        return {"unexplained": self.unexplained, "lr": self.lr, "threshold": self.threshold,
+                "where": None if h is None else h.text(),
+                "hypothesis": None if h is None else {
+                    "kind": h.kind, "where": h.where, "t0_s": h.t0_s, "t1_s": h.t1_s,
+                    "amplitude": h.amplitude, "unit": "W" if h.kind == "heat" else "tolerances",
+                    "peak_tolerances": h.peak, "hypotheses_tried": h.tried}}
+
+
+@dataclass
+class Selection:
+    base: Fit
+    steps: list[Step]
+    judged: list[Judgement]
+    verdict: Verdict | None = None
+
+    @property
+    def final(self) -> Fit:
+        return self.steps[-1].fit if self.steps else self.base
+
+
+def _own(label: str) -> tuple[str, ...]:
+    """The channels a candidate acts on (a per-channel effect: its channel)."""
+    name, channel = parse_label(label)
+    return (channel,) if channel else effect_of(label).channels
+
+
+def _fisher(*p_values: float) -> float:
+    """Fisher's combination of independent p-values (a signature read from the power or a
+    channel's onsets, and the open-loop fit's likelihood ratio)."""
+    from scipy.stats import combine_pvalues
+
+    return float(combine_pvalues([max(p, 1e-300) for p in p_values], method="fisher").pvalue)
+
+
+def _plausible(z: np.ndarray, k: int, alpha: float) -> bool:
+    """The base parameters' prior z (0 where a parameter has none; ``k`` have one) jointly
+    plausible at ``alpha``."""
+    return bool(float(z @ z) <= chi2_threshold(alpha, k)) if k else True
+
+
+def _cv_excess(cv: dict[str, float], floor: Mapping[str, float] | None,
+               channels: Sequence[str]) -> float:
+    """Cross-validated error above the noise floor on ``channels`` [tolerances squared]."""
+    return sum(max(v * v - (floor or {}).get(c, 0.0) ** 2, 0.0)
+               for c, v in cv.items() if c in channels)
+
+
+def _signature_start(label: str, signature) -> dict[str, float] | None:
+    """The effect's parameters as its signature test estimates them, where it does."""
+    par = signature.parameter if signature is not None and signature.applies else None
+    if not par:
+        return None
+    p = next((q for q in effect_of(label).params if q.name == par["name"]), None)
+    if p is None:
+        return None
+    return {p.name: min(max(par["value"], p.lo + 1e-6 * (p.hi - p.lo)), p.hi)}
+
+
+def signature_outcome(signature, values: Mapping[str, float], alpha: float,
+                      must_agree: bool = False) -> bool | None:
+    """True where the signature test is significant at ``alpha``; None where it does not
+    apply (or there is none). Where it applies and is not significant: False with
+    ``must_agree`` (Criteria.signature_must_agree: the test did not find the effect);
+    otherwise False only where its (1 - alpha) interval excludes the fitted value (the test
+    had the chance to see an effect of that size and did not), and None where it cannot
+    tell."""
+    from scipy.stats import norm
+
+    if signature is None or not signature.applies:
+        return None
+    if signature.significant(alpha):
+        return True
+    if must_agree:
+        return False
+    par = signature.parameter
+    if not par or par["name"] not in values:
+        return None
+    lo, hi = par["ci95"]
+    widen = float(norm.isf(alpha / 2)) / 1.96
+    centre = par["value"]
+    v = values[par["name"]]
+    return None if centre - widen * (centre - lo) <= v <= centre + widen * (hi - centre) \
+        else False
+
+
+def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Criteria,
+           signatures: Mapping[str, object] | None = None,
+           progress: Callable[[str], None] | None = None) -> Selection:
+    """Forward selection of ``candidates`` (labels) from the calibrated ``base`` (module
+    docstring); ``signatures``: the run's signature tests by label."""
+    say = progress or (lambda _m: None)
+    sig = dict(signatures or {})
+    current = base
+    steps: list[Step] = []
+    judged: list[Judgement] = []
+    reg = regressors(cal, base, criteria)
+    loc = local(cal, current)
+    while True:
+        rnd = len(steps) + 1
+        have = {parse_label(e)[0] for e in current.effects}
+        pending = [c for c in candidates if parse_label(c)[0] not in have]
+        if not pending:
+            break
+        fits = {}
+        for lab in pending:
+            say(f"round {rnd}: fitting {lab}")
+            # from a tenth into its range, and from its signature's estimate where there is one
+            tries = [fit_effect(loc, lab)]
+            from_signature = _signature_start(lab, sig.get(lab))
+            if from_signature:
+                tries.append(fit_effect(loc, lab, from_signature))
+            fits[lab] = max(tries, key=lambda f: f.gain)
+        say(f"round {rnd}: fitting something else")
+        shrink = current.n_eff / max(current.n, 1)
+        found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit, shrink)
+        g_gain, _g_best = joint_gain(loc, reg, found)
+        # every candidate's gain, penalised by half ln(n_eff) per parameter (BIC)
+        pen = 0.5 * math.log(max(current.n_eff, 2.0))
+        penalised = {lab: f.gain - pen * len(effect_of(lab).params) for lab, f in fits.items()}
+        cv_now = loc.cross_validate(criteria.cv_blocks) if criteria.cv_blocks else None
+        round_judged = []
+        for lab, ef in fits.items():
+            rivals = [v for other, v in penalised.items() if other != lab
+                      and parse_label(other)[0] != parse_label(lab)[0]
+                      and set(_own(other)) & set(_own(lab))]
+            round_judged.append(judge(loc, ef, sig.get(lab), criteria, penalised[lab],
+                                      g_gain - 3 * pen, max(rivals, default=-math.inf),
+                                      cv_now, rnd))
+        judged += round_judged
+        qualified = [j for j in round_judged if j.qualifies]
+        if not qualified:
+            break
+        best = max(qualified, key=lambda j: j.gain)
+        say(f"round {rnd}: refitting with {best.label}")
+        start = {**current.theta, **fits[best.label].values}
+        params = cal.gb.variant(current.effects).parameters()
+        for k, d in zip(current.free, fits[best.label].delta, strict=True):
+            start[k] = _from_z(params[k], _to_z(params[k], current.theta[k]) + float(d))
+        best.fit = cal.fit(current.effects + (best.label,), start=start,
+                           max_nfev=criteria.refit_nfev)
+        steps.append(Step(best, current))
+        current = best.fit
+        loc = local(cal, current)
+    say("fitting something else on the final model")
+    return Selection(base, steps, judged, verdict_on(loc, reg, criteria))
+
+
+def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
+          competitor: float, rival: float, cv_now: dict | None, rnd: int) -> Judgement:
+    """The named criteria of one candidate fitted on the linearized model (module
+    docstring). ``penalised``: its gain less half ln(n_eff) per parameter; ``competitor`` and
+    ``rival``: the same of the competitor's best hypothesis and of the best other candidate
+    on its channels."""
+    from scipy.stats import chi2
+
+    cal = loc.cal
+    k = len(effect_of(ef.label).params)
+    lr = max(2.0 * ef.gain, 0.0)
+    pv = float(chi2.sf(lr, k))
+    own = _own(ef.label)
+    rows = np.isin(loc.channel, [cal.channels.index(c) for c in own if c in cal.channels])
+    peak = float(np.max(np.abs(ef.shift[rows]))) if rows.any() else 0.0
+    # what the fitted model's prediction moves by, the base's re-adjustment included
+    net = float(np.max(np.abs(loc.r0[rows] - ef.residual[rows]))) if rows.any() else 0.0
+    margin = 0.5 * chi2_threshold(criteria.alpha, 1)
+    out: dict[str, bool | None] = {
+        "significant": pv < criteria.alpha,
+        "material": peak >= criteria.material_peak,
+        "signature": signature_outcome(signature, ef.values, criteria.alpha,
+                                       criteria.signature_must_agree),
+        "jointly_significant": (_fisher(signature.p_value, pv) < criteria.alpha
+                                if signature is not None and signature.applies else None),
+        "predicts": None,
+        "changes_prediction": (net >= criteria.material_peak
+                               if criteria.open_loop_material_change else None),
+        "beats_something_else": bool(penalised >= competitor),
+        "distinct": bool(penalised >= rival + margin),
+        "base_plausible": (_plausible(loc.prior_z_after(ef.delta),
+                                      int(np.count_nonzero(loc.prior_rows)), criteria.alpha)
+                           if criteria.open_loop_needs_plausible_base else None),
+    }
+    figures: dict[str, float | None] = {
+        "values": ef.values, "penalised_gain": penalised,
+        "competitor_penalised_gain": competitor if math.isfinite(competitor) else None,
+        "rival_penalised_gain": rival if math.isfinite(rival) else None,
+        "net_change_peak": net, "cv_before": None, "cv_after": None}
+    if criteria.cv_blocks and out["significant"] and out["material"] and not out["signature"]:
+        before = _cv_excess(cv_now or {}, cal.floor, own)
+        after = _cv_excess(effect_held_out(loc, ef, criteria.cv_blocks), cal.floor, own)
+        out["predicts"] = bool(after <= (1.0 - criteria.cv_gain) * before)
+        figures.update(cv_before=before, cv_after=after)
+    return Judgement(ef.label, rnd, None, ef.gain, lr, pv, peak, out, figures)
+
+
+def verdict_on(loc: Local, reg, criteria: Criteria) -> Verdict:
+    """The competitor on the final model (linearized as ``loc``) stepped to the whole run:
+    unexplained where it is significant (Bonferroni over its hypotheses) and material."""
+    rows = np.ones(len(loc.r0), dtype=bool)
+    r = loc.residual(loc.step(rows))
+    shrink = loc.fit.n_eff / max(loc.fit.n, 1)
+    found, tried = scan(reg, r, loc.channel, rows, shrink, top=1)
+    if not found:
+        return Verdict(None, 0.0, math.inf, False)
+    h = found[0]
+    lr = 2.0 * h.gain
+    threshold = chi2_threshold(criteria.alpha, 1, tried)
+    return Verdict(h, lr, threshold, bool(lr > threshold and h.peak >= criteria.material_peak))

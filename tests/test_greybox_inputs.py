@@ -1,0 +1,50 @@
+"""The grey box's per-interval inputs from a bench run (compare.fit.run.greybox_inputs): the
+losses an interval takes from the power balance are the mean over its samples of
+P_el - M omega, also where the speed ramps inside the interval (issue 32)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from compare.fit.run import greybox_inputs
+from spindle.bench import BenchRun
+
+
+def _ramp_run(losses_W: float = 900.0, torque_Nm: float = 42.0) -> BenchRun:
+    """10 min at 1 Hz: 5000 rpm, a ramp to 1000 rpm from 125 s to 135 s (inside the cell
+    120-180 s, before its middle), then 1000 rpm; a constant process torque and constant losses, so the logged
+    electrical power is the losses plus M omega at every sample."""
+    t = np.arange(0.0, 601.0, 1.0)
+    n = np.interp(t, [0.0, 125.0, 135.0, 600.0], [5000.0, 5000.0, 1000.0, 1000.0])
+    M = np.full_like(t, torque_Nm)
+    P_kW = (losses_W + M * 2.0 * math.pi * n / 60.0) / 1e3
+    cols = {"speed_rpm": n, "power_kW": P_kW, "load_torque_Nm": M,
+            "T_env_C": np.full_like(t, 20.0), "T_coolant_C": np.full_like(t, 20.0),
+            "T1_C": np.full_like(t, 20.0)}
+    return BenchRun(Path("ramp.csv"), {}, t, cols, {}, [], ["T1"], float(t[-1]),
+                    load_torque_measured=True)
+
+
+def test_losses_are_the_samples_mean_through_a_ramp_inside_a_cell():
+    inp = greybox_inputs(_ramp_run(), 60.0)
+    omega = 2.0 * math.pi * inp.speed_rpm / 60.0  # rad/s of each interval's held speed
+    losses = inp.power_kW * 1e3 - inp.load_torque_Nm * omega
+    # every interval, the ramp's included, gives the samples' 900 W to round-off
+    np.testing.assert_allclose(losses, 900.0, atol=1e-6)
+    # not vacuous: the mean power less the torque at the middle's speed (the old inputs) is
+    # M (mean omega - omega_mid) = 42 N m x 70 rad/s, about 2.9 kW, off in the ramp's cell
+    k = int(np.flatnonzero((inp.grid_s[:-1] <= 150.0) & (inp.grid_s[1:] > 150.0))[0])
+    old = inp.power_kW[k] * 1e3 - 42.0 * omega[k]
+    assert abs(old - 900.0) > 1000.0, old
+
+
+def test_a_run_without_torque_has_none():
+    from dataclasses import replace
+
+    run = _ramp_run()
+    run = replace(run, columns={**run.columns, "load_torque_Nm": np.zeros_like(run.time_s)},
+                  load_torque_measured=False)
+    assert np.all(greybox_inputs(run, 60.0).load_torque_Nm == 0.0)

@@ -1,0 +1,150 @@
+"""The selection (compare.fit.select) and its competitor (compare.fit.competitor): which route
+a candidate's criteria give, when a signature contradicts a fit, and, on data from the grey
+box itself, that a library effect is named, that clean data name nothing, and that a heat in
+a window no library effect makes is "unexplained" and located."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from compare.fit.calibrate import Calibrator, Measured
+from compare.fit.competitor import WindowHeat
+from compare.fit.criteria import Criteria
+from compare.fit.effects import candidates, hypothesis
+from compare.fit.greybox import GreyBox, inputs_from_cycle
+from compare.fit.select import Judgement, select, signature_outcome
+from compare.fit.signatures import EventTest
+from spindle.cycle_files import load_cycle
+from spindle.drive import DRIVES
+from spindle.spec_reader import load_spec
+
+CHANNELS = ["T1", "T2", "T_stator", "P1"]
+ALL_PASS = {"significant": True, "material": True, "signature": None,
+            "jointly_significant": None, "predicts": True, "beats_something_else": True,
+            "distinct": True, "base_plausible": True, "changes_prediction": True}
+
+
+@pytest.mark.parametrize("changes, route", [
+    ({}, "open loop"),
+    ({"signature": True, "predicts": None, "beats_something_else": False}, "signature"),
+    ({"signature": False}, None),  # a contradicting signature vetoes both routes
+    ({"significant": False, "signature": True, "jointly_significant": False}, None),
+    # a base that absorbs part of an effect its signature shows: the two tests together
+    ({"significant": False, "signature": True, "jointly_significant": True}, "signature"),
+    ({"significant": False, "jointly_significant": True}, None),  # no signature: open loop
+    ({"material": False}, None),
+    ({"predicts": False}, None),
+    ({"beats_something_else": False}, None),
+    ({"distinct": False}, None),
+    ({"base_plausible": False}, None),
+    ({"base_plausible": None}, "open loop"),  # the gate switched off (Criteria option)
+    ({"changes_prediction": False}, None),  # the base re-adjusts around it
+    ({"changes_prediction": False, "signature": True}, "signature"),  # its own evidence
+    ({"changes_prediction": None}, "open loop"),  # switched off
+])
+def test_a_candidates_route_follows_its_named_criteria(changes, route):
+    j = Judgement("x", 1, None, 10.0, 20.0, 1e-5, 2.0, {**ALL_PASS, **changes})
+    assert j.route == route and j.qualifies is (route is not None)
+
+
+def _test(z: float, value: float, ci: tuple[float, float]) -> EventTest:
+    from scipy.stats import norm
+
+    return EventTest("e", "P1", value, 1.0, z, float(norm.sf(z)), 5, "u", "m",
+                     parameter={"name": "k", "value": value, "ci95": list(ci)})
+
+
+@pytest.mark.parametrize("test, fitted, outcome", [
+    (None, 1.0, None),
+    (_test(4.0, 2.0, (1.0, 3.0)), 2.0, True),    # significant at 1 %
+    (_test(1.0, 0.5, (-0.5, 1.5)), 0.4, None),   # not significant, fit inside its interval
+    # not significant and the fit outside its interval widened to 99 % (2.576 / 1.96 of the
+    # 95 % half-width: 1.5 + 1.31 = 2.81): the test would have seen it
+    (_test(1.0, 0.5, (-0.5, 1.5)), 3.0, False),
+    (_test(1.0, 0.5, (-0.5, 1.5)), 1.8, None),
+])
+def test_a_signature_confirms_contradicts_or_cannot_tell(test, fitted, outcome):
+    assert signature_outcome(test, {"k": fitted}, 0.01) is outcome
+
+
+@pytest.mark.parametrize("test, outcome", [
+    (None, None),                            # no test: the open loop may judge
+    (_test(4.0, 2.0, (1.0, 3.0)), True),     # it found the effect
+    (_test(1.0, 0.5, (-0.5, 1.5)), False),   # it applies and did not find it
+])
+def test_a_signature_that_applies_must_agree(test, outcome):
+    """Criteria.signature_must_agree (the default): an applicable test that is not
+    significant vetoes the effect, whatever the fitted size."""
+    assert signature_outcome(test, {"k": 0.4}, 0.01, must_agree=True) is outcome
+
+
+@pytest.fixture(scope="module")
+def setup():
+    spec = load_spec("spl2782")
+    cycle = load_cycle("spl-16h")
+    grid = np.arange(0.0, cycle.duration_s + 1.0, 120.0)
+    return spec, inputs_from_cycle(cycle, grid)
+
+
+def _noisy(out: dict, n: int, seed: int) -> dict:
+    # white noise of a resolution-limited bench: 0.05 K, 0.1 µm
+    rng = np.random.default_rng(seed)
+    return {c: out[c] + rng.normal(0, 0.1e-6 if c == "P1" else 0.05, n) for c in CHANNELS}
+
+
+def _select(spec, inp, vals, names=None):
+    cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
+    base = cal.fit()
+    return select(cal, base, candidates(CHANNELS, names), Criteria())
+
+
+def test_selection_names_a_known_effect_and_recovers_it(setup):
+    """Grey-box data with fixture_expansion (k = 1.5 µm/K) and noise: the selection names it
+    alone among the whole library and recovers k within 0.1 µm/K (seeds 3 and 4 gave 1.449
+    +- 0.031 and 1.479 +- 0.030 with the old selection) with a 95 % interval narrower than
+    0.25 µm/K; the run is not unexplained."""
+    spec, inp = setup
+    truth = GreyBox(spec, DRIVES["spl2782"], inp, effects=("fixture_expansion",))
+    vals = _noisy(truth.simulate({"k_fix_um_K": 1.5, "f0": 0.4}), len(inp.grid_s), 3)
+    sel = _select(spec, inp, vals)
+    assert [s.label for s in sel.steps] == ["fixture_expansion"]
+    assert abs(sel.final.theta["k_fix_um_K"] - 1.5) < 0.1
+    lo, hi = sel.final.ci95["k_fix_um_K"]
+    assert hi - lo < 0.25
+    assert not sel.verdict.unexplained
+    every = {j.label for j in sel.judged if j.round == 1}
+    assert every == set(candidates(CHANNELS))  # each candidate judged, criteria recorded
+    assert all(set(j.criteria) == set(ALL_PASS) for j in sel.judged)
+
+
+def test_clean_data_name_nothing_and_are_explained(setup):
+    spec, inp = setup
+    vals = _noisy(GreyBox(spec, DRIVES["spl2782"], inp).simulate({"f0": 0.4}),
+                  len(inp.grid_s), 5)
+    sel = _select(spec, inp, vals)
+    assert sel.steps == [] and not sel.verdict.unexplained
+
+
+def test_a_heat_no_effect_makes_is_unexplained_and_located(setup):
+    """150 W into the housing from 6 h to 9 h (no library effect makes a heat that starts and
+    stops with no change of the inputs): nothing named; the competitor says unexplained, with
+    a heat into the housing whose window overlaps 6-9 h."""
+    spec, inp = setup
+    g = inp.grid_s
+    mid = 0.5 * (g[1:] + g[:-1])
+    extra = WindowHeat("housing", 6 * 3600.0, 9 * 3600.0)
+    extra.name = "test window heat"
+    lab = hypothesis(extra)
+    out = GreyBox(spec, DRIVES["spl2782"], inp, effects=(lab,)).simulate(
+        {"f0": 0.4, "q_else_W": 150.0})
+    assert np.any((mid > 6 * 3600) & (mid < 9 * 3600))
+    sel = _select(spec, inp, _noisy(out, len(g), 7))
+    assert sel.steps == []
+    v = sel.verdict
+    assert v.unexplained and v.lr > v.threshold
+    h = v.hypothesis
+    # located to the scan's 30 min blocks (Criteria.competitor_step_s): 6.0-9.0 h exactly
+    # on seeds 7 and 8; its amplitude is what the calibrated base leaves (about 40 W: the
+    # base parameters take up the rest), so it is not asserted
+    assert (h.kind, h.where, h.t0_s, h.t1_s) == ("heat", "housing", 6 * 3600.0, 9 * 3600.0), h
