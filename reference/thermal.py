@@ -454,7 +454,7 @@ class ThermalModel:
             # are read as the step's own values: at t1 from the left, at t0 from the right.
             # Read at t1 itself, a held input switching there would already act over this
             # step, a lead of one step (60 s on a bench grid: 4 K at the stator at a speed
-            # step, docs/fit.md); a continuous input is the same either way
+            # step, docs/fit-history.md); a continuous input is the same either way
             t1_in, t0_in = t1 - 1e-9 * dt, t0 + 1e-9 * dt
             F1 = op.F(case, t1_in, n1)
             if theta < 1.0:
