@@ -49,6 +49,12 @@ def implausible_z(alpha: float) -> float:
     return float(norm.isf(alpha / 2))
 
 
+def block_index(edges: np.ndarray, t_s: np.ndarray) -> np.ndarray:
+    """Index of the block [edges[i], edges[i + 1]) each time [s] lies in, the last block
+    closed at its end and times outside taken into the nearest block."""
+    return np.clip(np.searchsorted(edges, t_s, side="right") - 1, 0, len(edges) - 2)
+
+
 @dataclass
 class Measured:
     """Measured channels on the model grid (NaN where not measured), and the windows.
@@ -85,8 +91,7 @@ class Measured:
 
     def block_of(self, t_s: np.ndarray) -> np.ndarray:
         """Index of the block each time [s] lies in."""
-        return np.clip(np.searchsorted(self.block_edges(), t_s, side="right") - 1, 0,
-                       self.blocks - 1)
+        return block_index(self.block_edges(), t_s)
 
     def validation_blocks(self) -> list[int]:
         """The validating blocks: ``held_out``, or round(blocks (1 - fit_fraction)) of them

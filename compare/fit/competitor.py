@@ -9,7 +9,8 @@ with a freedom comparable to an effect's (an amplitude, a start and an end):
 - **an unexplained heat** q [W] into one part of the spindle (one of each role a motor
   spindle's heat passes through: ``Criteria.competitor_masses``, spread over the part's masses
   by their capacity) during a window [t0, t1) (:class:`WindowHeat`);
-- **an offset** d [tolerances] on one channel during a window (:class:`WindowOffset`): what a
+- **an offset** d [tolerances] on one channel during a window (a column of
+  :class:`Regressors`, the channel's indicator of the window): what a
   sensor or its electronics does.
 
 Windows lie on a grid of ``Criteria.competitor_step_s``. :func:`scan` fits every hypothesis by
@@ -23,10 +24,11 @@ Its significance counts every hypothesis the scan tried (Bonferroni).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from compare.fit.calibrate import block_index
 from compare.fit.effects import Effect, hypothesis
 from compare.fit.params import Param
 
@@ -76,29 +78,6 @@ class WindowHeat(Effect):
         return {**sources_W, NAME: theta["q_else_W"] * shape}
 
 
-class WindowOffset(Effect):
-    """An offset d [tolerances] on ``channel`` as measured during [t0, t1) [s]."""
-
-    def __init__(self, channel: str, t0_s: float, t1_s: float):
-        self.channel, self.t0_s, self.t1_s = channel, float(t0_s), float(t1_s)
-        self.channels = (channel,)
-        self.name = f"{NAME}[offset of {channel}, {t0_s / 3600:.1f}-{t1_s / 3600:.1f} h]"
-        self.explanation = (f"{channel} reads off by d from {t0_s / 3600:.1f} h to "
-                            f"{t1_s / 3600:.1f} h, as a sensor or its electronics can")
-        self.params = (Param("d_else_tol", "tolerances", 0.0, -D_MAX_TOL, D_MAX_TOL,
-                             "offset of the channel during the window", log=False),)
-
-    def as_measured(self, out, theta, inputs, channel):
-        from spindle.tolerances import channel_tolerance
-
-        g = inputs.grid_s
-        on = ((g >= self.t0_s) & (g < self.t1_s)).astype(float)
-        out = dict(out)
-        out[self.channel] = out[self.channel] + theta["d_else_tol"] * channel_tolerance(
-            self.channel) * on
-        return out
-
-
 @dataclass(frozen=True)
 class Hypothesis:
     """One hypothesis of the scan: kind ("heat" or "offset"), where (a role or a channel), the
@@ -115,11 +94,6 @@ class Hypothesis:
     gain: float
     peak: float
     tried: int
-
-    def effect(self) -> Effect:
-        if self.kind == "heat":
-            return WindowHeat(self.where, self.t0_s, self.t1_s)
-        return WindowOffset(self.where, self.t0_s, self.t1_s)
 
     def text(self) -> str:
         span = f"{self.t0_s / 3600:.1f}-{self.t1_s / 3600:.1f} h"
@@ -201,7 +175,7 @@ def regressors(cal, fit, criteria) -> Regressors:
         # the residual falls by the response: measured minus model
         heat[role] = -(resp[:, ch, pt] / tol[ch]).T
     g = cal.measured.grid_s
-    block = np.clip(np.searchsorted(edges, g[pt], side="right") - 1, 0, len(edges) - 2)
+    block = block_index(edges, g[pt])
     offset = {}
     for j, c in enumerate(channels):
         cols = np.zeros((len(pt), len(edges) - 1))
@@ -258,25 +232,16 @@ def scan(reg: Regressors, r: np.ndarray, channel: np.ndarray, rows: np.ndarray,
                                         float(reg.edges[b + 1]), float(beta[k]),
                                         float(gain[k]), peak, 0))
     found.sort(key=lambda h: -h.gain)
-    return [Hypothesis(h.kind, h.where, h.t0_s, h.t1_s, h.amplitude, h.gain, h.peak, tried)
-            for h in found[:top]], tried
+    return [replace(h, tried=tried) for h in found[:top]], tried
 
 
 #: the bounds of the competitor's amplitudes in a joint step (W of heat; tolerances of offset)
 BOUNDS = {"heat": (-Q_MAX_W, Q_MAX_W), "offset": (-D_MAX_TOL, D_MAX_TOL)}
 
 
-def joint_gain(loc, reg: Regressors, hypotheses: list[Hypothesis]
-               ) -> tuple[float, Hypothesis | None]:
-    """The best of ``hypotheses`` fitted jointly with the base parameters by one step of the
-    linearized model ``loc`` (compare.fit.linear.Local) over the fit window: (its
-    log-posterior gain, the hypothesis with its joint amplitude)."""
-    best, best_h = -math.inf, None
-    for h in hypotheses:
-        col = reg.column(h)[:, None]
-        gain, delta = loc.gain(col, [BOUNDS[h.kind]])
-        if gain > best:
-            best = gain
-            best_h = Hypothesis(h.kind, h.where, h.t0_s, h.t1_s, float(delta[-1]), gain,
-                                float(np.max(np.abs(delta[-1] * col))), h.tried)
-    return best, best_h
+def joint_gain(loc, reg: Regressors, hypotheses: list[Hypothesis]) -> float:
+    """The best log-posterior gain of ``hypotheses``, each fitted jointly with the base
+    parameters by one step of the linearized model ``loc`` (compare.fit.linear.Local) over
+    the fit window (-inf for none)."""
+    return max((loc.gain(reg.column(h)[:, None], [BOUNDS[h.kind]])[0] for h in hypotheses),
+               default=-math.inf)

@@ -60,6 +60,13 @@ def inputs_from_cycle(cycle, grid_s: np.ndarray) -> Inputs:
                   float(cycle.T_ambient_K(grid_s[0])))
 
 
+def _geometric(x: np.ndarray, floor: float, rel: float) -> np.ndarray:
+    """``x`` (at least ``floor`` taken) rounded to the nearest point of the geometric grid of
+    relative step ``rel``."""
+    step = np.log1p(rel)
+    return np.exp(np.round(np.log(np.maximum(x, floor)) / step) * step)
+
+
 @dataclass
 class GreyBox:
     """The lumped model of ``spec`` with parameters and the effects ``effects`` (labels),
@@ -104,11 +111,9 @@ class GreyBox:
         term by at most 2.5 %, a fraction of a percent of the bearing's heat)."""
         if self.speed_bin_rel <= 0:
             return q
-        step = np.log1p(self.speed_bin_rel)
         q = np.asarray(q, dtype=float)
-        safe = np.maximum(np.abs(q), 1e-9)
         return np.where(np.abs(q) > 1e-9,
-                        np.sign(q) * np.exp(np.round(np.log(safe) / step) * step), 0.0)
+                        np.sign(q) * _geometric(np.abs(q), 1e-9, self.speed_bin_rel), 0.0)
 
     def conductance_speeds(self) -> np.ndarray:
         """Per interval, the speed [rpm] the conductances are evaluated at
@@ -116,9 +121,7 @@ class GreyBox:
         n = np.asarray(self.inputs.speed_rpm, dtype=float)
         if self.speed_bin_rel <= 0:
             return n
-        step = np.log1p(self.speed_bin_rel)
-        safe = np.maximum(n, 1.0)
-        return np.where(n >= 1.0, np.exp(np.round(np.log(safe) / step) * step), n)
+        return np.where(n >= 1.0, _geometric(n, 1.0, self.speed_bin_rel), n)
 
     def _effects(self) -> list[tuple[object, str | None]]:
         return [(effect_of(lab), parse_label(lab)[1]) for lab in self.effects]

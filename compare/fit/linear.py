@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from compare.fit.calibrate import TOLERANCE, Calibrator, Fit, _bounds_z, _to_z
+from compare.fit.calibrate import TOLERANCE, Calibrator, Fit, _bounds_z, _from_z, _to_z, block_index
 from compare.fit.effects import effect_of
 
 #: the step of the finite differences on the fitted scale (as the nonlinear fit's)
@@ -104,39 +104,46 @@ class Local:
                 total += -0.5 * m.sum() * math.log(max(float(np.mean(r[m] ** 2)), 1e-300))
         return total
 
+    def gain_of(self, r1: np.ndarray, delta: np.ndarray) -> float:
+        """The log-posterior gain over the fit window of the residual ``r1`` after the step
+        ``delta`` against this model's own, counted in the fit's effective samples (the
+        likelihood of compare.fit.calibrate)."""
+        rows = self.in_fit
+        shrink = self.fit.n_eff / max(self.fit.n, 1)
+        return ((self.loglik(r1, rows) - self.loglik(self.r0, rows)) * shrink
+                - (self.penalty(delta) - self.penalty(np.zeros_like(delta))))
+
     def gain(self, extra: np.ndarray | None = None,
              extra_bounds: Sequence[tuple[float, float]] = ()) -> tuple[float, np.ndarray]:
-        """(log-posterior gain over the fit window of the step with ``extra``, counted in the
-        fit's effective samples, the likelihood of compare.fit.calibrate; the step)."""
-        rows = self.in_fit
-        delta = self.step(rows, extra, extra_bounds)
-        r1 = self.residual(delta, extra)
-        l0 = self.loglik(self.r0, rows)
-        l1 = self.loglik(r1, rows)
-        shrink = self.fit.n_eff / max(self.fit.n, 1)
-        return (l1 - l0) * shrink - (self.penalty(delta) - self.penalty(np.zeros_like(delta))
-                                     ), delta
+        """(log-posterior gain over the fit window of the step with ``extra`` (:meth:`gain_of`);
+        the step)."""
+        delta = self.step(self.in_fit, extra, extra_bounds)
+        return self.gain_of(self.residual(delta, extra), delta), delta
 
-    def held_out(self, blocks: int) -> np.ndarray:
+    def held_out(self, blocks: int, extra: np.ndarray | None = None,
+                 extra_bounds: Sequence[tuple[float, float]] = ()) -> np.ndarray:
         """Blocked cross-validation, one step per fold: each of ``blocks`` equal blocks of the
-        run held out, the step fitted on the rest (every window); the residual of every row
-        where its block was held out [tolerances]."""
+        run held out, the step (with the ``extra`` columns, as :meth:`step`) fitted on the rest
+        (every window); the residual of every row where its block was held out
+        [tolerances]."""
         meas = self.cal.measured
         edges = np.linspace(meas.grid_s[0], meas.grid_s[-1], blocks + 1)
-        block = np.clip(np.searchsorted(edges, meas.grid_s[self.point], side="right") - 1, 0,
-                        blocks - 1)
+        block = block_index(edges, meas.grid_s[self.point])
         held = np.empty_like(self.r0)
         for b in range(blocks):
             out = block == b
-            delta = self.step(~out)
-            held[out] = self.residual(delta)[out]
+            delta = self.step(~out, extra, extra_bounds)
+            held[out] = self.residual(delta, extra)[out]
         return held
+
+    def rms_by_channel(self, held: np.ndarray) -> dict[str, float]:
+        """Per channel, the RMS of a residual over every row [tolerances]."""
+        return {c: float(np.sqrt(np.mean(held[self.channel == j] ** 2)))
+                for j, c in enumerate(self.cal.channels) if (self.channel == j).any()}
 
     def cross_validate(self, blocks: int) -> dict[str, float]:
         """Per channel, the RMS of the held-out residual [tolerances] (:meth:`held_out`)."""
-        held = self.held_out(blocks)
-        return {c: float(np.sqrt(np.mean(held[self.channel == j] ** 2)))
-                for j, c in enumerate(self.cal.channels) if (self.channel == j).any()}
+        return self.rms_by_channel(self.held_out(blocks))
 
     def cross_validation_report(self, blocks: int) -> dict:
         """:meth:`held_out` pooled per channel as the report shows it: RMS, max, bias (the
@@ -188,7 +195,7 @@ def local(cal: Calibrator, fit: Fit) -> Local:
         # step inside the bounds (a parameter on its upper bound steps down)
         h = STEP if z0[i] + STEP <= hi[i] else -STEP
         th = dict(fit.theta)
-        th[k] = _from_z_safe(params[k], z0[i] + h)
+        th[k] = _from_z(params[k], z0[i] + h)
         r1 = residual_rows(cal, gb.simulate(th))[0]
         J[:, i] = (r1 - r0) / h
     prior_rows = np.zeros(len(free))
@@ -199,12 +206,6 @@ def local(cal: Calibrator, fit: Fit) -> Local:
             prior_rows[i] = cal.prior_scale / p.prior_sd
             prior_z[i] = _to_z(p, cal.prior[k])
     return Local(cal, fit, ch, pt, in_fit, r0, J, z0, lo, hi, prior_rows, prior_z)
-
-
-def _from_z_safe(p, z: float) -> float:
-    from compare.fit.calibrate import _from_z
-
-    return _from_z(p, z)
 
 
 @dataclass
@@ -232,8 +233,6 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
     few Gauss-Newton iterations within their bounds. ``start``: the effect's parameters to
     start from (default: a tenth into their range). Costs one simulation per iteration and
     parameter, and one more per iteration."""
-    from compare.fit.calibrate import _from_z
-
     cal, fit = loc.cal, loc.fit
     gb = cal.gb.variant(fit.effects + (label,))
     params = effect_of(label).params
@@ -263,13 +262,10 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
             zz[i] += h
             cols[:, i] = (at(zz) - r_z) / h
         # the base parameters' step from the current model and the effect's from z
-        shifted = Local(cal, fit, loc.channel, loc.point, loc.in_fit, r_z, loc.J, loc.z0,
-                        loc.lo, loc.hi, loc.prior_rows, loc.prior_z)
+        shifted = replace(loc, r0=r_z)
         step = shifted.step(rows, cols, list(zip(lo - z, hi - z, strict=True)))
         r1 = shifted.residual(step, cols)
-        shrink = fit.n_eff / max(fit.n, 1)
-        gain = ((loc.loglik(r1, rows) - loc.loglik(loc.r0, rows)) * shrink
-                - (loc.penalty(step[:kb]) - loc.penalty(np.zeros(kb))))
+        gain = loc.gain_of(r1, step)
         if best is None or gain > best[0]:
             best = (gain, z.copy(), step[:kb].copy(), r1, cols, r_z)
         z_new = np.clip(z + step[kb:], lo, hi)
@@ -285,20 +281,9 @@ def effect_held_out(loc: Local, ef: EffectFit, blocks: int) -> dict[str, float]:
     """Blocked cross-validation of the model with the effect fitted as ``ef``, one
     Gauss-Newton step per fold on the base parameters and the effect's (its columns at its
     estimate): per channel, the RMS of the held-out residual [tolerances]."""
-    around = Local(loc.cal, loc.fit, loc.channel, loc.point, loc.in_fit,
-                   ef.residual, loc.J, loc.z0 + ef.delta, loc.lo, loc.hi, loc.prior_rows,
-                   loc.prior_z)
-    meas = loc.cal.measured
-    edges = np.linspace(meas.grid_s[0], meas.grid_s[-1], blocks + 1)
-    block = np.clip(np.searchsorted(edges, meas.grid_s[loc.point], side="right") - 1, 0,
-                    blocks - 1)
+    around = replace(loc, r0=ef.residual, z0=loc.z0 + ef.delta)
     params = effect_of(ef.label).params
     lo = np.array([_bounds_z(p)[0] for p in params]) - ef.z
     hi = np.array([_bounds_z(p)[1] for p in params]) - ef.z
-    held = np.empty_like(ef.residual)
-    for b in range(blocks):
-        out = block == b
-        step = around.step(~out, ef.columns, list(zip(lo, hi, strict=True)))
-        held[out] = around.residual(step, ef.columns)[out]
-    return {c: float(np.sqrt(np.mean(held[loc.channel == j] ** 2)))
-            for j, c in enumerate(loc.cal.channels) if (loc.channel == j).any()}
+    held = around.held_out(blocks, ef.columns, list(zip(lo, hi, strict=True)))
+    return around.rms_by_channel(held)

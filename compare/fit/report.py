@@ -154,7 +154,8 @@ def report_dict(rep) -> dict:
                     "validation": [[a, b] for a, b, w in rep.measured.spans()
                                    if w == "validation"]},
         "cross_validation": rep.cross_validation,
-        "tolerances": {"temperature_K": TOLERANCE["T1"], "growth_um": TOLERANCE["P1"] * 1e6},
+        "tolerances": {"temperature_K": TOLERANCE["T1"],
+                       "growth_um": TOLERANCE["P1"] * edge_scale("P1")},
         "alpha": rep.criteria.alpha,
         "calibration_model": rep.calibration_model,
         "fem_calibration": rep.fem_calibration,

@@ -293,6 +293,10 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     t0 = time.perf_counter()
     criteria = (criteria or Criteria()).with_options(alpha=alpha, cv_gain=min_gain,
                                                      cv_blocks=cv_blocks)
+    unknown = [c for c in (candidates or []) if c not in LIBRARY]
+    if unknown:  # before any work
+        raise InputError("command line", "--candidates", f"unknown effect {unknown[0]}",
+                         f"use some of {', '.join(LIBRARY)}")
     say = progress or (lambda _m: None)
     prep = calibrate_base(path, spec, fit_fraction, nodes, grid_s, progress, fem_level, model,
                           base_extra, blocks, criteria)
@@ -300,10 +304,6 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     cal, base = prep.cal, prep.base
     say("reading the effects' signatures in the raw samples")
     sig = signature_tests(run, cal.gb, base.theta, channels, criteria)
-    unknown = [c for c in (candidates or []) if c not in LIBRARY]
-    if unknown:
-        raise InputError("command line", "--candidates", f"unknown effect {unknown[0]}",
-                         f"use some of {', '.join(LIBRARY)}")
     sel = select(cal, base, candidate_labels(channels, candidates), criteria, sig, say)
     final = sel.final
     for fit in (sel.base, final):  # nothing impossible is written (issue 14)

@@ -253,7 +253,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         say(f"round {rnd}: fitting something else")
         shrink = current.n_eff / max(current.n, 1)
         found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit, shrink)
-        g_gain, _g_best = joint_gain(loc, reg, found)
+        g_gain = joint_gain(loc, reg, found)
         # every candidate's gain, penalised by half ln(n_eff) per parameter (BIC)
         pen = 0.5 * math.log(max(current.n_eff, 2.0))
         penalised = {lab: f.gain - pen * len(effect_of(lab).params) for lab, f in fits.items()}
