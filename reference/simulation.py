@@ -80,16 +80,17 @@ class ReferenceModel:
         return omega2 * self.elastic.gain(reading)[1]
 
     def exact_readouts(self, case: LoadCase, dt_s: float, T0: float | None = None,
-                       method: str = "cram") -> tuple[np.ndarray, dict[str, np.ndarray],
-                                                      dict[str, np.ndarray], dict[str, float]]:
-        """(times [s], sensors [K], growth readings [m], each read-out's bound on its time
-        error [K or m]) on time_grid(case, dt_s), exact in time for inputs linear between
-        grid points (ThermalModel.exact_readouts)."""
+                       method: str = "krylov", progress: Callable[[int, int], None] | None = None
+                       ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray],
+                                  dict[str, float]]:
+        """(times [s], sensors [K], growth readings [m], each read-out's time error [K or
+        m]: the estimate for "krylov", the bound for "cram") on time_grid(case, dt_s), exact
+        in time for inputs linear between grid points (ThermalModel.exact_readouts)."""
         gains = self.growth_gains()
         if self.elastic is not None:  # the gains are kept; its LU is not needed (memory)
             self.elastic.release()
         t, names, S, F, bound = self.thermal.exact_readouts(
-            case, dt_s, T0, {k: g for k, (g, _) in gains.items()}, method)
+            case, dt_s, T0, {k: g for k, (g, _) in gains.items()}, method, progress=progress)
         growth = self._growth(gains, F, self._step_speeds(case, t))
         return (t, {n: S[:, j] for j, n in enumerate(names)}, zeroed_at_start(growth), bound)
 

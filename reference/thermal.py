@@ -36,6 +36,10 @@ TWO_PI = 2.0 * math.pi
 #: (method "modal", the check of the CRAM path: eigh of a 2500 x 2500 pencil takes about
 #: 4 s per speed; spl2782 level 0, 3200, 34 s for 5)
 EXACT_MAX_DOFS = 2500
+#: the projection error asked of the Krylov integration (ThermalModel.exact_readouts):
+#: 1e-5 K and 1e-10 m, under 1 % of the spatial uncertainty of a converged level (spl2782's
+#: worst GCI, 0.12 %, is about 0.04 K and 0.016 um: docs/verification.md)
+KRYLOV_TOL = (1e-5, 1e-10)
 
 
 def factorize(A: sp.spmatrix):
@@ -299,7 +303,9 @@ class ThermalModel:
         return SteadyResult(self, case, t, n, T, q_in, q_out, residual)
 
     def exact_readouts(self, case: LoadCase, dt_s: float, T0: float | None = None,
-                       functionals: dict[str, np.ndarray] | None = None, method: str = "cram"
+                       functionals: dict[str, np.ndarray] | None = None,
+                       method: str = "krylov", tol: tuple[float, float] = KRYLOV_TOL,
+                       progress: Callable[[int, int], None] | None = None
                        ) -> tuple[np.ndarray, list[str], np.ndarray, dict[str, np.ndarray],
                                   dict[str, float]]:
         """Sensor temperatures [K] and functionals g . T on time_grid(case, dt_s), integrated
@@ -307,15 +313,20 @@ class ThermalModel:
         its mid-step value (as solve_transient), sources, ambient and coolant linear from
         just after one grid point to just before the next, so steps land exactly.
 
-        ``method`` "cram" (any mesh): each step's exponential by CRAM-16 on sparse LUs
-        (reference.exact); "modal" (at most EXACT_MAX_DOFS unknowns, an independent check):
-        per speed, the dense generalised eigenproblem K v = lambda M v gives the modes and
-        each step is the exponential of the modal rates.
+        ``method`` "krylov" (the default, any mesh): per speed segment, the Galerkin system
+        on a rational Krylov space integrated exactly by its modes, the space grown until
+        the estimate of the projection error is below ``tol`` ([K] for the sensors, [m] for
+        the functionals; reference.krylov); "cram" (any mesh, the test oracle): each step's
+        exponential by CRAM-16 on sparse LUs (reference.exact), about 20 times slower;
+        "modal" (at most EXACT_MAX_DOFS unknowns, an independent check): per speed, the
+        dense generalised eigenproblem K v = lambda M v gives the modes and each step is
+        the exponential of the modal rates.
         Returns (times [s], sensor names, sensors [n_t, n_sensors], functional series, and
-        per read-out a bound on its approximation error: CRAM's, 0 for "modal"; rounding
-        aside)."""
-        if method not in ("cram", "modal"):
-            raise ValueError(f"method must be 'cram' or 'modal', not {method!r}")
+        per read-out its error: the projection error's estimate for "krylov", CRAM's bound
+        for "cram", 0 for "modal"; rounding aside). ``progress(k, n)`` is called after each
+        of the n speed segments ("krylov")."""
+        if method not in ("krylov", "cram", "modal"):
+            raise ValueError(f"method must be 'krylov', 'cram' or 'modal', not {method!r}")
         grid = time_grid(case, dt_s)
         names, pts = self.sensor_points()
         fnames = list(functionals or {})
@@ -324,6 +335,15 @@ class ThermalModel:
         x0 = np.full(self.op.M.shape[0], start_temperature_K(case, T0))
         if method == "modal":
             Y, bound = self._modal_readouts(case, grid, readout, x0), np.zeros(len(readout))
+        elif method == "krylov":
+            tols = np.array([tol[0]] * len(names) + [tol[1]] * len(fnames))
+            Y, bound = self._krylov_readouts(case, grid, readout, x0, tols, progress)
+            # the estimate holds for a kind of read-out as a whole, not for each one (one
+            # sensor's difference of two spaces can be smaller than its error while the
+            # largest over the sensors is not: tests/test_time_convergence.py)
+            for part in (slice(0, len(names)), slice(len(names), None)):
+                if bound[part].size:
+                    bound[part] = bound[part].max()
         else:
             Y, bound = self._cram_readouts(case, grid, readout, x0)
         n_s = len(names)
@@ -337,6 +357,34 @@ class ThermalModel:
         eps = 1e-9 * (t1 - t0)
         a = self.op.F(case, t0 + eps, n)
         return a, (self.op.F(case, t1 - eps, n) - a) / (t1 - t0)
+
+    def _krylov_readouts(self, case: LoadCase, grid: np.ndarray, readout: np.ndarray,
+                         x: np.ndarray, tol: np.ndarray,
+                         progress: Callable[[int, int], None] | None = None
+                         ) -> tuple[np.ndarray, np.ndarray]:
+        """Read-outs on ``grid`` by rational Krylov projection per speed segment
+        (reference.krylov), and each read-out's largest error estimate."""
+        from reference.krylov import segment_readouts
+
+        op = self.op
+        Y = np.empty((len(grid), readout.shape[0]))
+        Y[0] = readout @ x
+        h = np.diff(grid)
+        speeds = np.asarray(case.speed_rpm(0.5 * (grid[1:] + grid[:-1])), dtype=float)
+        starts = [*np.flatnonzero(np.r_[True, speeds[1:] != speeds[:-1]]), len(speeds)]
+        estimate = np.zeros(readout.shape[0])
+        for s0, s1 in zip(starts[:-1], starts[1:], strict=True):
+            n = float(speeds[s0])
+            loads = [self._linear_load(case, grid[k], grid[k + 1], n) for k in range(s0, s1)]
+            Ys, est, x, _ = segment_readouts(op.K(n), op.M, x, loads, h[s0:s1], readout,
+                                             factorize, tol)
+            Y[s0 + 1:s1 + 1] = Ys
+            # the segments' errors add up at worst (the heat equation forgets, never grows
+            # an error: an upper estimate)
+            estimate += est
+            if progress is not None:
+                progress(len([s for s in starts if s <= s0]), len(starts) - 1)
+        return Y, estimate
 
     def _cram_readouts(self, case: LoadCase, grid: np.ndarray, readout: np.ndarray,
                        x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -35,3 +35,23 @@ def test_snippet_runs(where, code, tmp_path, monkeypatch):
         pytest.skip("CalculiX (ccx) is not installed; apt-get install calculix-ccx")
     monkeypatch.chdir(tmp_path)  # snippets write to relative folders such as out/
     exec(compile(code, where, "exec"), {"__name__": "__snippet__"})
+
+
+def test_the_readme_quotes_the_measured_main_job():
+    """The README's time and memory of the main job are those of
+    docs/figures/main-job.json (written by benchmarks/bench_main_job.py), not a hand copy
+    that goes stale when the study changes."""
+    import json
+
+    doc = json.loads((ROOT / "docs" / "figures" / "main-job.json").read_text(encoding="utf-8"))
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert main_job_figures(doc) in readme, main_job_figures(doc)
+
+
+def main_job_figures(doc: dict) -> str:
+    """The README's sentence on the main job's cost, from the measured figures."""
+    s, c = doc["study"], doc["check"]
+    peak = f"{s['peak_MB']:,}".replace(",", " ")
+    return (f"{s['wall_s']:.0f} s wall, {s['cpu_s']:.0f} s of CPU and {peak} MB at its peak "
+            f"(the regression check: {c['wall_s']:.0f} s), measured {doc['date']} at commit "
+            f"{doc['commit']}")

@@ -1,7 +1,8 @@
-"""The transient reference exact in time (issue 15 §1): CRAM-16 steps on sparse LUs
-(reference.exact) for any mesh, checked against the dense modal integration, against
+"""The transient reference exact in time (issue 15 §1, issue 33): CRAM-16 steps on sparse
+LUs (reference.exact, the oracle) checked against the dense modal integration, against
 itself on two time grids, against the steady state and against backward Euler in the limit;
-and study verdicts that do not change with the requested time step."""
+the Krylov integration the study uses (reference.krylov) checked against CRAM-16 within its
+stated error estimate; and study verdicts that do not change with the requested time step."""
 
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ def fin():
     case = case.with_jump_ladder()
     model = ReferenceModel(spec, 0)
     T0 = float(case.T_ambient_K(0.0))
-    t, S, _, bound = model.exact_readouts(case, 60.0, T0)
+    t, S, _, bound = model.exact_readouts(case, 60.0, T0, method="cram")
     return model, case, T0, t, S, bound
 
 
@@ -52,7 +53,7 @@ def test_cram_steps_match_the_dense_modal_integration(fin, level):
     model, case, T0, t, S, bound = fin
     if level:
         model = ReferenceModel(model.spec, level)
-        t, S, _, bound = model.exact_readouts(case, 60.0, T0)
+        t, S, _, bound = model.exact_readouts(case, 60.0, T0, method="cram")
     tm, Sm, _, bm = model.exact_readouts(case, 60.0, T0, method="modal")
     assert np.array_equal(t, tm)
     assert _worst(S, Sm) < 1e-8
@@ -63,7 +64,7 @@ def test_cram_steps_do_not_depend_on_the_time_grid(fin):
     """The same instants read from the dt = 60 s and dt = 20 s grids (different step
     lengths, sub-steps and LU sets) agree to 1e-8 K (measured 7e-13 K)."""
     model, case, T0, t, S, _ = fin
-    t2, S2, _, _ = model.exact_readouts(case, 20.0, T0)
+    t2, S2, _, _ = model.exact_readouts(case, 20.0, T0, method="cram")
     idx = np.searchsorted(t2, t - 1e-6)
     assert np.allclose(t2[idx], t, rtol=0.0, atol=1e-6)
     assert _worst(S2, S, idx) < 1e-8
@@ -75,7 +76,7 @@ def test_a_long_constant_run_reaches_the_steady_state(fin):
     what remains is the particular solution K^-1 F)."""
     model = fin[0]
     case = replace(model.spec.default_load_case(), duration_s=200 * 3600.0)
-    _, S, _, _ = model.exact_readouts(case, 3600.0)
+    _, S, _, _ = model.exact_readouts(case, 3600.0, method="cram")
     steady = model.steady(case)
     assert max(abs(S[k][-1] - steady.sensors[k]) for k in S) < 1e-8
 
@@ -94,7 +95,7 @@ def test_backward_euler_converges_to_the_exact_integration_at_order_one(fin):
     the exact read-outs are the limit dt -> 0."""
     model, _, T0 = fin[:3]
     _, case = study_cases(model.spec)
-    t, S, _, _ = model.exact_readouts(case, 60.0, T0)
+    t, S, _, _ = model.exact_readouts(case, 60.0, T0, method="cram")
     errs = [_be_error(model, case, T0, t, S, dt) for dt in (60.0, 15.0, 3.75)]
     orders = np.log(np.array(errs[:-1]) / np.array(errs[1:])) / np.log(4.0)
     assert np.all((orders > 0.85) & (orders < 1.15)), (errs, orders)
@@ -111,9 +112,70 @@ def test_study_verdicts_do_not_depend_on_the_time_step():
     for dt in (60.0, 20.0):
         res = run_study(spec, levels=(0, 1, 2), nodes=(11, 41), dt_s=dt)
         ti = res.time_integration
-        assert ti["converged"] and ti["relative"] < 1e-9, ti
+        # the Krylov estimate within 1 % of the spatial GCI (the study's own limit)
+        assert ti["converged"] and ti["share"] <= 0.01, ti
         rows[dt] = {r["model"]: r for r in res.transient.summary()["models"]}
     for name, r60 in rows[60.0].items():
         r20 = rows[20.0][name]
         assert abs(r60["shaft_max_K"] - r20["shaft_max_K"]) < 0.05, (name, r60, r20)
         assert r60["meets_tolerances"] == r20["meets_tolerances"], name
+
+
+def _krylov_against_cram(name: str, level: int, dt: float = 60.0):
+    spec = load_spec(name)
+    _, case = study_cases(spec)
+    case = case.with_jump_ladder()
+    model = ReferenceModel(spec, level)
+    T0 = float(case.T_ambient_K(0.0))
+    t, S, G, est = model.exact_readouts(case, dt, T0)  # the default: Krylov
+    tc, Sc, Gc, bound = model.exact_readouts(case, dt, T0, method="cram")
+    assert np.array_equal(t, tc)
+    err_K = _worst(S, Sc)
+    est_K = max(est[k] for k in S)
+    err_m = _worst(G, Gc) if G else 0.0
+    est_m = max((est[k] for k in G), default=0.0)
+    return err_K, est_K, err_m, est_m, max(bound.values())
+
+
+@pytest.mark.parametrize("name, level", [("fin-shaft", 0), ("fin-shaft", 1), ("spl2782", 0)])
+def test_krylov_integration_is_within_its_estimate_of_cram(name, level):
+    """The Krylov read-outs against the CRAM-16 oracle (its own error below 1e-8 K, above)
+    on the study's cycle with the jump ladder: the largest difference over the sensors is
+    below the stated estimate, and so over the growth read-outs; and the estimate is
+    below 1e-4 K and 1e-4 um, about 1 % of spl2782's spatial GCI at level 2 (0.04 K, 0.016
+    um; docs/verification.md). Measured: fin-shaft 1.4e-6 and 2.3e-6 K under 9e-6 and 8e-6
+    K; spl2782 level 0 5.7e-6 K under 5.2e-5 K, P1 5.7e-13 m under 4.2e-12 m."""
+    err_K, est_K, err_m, est_m, cram = _krylov_against_cram(name, level)
+    assert cram < 1e-8
+    assert err_K <= est_K < 1e-4, (err_K, est_K)
+    assert err_m <= est_m < 1e-10 or err_m == est_m == 0.0, (err_m, est_m)
+
+
+@pytest.mark.slow
+def test_krylov_integration_of_the_study_reference_level():
+    """spl2782 level 2 (45 881 unknowns), the study's reference: as above (CRAM-16 takes
+    minutes here, hence slow; the fast test above runs the same code on level 0)."""
+    err_K, est_K, err_m, est_m, cram = _krylov_against_cram("spl2782", 2)
+    assert cram < 1e-8
+    assert err_K <= est_K < 1e-3, (err_K, est_K)
+    assert err_m <= est_m, (err_m, est_m)
+
+
+def test_krylov_read_outs_do_not_depend_on_the_time_grid(fin):
+    """The same instants on the 60 s and 20 s grids by Krylov (other segments' step counts,
+    other spaces) agree within the two estimates."""
+    model, case, T0, t, _, _ = fin
+    _, S, _, e = model.exact_readouts(case, 60.0, T0)
+    t2, S2, _, e2 = model.exact_readouts(case, 20.0, T0)
+    idx = np.searchsorted(t2, t - 1e-6)
+    assert _worst(S2, S, idx) <= max(e.values()) + max(e2.values())
+
+
+def test_krylov_reaches_the_steady_state(fin):
+    """Constant inputs for 200 h: the last Krylov read-outs are solve_steady's within the
+    estimate (the space holds K^-1 F exactly, so the particular solution is exact)."""
+    model = fin[0]
+    case = replace(model.spec.default_load_case(), duration_s=200 * 3600.0)
+    _, S, _, est = model.exact_readouts(case, 3600.0)
+    steady = model.steady(case)
+    assert max(abs(S[k][-1] - steady.sensors[k]) for k in S) <= max(max(est.values()), 1e-9)

@@ -353,7 +353,7 @@ def _end_heat(spec: Spec, power: dict[str, float]) -> tuple[float, float] | None
 
 
 def fem_entry(spec: Spec, level: int, case: LoadCase, dt_s: float | None, T0: float | None,
-              order: int = 2) -> Entry:
+              order: int = 2, progress: Callable[[int, int], None] | None = None) -> Entry:
     from reference import ReferenceModel
 
     t = time.perf_counter()
@@ -362,8 +362,8 @@ def fem_entry(spec: Spec, level: int, case: LoadCase, dt_s: float | None, T0: fl
         sensors, growth = _read_outs(model, case, dt_s, T0)
         return Entry(f"FEM level {level}", "fem", int(model.thermal.basis.N),
                      time.perf_counter() - t, sensors, growth, level=level)
-    # exact in time for inputs linear between grid points (CRAM-16 on sparse LUs)
-    _, sensors, growth, err = model.exact_readouts(case, dt_s, T0)
+    # exact in time for inputs linear between grid points (Krylov, reference.krylov)
+    _, sensors, growth, err = model.exact_readouts(case, dt_s, T0, progress=progress)
     return Entry(f"FEM level {level}", "fem", int(model.thermal.basis.N),
                  time.perf_counter() - t, sensors, growth, level=level, time_error=err)
 
