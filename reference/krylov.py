@@ -78,6 +78,17 @@ def _load_basis(loads: Sequence[tuple[np.ndarray, np.ndarray]], rel: float = 1e-
     return Q
 
 
+def modal_step(z: np.ndarray, lam: np.ndarray, dt: float, a: np.ndarray, b: np.ndarray
+               ) -> np.ndarray:
+    """Modal amplitudes after an exact step of ``dt`` [s] of z' = -lam z + a + b t (rates
+    lam [1/s], modal loads a + b t over the step); series where lam dt is small."""
+    e = np.exp(-lam * dt)
+    g1 = np.where(lam * dt > 1e-8, -np.expm1(-lam * dt) / np.maximum(lam, 1e-300), dt)
+    g2 = np.where(lam * dt > 1e-4, (dt - g1) / np.maximum(lam, 1e-300),
+                  dt * dt / 2 - lam * dt ** 3 / 6)
+    return e * z + g1 * a + g2 * b
+
+
 def _galerkin_readouts(V: np.ndarray, KV: np.ndarray, M: sp.spmatrix, x0: np.ndarray,
                        loads_r: list[tuple[np.ndarray, np.ndarray]], h: np.ndarray,
                        readout_r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -92,12 +103,7 @@ def _galerkin_readouts(V: np.ndarray, KV: np.ndarray, M: sp.spmatrix, x0: np.nda
     OW = readout_r @ W
     Y = np.empty((len(h), readout_r.shape[0]))
     for k, dt in enumerate(h):
-        a, b = W.T @ loads_r[k][0], W.T @ loads_r[k][1]
-        e = np.exp(-lam * dt)
-        g1 = np.where(lam * dt > 1e-8, -np.expm1(-lam * dt) / np.maximum(lam, 1e-300), dt)
-        g2 = np.where(lam * dt > 1e-4, (dt - g1) / np.maximum(lam, 1e-300),
-                      dt * dt / 2 - lam * dt ** 3 / 6)
-        z = e * z + g1 * a + g2 * b
+        z = modal_step(z, lam, dt, W.T @ loads_r[k][0], W.T @ loads_r[k][1])
         Y[k] = OW @ z
     return Y, V @ (W @ z)
 

@@ -417,6 +417,8 @@ class ThermalModel:
         """Read-outs on ``grid`` by dense modes (small meshes only)."""
         from scipy.linalg import eigh
 
+        from reference.krylov import modal_step
+
         op, N = self.op, self.op.M.shape[0]
         if N > EXACT_MAX_DOFS:
             raise SolverError(f"modal time integration is for meshes of at most "
@@ -438,11 +440,7 @@ class ThermalModel:
                 z = VtM @ (x if current is None else modes[current][1] @ z)
                 current = n
             a, b = (V.T @ f for f in self._linear_load(case, t0, t1, n))
-            e = np.exp(-lam * dt)
-            g1 = np.where(lam * dt > 1e-8, -np.expm1(-lam * dt) / np.maximum(lam, 1e-300), dt)
-            g2 = np.where(lam * dt > 1e-4, (dt - g1) / np.maximum(lam, 1e-300),
-                          dt * dt / 2 - lam * dt ** 3 / 6)
-            z = e * z + g1 * a + g2 * b
+            z = modal_step(z, lam, dt, a, b)
             Y[k] = OV @ z
         return Y
 
