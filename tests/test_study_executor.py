@@ -51,10 +51,13 @@ def test_serial_and_pool_give_the_same_figures():
     for k in a:
         np.testing.assert_allclose(b[k], a[k], rtol=1e-12, atol=0.0, err_msg=k)
     # progress: one line per pooled run, "[i/n] label done x s"; the reference transient
-    # runs first, on its own, and states its temporal error (issue 15 §1)
-    done = [ln for ln in lines if ln.startswith("[")]
-    assert len(done) == 6 and all(" done " in ln for ln in done)
-    assert any(ln.startswith("reference transient (exact in time)") for ln in lines)
+    # runs first, on its own, reports each speed segment "[k/n] reference transient: ..."
+    # (issue 33) and states its temporal error (issue 15 §1)
+    runs = [ln for ln in lines if ln.startswith("[") and "reference transient" not in ln]
+    assert len(runs) == 6 and all(" done " in ln for ln in runs)
+    segments = [ln for ln in lines if ln.startswith("[") and "reference transient" in ln]
+    assert segments and segments[-1].startswith(f"[{len(segments)}/{len(segments)}]")
+    assert any(ln.startswith("reference transient on level") for ln in lines)
     assert any(ln.startswith("temporal error ") for ln in lines)
 
 
