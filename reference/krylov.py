@@ -47,20 +47,21 @@ def _m_orthonormalise(W: np.ndarray, V: np.ndarray | None, M: sp.spmatrix,
                       drop: float = 1e-10) -> np.ndarray:
     """Columns of W made M-orthonormal to V and to each other (twice, classical
     Gram-Schmidt; a column that is numerically in the span already is dropped)."""
-    out = []
+    new: list[np.ndarray] = []
     for w in W.T:
         w = w.copy()
         n0 = float(np.sqrt(max(w @ (M @ w), 0.0)))
         if n0 == 0.0:
             continue
         for _ in range(2):
-            for B in ([V] if V is not None and V.shape[1] else []) + ([np.array(out).T]
-                                                                      if out else []):
-                w -= B @ (B.T @ (M @ w))
+            # against V, then the columns kept so far (not stacked onto V: V is large)
+            for B in (V, np.array(new).T if new else None):
+                if B is not None and B.shape[1]:
+                    w -= B @ (B.T @ (M @ w))
         n1 = float(np.sqrt(max(w @ (M @ w), 0.0)))
         if n1 > drop * n0:
-            out.append(w / n1)
-    return np.array(out).T if out else np.zeros((W.shape[0], 0))
+            new.append(w / n1)
+    return np.array(new).T if new else np.zeros((W.shape[0], 0))
 
 
 def _load_basis(loads: Sequence[tuple[np.ndarray, np.ndarray]], rel: float = 1e-12
@@ -128,31 +129,30 @@ def segment_readouts(K: sp.spmatrix, M: sp.spmatrix, x0: np.ndarray,
     del lu_K
     lus = [factor((M + s * K).tocsc()) for s in shifts]
     coeffs = [(Q.T @ a, Q.T @ b) for a, b in loads]
+
+    def galerkin() -> tuple[np.ndarray, np.ndarray]:
+        VQ = V.T @ Q
+        return _galerkin_readouts(V, K @ V, M, x0, [(VQ @ a, VQ @ b) for a, b in coeffs], h,
+                                  readout @ V)
+
     block = V
-    previous, est = None, np.full(readout.shape[0], np.inf)
+    previous, est, checked = None, np.full(readout.shape[0], np.inf), 0
     for j in range(MAX_BLOCKS):
-        lu = lus[j % len(lus)]
-        MB = M @ block
-        block = _m_orthonormalise(np.column_stack([lu.solve(MB[:, i])
-                                                   for i in range(MB.shape[1])]), V, M)
+        block = _m_orthonormalise(lus[j % len(lus)].solve(M @ block), V, M)
         if block.shape[1] == 0:  # the space is invariant: the projection is exact
             break
         V = np.column_stack([V, block])
         if (j + 1) % CHECK_EVERY:
             continue
-        KV = K @ V
-        VQ = V.T @ Q
-        Y, x_end = _galerkin_readouts(V, KV, M, x0, [(VQ @ a, VQ @ b) for a, b in coeffs], h,
-                                      readout @ V)
+        Y, x_end = galerkin()
+        checked = V.shape[1]
         if previous is not None:
             est = np.max(np.abs(Y - previous), axis=0)
             if np.all(est <= tol):
-                return Y, est, x_end, V.shape[1]
+                return Y, est, x_end, checked
         previous = Y
-    KV = K @ V
-    VQ = V.T @ Q
-    Y, x_end = _galerkin_readouts(V, KV, M, x0, [(VQ @ a, VQ @ b) for a, b in coeffs], h,
-                                  readout @ V)
-    if previous is not None and previous.shape == Y.shape:
-        est = np.max(np.abs(Y - previous), axis=0)
+    if checked != V.shape[1]:  # the space grew since the last check
+        Y, x_end = galerkin()
+        if previous is not None:
+            est = np.max(np.abs(Y - previous), axis=0)
     return Y, est, x_end, V.shape[1]

@@ -373,7 +373,7 @@ class ThermalModel:
         speeds = np.asarray(case.speed_rpm(0.5 * (grid[1:] + grid[:-1])), dtype=float)
         starts = [*np.flatnonzero(np.r_[True, speeds[1:] != speeds[:-1]]), len(speeds)]
         estimate = np.zeros(readout.shape[0])
-        for s0, s1 in zip(starts[:-1], starts[1:], strict=True):
+        for i, (s0, s1) in enumerate(zip(starts[:-1], starts[1:], strict=True), start=1):
             n = float(speeds[s0])
             loads = [self._linear_load(case, grid[k], grid[k + 1], n) for k in range(s0, s1)]
             Ys, est, x, _ = segment_readouts(op.K(n), op.M, x, loads, h[s0:s1], readout,
@@ -383,7 +383,7 @@ class ThermalModel:
             # an error: an upper estimate)
             estimate += est
             if progress is not None:
-                progress(len([s for s in starts if s <= s0]), len(starts) - 1)
+                progress(i, len(starts) - 1)
         return Y, estimate
 
     def _cram_readouts(self, case: LoadCase, grid: np.ndarray, readout: np.ndarray,
