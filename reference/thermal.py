@@ -19,9 +19,10 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 from scipy.spatial import cKDTree
-from skfem import Basis, ElementTriP0, ElementTriP1, ElementTriP2, FacetBasis, asm
+from skfem import Basis, ElementTriP1, ElementTriP2, FacetBasis, asm
 
 from meshes import SpindleMesh
+from reference.assembly import assemble, light_basis, return_free_memory
 from reference.forms import capacity, conduction, film, surface_flux, volume_source
 from reference.probes import probe_matrix
 from spindle.errors import SolverError
@@ -46,9 +47,13 @@ def factorize(A: sp.spmatrix):
     """Sparse LU of a symmetric positive definite matrix (conductance, or M/dt + theta K).
 
     SuperLU in symmetric mode: minimum-degree ordering on A^T + A and no pivoting (SPD
-    matrices need none), which halves the fill of the default COLAMD ordering here.
+    matrices need none), which halves the fill of the default COLAMD ordering here. A CSR
+    matrix is factorised as its transpose, the CSC matrix on the same arrays: equal to A for a
+    symmetric A, and no copy of A (95 MB for the elastic operator of spl2782 level 3) sits
+    beside the factorisation while it is made.
     """
-    return splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+    At = A.T if A.format == "csr" else A.tocsc()
+    return splu(At, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                 options={"SymmetricMode": True})
 ELEMENTS = {1: ElementTriP1, 2: ElementTriP2}
 
@@ -158,8 +163,10 @@ class ThermalModel:
             raise ValueError(f"order must be 1 or 2, not {order}")
         self.smesh, self.order, self.spec = smesh, order, smesh.spec
         mesh = smesh.mesh
-        self.basis = Basis(mesh, ELEMENTS[order](), intorder=2 * order + 1)
+        self.intorder = 2 * order + 1
+        self.basis = light_basis(mesh, ELEMENTS[order]())  # DOFs and probes (assembly.py)
         self.op = self._assemble()
+        return_free_memory()  # the assembly's temporaries
         self._lu: dict[tuple, object] = {}
 
     # ------------------------------------------------------------------ assembly
@@ -170,16 +177,24 @@ class ThermalModel:
         rhoc = np.array([r.material.rho_kg_m3 * r.material.c_J_kgK for r in regions])[er]
         return kr, kz, rhoc
 
-    def _cell(self, values: np.ndarray):
-        """A per-element constant as a field at the quadrature points."""
-        b0 = self.basis.with_element(ElementTriP0())
-        return b0.interpolate(values)
+    def quadrature_basis(self, elements: np.ndarray | None = None) -> Basis:
+        """A basis with this model's element and quadrature (order 2p + 1) on ``elements``
+        (default: all), for forms, projections and norms of your own. Built on each call and
+        not kept (``basis`` has no quadrature points: reference/assembly.py)."""
+        return Basis(self.smesh.mesh, self.basis.elem, elements=elements,
+                     intorder=self.intorder)
+
+    def assemble(self, form, cells: dict[str, np.ndarray] | None = None,
+                 elements: np.ndarray | None = None):
+        """``form`` on this model's element and quadrature (``cells``: per-element constants
+        by name), in chunks of elements (:func:`reference.assembly.assemble`)."""
+        return assemble(form, self.smesh.mesh, self.basis.elem, self.intorder, cells, elements)
 
     def _assemble(self) -> Operator:
         sm, spec, basis = self.smesh, self.spec, self.basis
         kr, kz, rhoc = self.element_fields()
-        K_solid = asm(conduction, basis, kr=self._cell(kr), kz=self._cell(kz)).tocsr()
-        M = asm(capacity, basis, rhoc=self._cell(rhoc)).tocsr()
+        K_solid = self.assemble(conduction, {"kr": kr, "kz": kz})
+        M = self.assemble(capacity, {"rhoc": rhoc})
         links = []
         for li, lk in enumerate(spec.links):
             if isinstance(lk, ContactLink):
@@ -188,17 +203,15 @@ class ThermalModel:
             for ri, reg in enumerate(sm.regions):
                 if reg.link == li:
                     factor[ri] = layer_conductivity_factor(reg.shape, reg.kind)
-            els = np.nonzero(factor[sm.element_region] > 0)[0]
-            cb = Basis(sm.mesh, basis.elem, elements=els, intorder=2 * self.order + 1)
-            g = cb.with_element(ElementTriP0()).interpolate(
-                np.zeros(sm.mesh.nelements) + factor[sm.element_region])
-            links.append((lk, asm(conduction, cb, kr=g, kz=g).tocsr()))
+            g = factor[sm.element_region]
+            els = np.nonzero(g > 0)[0]
+            links.append((lk, self.assemble(conduction, {"kr": g, "kz": g}, els)))
         films = []
         for s in spec.surfaces:
             if s.h_W_m2K is None:
                 continue
             fb = FacetBasis(sm.mesh, basis.elem, facets=sm.surfaces[s.name],
-                            intorder=2 * self.order + 1)
+                            intorder=self.intorder)
             films.append((s, asm(film, fb, h=1.0).tocsr(), asm(surface_flux, fb, qs=1.0)))
         contacts = [(spec.links[li], self._contact_matrix(fa, fb))
                     for li, fa, fb in sm.contacts if len(fa)]
@@ -206,7 +219,7 @@ class ThermalModel:
         for src in spec.heat_sources:
             if src.surface is not None:
                 fb = FacetBasis(sm.mesh, basis.elem, facets=sm.surfaces[src.surface],
-                                intorder=2 * self.order + 1)
+                                intorder=self.intorder)
                 area = TWO_PI * asm(surface_flux, fb, qs=1.0).sum()
                 sources.append((src, asm(surface_flux, fb, qs=1.0 / area)))
             else:
@@ -222,7 +235,7 @@ class ThermalModel:
         same place (the two sides' Lagrange traces coincide, so this is exact).
         """
         basis, n = self.basis, self.basis.N
-        fbasis = FacetBasis(self.smesh.mesh, basis.elem, facets=fa, intorder=2 * self.order + 1)
+        fbasis = FacetBasis(self.smesh.mesh, basis.elem, facets=fa, intorder=self.intorder)
         Ma = asm(film, fbasis, h=1.0).tocsr()
         da = np.unique(basis.get_dofs(facets=fa).flatten())
         db = np.unique(basis.get_dofs(facets=fb).flatten())
@@ -236,10 +249,8 @@ class ThermalModel:
     # ------------------------------------------------------------------ sensors
     def _volume_weights(self, part: str, section: str | None = None) -> np.ndarray:
         """int phi_i r dA over the part (or one section): sums to its volume / 2 pi [m3]."""
-        sm = self.smesh
-        cb = Basis(sm.mesh, self.basis.elem, elements=sm.elements_of(part, section),
-                   intorder=2 * self.order + 1)
-        return asm(volume_source, cb, q=1.0)
+        return self.assemble(volume_source, {"q": np.ones(self.smesh.mesh.nelements)},
+                             self.smesh.elements_of(part, section))
 
     def mean_functional(self, part: str) -> np.ndarray:
         """Vector w with w . T = volume-mean temperature of ``part`` [K]."""
@@ -273,6 +284,7 @@ class ThermalModel:
     def release(self) -> None:
         """Drop the cached factorisations (memory; they are made again when next needed)."""
         self._lu.clear()
+        return_free_memory()
 
     def set_coefficients(self, films: list | None = None, contacts: list | None = None,
                          links: list | None = None) -> None:

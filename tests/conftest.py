@@ -55,7 +55,7 @@ def _l2_sq(w):
 
 def l2_error(model, T: np.ndarray, exact) -> float:
     """sqrt(int (T_h - T)^2 r dA) with the exact solution at the quadrature points."""
-    b = model.basis
+    b = model.quadrature_basis()
     return float(np.sqrt(_l2_sq.assemble(b, uh=b.interpolate(T),
                                          exact=exact(*np.asarray(b.global_coordinates())))))
 

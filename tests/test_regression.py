@@ -81,10 +81,15 @@ def test_helper_on_the_shipped_specs(spindle_verify):
         spindle_verify.assert_within("spl2782", "lumped:11", case="nominal")
 
 
-@pytest.mark.parametrize("name", ["fin-shaft", "spl2782"])
+@pytest.mark.parametrize("name", [
+    "fin-shaft", "spl2782-steady",
+    # the full study of spl2782 (its 16 h transient on level 2, 26 s): the steady baseline
+    # covers its steady path and fin-shaft's the transient one in the default run
+    pytest.param("spl2782", marks=pytest.mark.slow)])
 def test_shipped_baselines_still_hold(name, capsys):
     """CI's regression verification: the committed figures of both shipped specs (written by
-    'spindle-verify baseline', default tolerances 0.01 K and 0.01 µm) are reproduced."""
+    'spindle-verify baseline', default tolerances 0.01 K and 0.01 µm; spl2782-steady with
+    --steady-only) are reproduced."""
     path = f"tests/baselines/{name}.json"
     status = main(["check", path, "--quiet"])
     assert status == 0, capsys.readouterr().out

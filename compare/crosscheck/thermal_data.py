@@ -61,8 +61,7 @@ def thermal_inputs(model: ReferenceModel, case: LoadCase, t: float = 0.0) -> The
                 kr[els] += k
                 kz[els] += k
     # the same matrix as the reference's K_solid + sum_l g_l(n) K_l ?
-    p0 = th.basis.with_element(ElementTriP0())
-    K_mine = asm(conduction, th.basis, kr=p0.interpolate(kr), kz=p0.interpolate(kz))
+    K_mine = th.assemble(conduction, {"kr": kr, "kz": kz})
     K_ref = th.op.K_solid.copy()
     for lk, A in th.op.links:
         K_ref = K_ref + (lk.G_W_K(n) if isinstance(lk, BearingLink) else lk.h_W_m2K(n)) * A

@@ -312,23 +312,22 @@ def convergence_study(spec: Spec, case: LoadCase | None = None, levels: Sequence
     if len(levels) < 3:
         raise ValueError("a GCI needs three or more levels")
     case = case or spec.default_load_case()
-    values: dict[str, list[float]] = {}
-    units: dict[str, str] = {}
-    elements, dofs, runtime, results = [], [], [], []
-    for lv in levels:
+    levels = sorted(levels)
+    per_level: dict[int, tuple] = {}
+    # finest first: its factorisations are the largest (0.65 GB of the 0.95 GB peak on spl2782
+    # level 3), made while no coarser level's operators are held beside them
+    for lv in reversed(levels):
         if progress:
             progress(f"FEM level {lv}")
         t = time.perf_counter()
         model = ReferenceModel(spec, lv, order)
-        res = model.steady(case)
-        runtime.append(time.perf_counter() - t)
-        elements.append(model.thermal.smesh.counts(order)["elements"])
-        dofs.append(int(model.thermal.basis.N))
+        res = model.steady(case, keep_factorisations=False)
         vals, units = quantities(spec, res, case)
-        for k, v in vals.items():
-            values.setdefault(k, []).append(v)
-        model.release()  # a finer level comes next: its factorisations need the memory
-        if keep_results:
-            results.append(res)
-    return ConvergenceResult(spec, case.name, list(levels), elements, dofs, runtime, values,
-                             units, threshold, results)
+        per_level[lv] = (time.perf_counter() - t, model.thermal.smesh.counts(order)["elements"],
+                         int(model.thermal.basis.N), vals, res if keep_results else None)
+        del model, res
+    runtime, elements, dofs, vals_per_level, results = (list(x) for x in zip(
+        *(per_level[lv] for lv in levels), strict=True))
+    values = {k: [v[k] for v in vals_per_level] for k in vals_per_level[0]}
+    return ConvergenceResult(spec, case.name, levels, elements, dofs, runtime, values, units,
+                             threshold, results if keep_results else [])
