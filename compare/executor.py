@@ -15,13 +15,20 @@ Where the cases run:
   imported only here: ``pip install "spindle-verify[dask]"``.
 
 ``progress`` (e.g. :func:`stderr_progress`) gets one line per finished case:
-``[3/12] A_M=0.02 m2 done 1.4 s`` or ``[4/12] ... FAILED: message``.
+``[3/12] A_M=0.02 m2 done 1.4 s`` or ``[4/12] ... FAILED: message``. A function that takes
+a ``progress`` keyword (``progress(k, n)``: k of its n steps done) reports from inside a
+case too, in this process or from a pool's worker (through a queue; not on Dask), as
+``[3.4/12] FEM level 1 transient: 4 of 9``: the cases done so far, counting the running
+ones' fractions, so that a long case moves the count (compare.progress reads it).
 """
 
 from __future__ import annotations
 
+import functools
+import inspect
 import os
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -67,16 +74,41 @@ def _message(exc: BaseException) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
-def _call(fn: Callable[[Any], Any], case: Any) -> tuple[Any, str | None, str | None, float]:
+def _call(fn: Callable[[Any], Any], case: Any, report: Callable[[int, int], None] | None = None
+          ) -> tuple[Any, str | None, str | None, float]:
     """Run one case, catching its error: (value, message, type name, runtime [s]).
 
     Runs in the worker, so a failing case reaches the caller as data, not as a traceback.
+    ``report``: handed to ``fn`` as its ``progress`` keyword, if given.
     """
     t0 = time.perf_counter()
     try:
-        return fn(case), None, None, time.perf_counter() - t0
+        value = fn(case) if report is None else fn(case, progress=report)
+        return value, None, None, time.perf_counter() - t0
     except Exception as exc:  # every case failure is reported, none stops the run
         return None, _message(exc), type(exc).__name__, time.perf_counter() - t0
+
+
+def _takes_progress(fn: Callable) -> bool:
+    """Does ``fn`` take a ``progress`` keyword (and has it not been bound already)?"""
+    if isinstance(fn, functools.partial) and "progress" in fn.keywords:
+        return False
+    try:
+        return "progress" in inspect.signature(fn).parameters
+    except (TypeError, ValueError):  # a builtin without a signature
+        return False
+
+
+@dataclass(frozen=True)
+class _QueueReport:
+    """A case's ``progress(k, n)`` in a pool's worker: (case, k, n) onto the parent's queue
+    (picklable, unlike a closure)."""
+
+    queue: Any
+    index: int
+
+    def __call__(self, k: int, n: int) -> None:
+        self.queue.put((self.index, k, n))
 
 
 def stderr_progress(enabled: bool = True) -> Callable[[str], None]:
@@ -106,42 +138,76 @@ def run_cases(fn: Callable[[Any], Any], cases: Iterable[Any], scheduler: str | N
     labels = [case_label(c) for c in cases]
     outcomes: list[CaseOutcome | None] = [None] * len(cases)
     done = 0
+    running: dict[int, float] = {}  # the fraction done of each running case that reports
+    lock = threading.Lock()
 
     def finish(i: int, value: Any, error: str | None, etype: str | None, dt: float) -> None:
         nonlocal done
-        done += 1
-        outcomes[i] = CaseOutcome(i, labels[i], value, error, etype, dt)
-        if progress is not None:
-            status = f"done {dt:.1f} s" if error is None else f"FAILED: {error}"
-            progress(f"[{done}/{len(cases)}] {labels[i]} {status}")
+        with lock:
+            done += 1
+            running.pop(i, None)
+            outcomes[i] = CaseOutcome(i, labels[i], value, error, etype, dt)
+            if progress is not None:
+                status = f"done {dt:.1f} s" if error is None else f"FAILED: {error}"
+                progress(f"[{done}/{len(cases)}] {labels[i]} {status}")
+
+    def step(i: int, k: int, n: int) -> None:
+        with lock:
+            if outcomes[i] is not None or progress is None:
+                return
+            running[i] = min(max(k / max(n, 1), 0.0), 1.0)
+            count = done + sum(running.values())
+            progress(f"[{count:.1f}/{len(cases)}] {labels[i]}: {k} of {n}")
 
     if not cases:
         return []
+    reports = progress is not None and _takes_progress(fn)
     if scheduler:
         _run_dask(fn, cases, scheduler, workers, finish)
     elif workers == 1:
         for i, c in enumerate(cases):
-            finish(i, *_call(fn, c))
+            finish(i, *_call(fn, c, (lambda k, n, i=i: step(i, k, n)) if reports else None))
     else:
-        _run_pool(fn, cases, workers, finish)
+        _run_pool(fn, cases, workers, finish, step if reports else None)
     return [o for o in outcomes if o is not None]
 
 
-def _run_pool(fn, cases: Sequence[Any], workers: int, finish) -> None:
-    with ProcessPoolExecutor(max_workers=min(workers, len(cases))) as pool:
-        futures = {}
-        for i, c in enumerate(cases):
-            t0 = time.perf_counter()
-            try:
-                futures[pool.submit(_call, fn, c)] = (i, t0)
-            except Exception as exc:  # e.g. the pool broke: report, go on
-                finish(i, None, _message(exc), type(exc).__name__, 0.0)
-        for fut in as_completed(futures):
-            i, t0 = futures[fut]
-            try:
-                finish(i, *fut.result())
-            except Exception as exc:  # pickling errors, a worker that died
-                finish(i, None, _message(exc), type(exc).__name__, time.perf_counter() - t0)
+def _run_pool(fn, cases: Sequence[Any], workers: int, finish, step=None) -> None:
+    manager = queue = drain = None
+    if step is not None:  # the workers' progress(k, n) comes back through a queue
+        import multiprocessing
+
+        manager = multiprocessing.Manager()
+        queue = manager.Queue()
+
+        def pump() -> None:
+            while (item := queue.get()) is not None:
+                step(*item)
+
+        drain = threading.Thread(target=pump, daemon=True)
+        drain.start()
+    try:
+        with ProcessPoolExecutor(max_workers=min(workers, len(cases))) as pool:
+            futures = {}
+            for i, c in enumerate(cases):
+                t0 = time.perf_counter()
+                report = _QueueReport(queue, i) if queue is not None else None
+                try:
+                    futures[pool.submit(_call, fn, c, report)] = (i, t0)
+                except Exception as exc:  # e.g. the pool broke: report, go on
+                    finish(i, None, _message(exc), type(exc).__name__, 0.0)
+            for fut in as_completed(futures):
+                i, t0 = futures[fut]
+                try:
+                    finish(i, *fut.result())
+                except Exception as exc:  # pickling errors, a worker that died
+                    finish(i, None, _message(exc), type(exc).__name__,
+                           time.perf_counter() - t0)
+    finally:
+        if manager is not None:
+            queue.put(None)
+            drain.join(timeout=5)
+            manager.shutdown()
 
 
 def import_dask():

@@ -17,8 +17,9 @@ Commands hand :meth:`Progress.say` to code that reports with one message per sta
 (``Callable[[str], None]``), :meth:`Progress.fraction` to code that reports a fraction
 (``Callable[[float], None]``, the transients), and wrap their output writing in
 :meth:`Progress.pictures`, which reports every PNG :func:`spindle.outputs.atomic_write` writes.
-Messages starting ``[k/n]`` (the executor's finished cases) make one stage whose fraction
-is ``k/n``: a log gets a line per 10 % of the cases, not one per case.
+Messages starting ``[k/n]`` (the executor's finished cases; k may be fractional, ``[3.4/20]``,
+counting the running cases' own progress) make one stage whose fraction is ``k/n``: a log
+gets a line per 10 % of the cases, not one per case.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ DELAY_S = 0.5
 #: how often the terminal line is redrawn (the elapsed seconds move on) [s]
 REDRAW_S = 0.2
 _BAR = 10
-_COUNT = re.compile(r"^\s*\[(\d+)/(\d+)\]")
+_COUNT = re.compile(r"^\s*\[(\d+(?:\.\d+)?)/(\d+)\]")
 
 
 class Progress:
@@ -100,7 +101,7 @@ class Progress:
         if m is None:
             self.stage(message.strip())
             return
-        done, total = int(m[1]), max(int(m[2]), 1)
+        done, total = float(m[1]), max(int(m[2]), 1)
         with self._lock:
             if self._counted == total:  # the next of the same cases: the stage goes on
                 self._continue(message.strip(), done / total)

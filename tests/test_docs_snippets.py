@@ -55,3 +55,31 @@ def main_job_figures(doc: dict) -> str:
     return (f"{s['wall_s']:.0f} s wall, {s['cpu_s']:.0f} s of CPU and {peak} MB at its peak "
             f"(the regression check: {c['wall_s']:.0f} s), measured {doc['date']} at commit "
             f"{doc['commit']}")
+
+
+def test_verification_quotes_the_measured_solvers():
+    """docs/verification.md's table of sparse solvers is docs/figures/solvers.json's (written
+    by benchmarks/bench_solvers.py), so it cannot go stale."""
+    import json
+
+    doc = json.loads((ROOT / "docs" / "figures" / "solvers.json").read_text(encoding="utf-8"))
+    text = (ROOT / "docs" / "verification.md").read_text(encoding="utf-8")
+    assert solver_table(doc) in text, solver_table(doc)
+
+
+def solver_table(doc: dict) -> str:
+    """The table of docs/verification.md from the benchmark's rows: one row per matrix, a
+    column per solver with its factorisation time [s] and peak memory [MB]."""
+    solvers = list(dict.fromkeys(r["solver"] for r in doc["rows"]))
+    matrices = list(dict.fromkeys(r["matrix"] for r in doc["rows"]))
+    cell = {(r["matrix"], r["solver"]): r for r in doc["rows"]}
+    lines = ["| matrix | unknowns | " + " | ".join(solvers) + " |",
+             "|---|---:|" + "---:|" * len(solvers)]
+    for m in matrices:
+        row = [m, f"{next(r['n'] for r in doc['rows'] if r['matrix'] == m):,}".replace(",", " ")]
+        for s in solvers:
+            r = cell[(m, s)]
+            row.append(f"{r['factor_s']:.2f} s, {r['peak_MB']} MB" if r["installed"]
+                       else "not installed")
+        lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)

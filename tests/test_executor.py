@@ -135,3 +135,43 @@ def test_real_local_dask_cluster():
     out = run_cases(square_or_fail, [1, 2, 3], scheduler="local", workers=2)
     assert [o.value for o in out] == [1, 4, None]
     assert out[2].error == "three is not allowed"
+
+
+def square_in_steps(x: int, progress=None) -> int:
+    """A case that reports its own progress (k of 4 steps), as run_study_case does; module
+    level so the pool can pickle it."""
+    import time
+
+    for k in range(1, 5):
+        if progress is not None:
+            progress(k, 4)
+            time.sleep(0.05)  # a step takes time, so a worker's report is read before the end
+    return x * x
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_case_reports_its_own_steps_in_the_process_and_from_a_worker(workers):
+    """A long case moves the count while it runs: [done + its fraction / n], also from a
+    pool's worker (through the queue), and the finished lines are as before."""
+    lines: list[str] = []
+    out = run_cases(square_in_steps, [1, 2, 3], workers=workers, progress=lines.append)
+    assert [o.value for o in out] == [1, 4, 9]
+    steps = [ln for ln in lines if " of 4" in ln]
+    if workers == 1:  # every step, in order: the first case's second is half a case of three
+        assert len(steps) == 12 and steps[1] == "[0.5/3] 1: 2 of 4"
+    else:  # a worker's step read after its case finished is not shown (the case is done)
+        for x in (1, 2, 3):
+            assert any(f"] {x}: 1 of 4" in ln for ln in steps), steps
+    assert sum(1 for ln in lines if " done " in ln) == 3
+
+
+def test_a_bound_progress_is_not_replaced():
+    """A function whose progress is already bound (functools.partial) keeps its own."""
+    from functools import partial
+
+    mine: list[tuple[int, int]] = []
+    lines: list[str] = []
+    run_cases(partial(square_in_steps, progress=lambda k, n: mine.append((k, n))), [5],
+              workers=1, progress=lines.append)
+    assert mine == [(1, 4), (2, 4), (3, 4), (4, 4)]
+    assert not any(" of 4" in ln for ln in lines)

@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from compare.progress import DELAY_S, Progress
 from spindle.outputs import atomic_write, expect_pictures
 
@@ -207,3 +209,15 @@ def test_counted_cases_are_one_stage_with_a_line_per_10_percent_at_most_every_de
     # the lines come at least DELAY_S apart (0.05 s: the printed seconds' rounding)
     assert all(b - a >= DELAY_S - 0.05 for a, b in zip(seconds, seconds[1:], strict=False))
     assert len(lines) == 9
+
+
+def test_a_fractional_count_sets_the_fraction_of_the_cases_stage():
+    """The executor's [3.4/20] (cases done, the running ones' fractions counted) is read as
+    a fraction of one counted stage, 17 %, as [3/20] is 15 %."""
+    out = io.StringIO()
+    p = Progress("study", stream=out, tty=False, delay_s=0.0, ticker=False)
+    p.say("[3/20] FEM level 0 transient done 1.0 s")
+    assert p.stage_fraction == pytest.approx(0.15)
+    p.say("[3.4/20] FEM level 1 transient: 4 of 9")
+    assert p.stage_fraction == pytest.approx(0.17)
+    assert p._counted == 20  # the same stage, not a new one per message

@@ -4,6 +4,7 @@ the same figures serially and in a process pool, and a failed run is reported, n
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -50,11 +51,15 @@ def test_serial_and_pool_give_the_same_figures():
     # (a few thousand ulp), far below any figure the study reports (3 significant digits).
     for k in a:
         np.testing.assert_allclose(b[k], a[k], rtol=1e-12, atol=0.0, err_msg=k)
-    # progress: one line per pooled run, "[i/n] label done x s"; the reference transient
-    # runs first, on its own, reports each speed segment "[k/n] reference transient: ..."
-    # (issue 33) and states its temporal error (issue 15 §1)
+    # progress: one line per pooled run, "[i/n] label done x s", and a FEM transient's speed
+    # segments from inside its worker, "[x.y/n] label: k of m" (issue 33); the reference
+    # transient runs first, on its own, reports each speed segment "[k/n] reference
+    # transient: ..." and states its temporal error (issue 15 §1)
     runs = [ln for ln in lines if ln.startswith("[") and "reference transient" not in ln]
-    assert len(runs) == 6 and all(" done " in ln for ln in runs)
+    finished = [ln for ln in runs if " done " in ln]
+    assert len(finished) == 6
+    assert all(re.match(r"\[\d+\.\d/6\] FEM level \d transient .*: \d+ of \d+$", ln)
+               for ln in runs if ln not in finished)
     segments = [ln for ln in lines if ln.startswith("[") and "reference transient" in ln]
     assert segments and segments[-1].startswith(f"[{len(segments)}/{len(segments)}]")
     assert any(ln.startswith("reference transient on level") for ln in lines)
