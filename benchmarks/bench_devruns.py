@@ -1,5 +1,5 @@
 """Bench-data loop on runs we did not make: ``fit`` on every run of a folder with a truth.json
-(default ../shared/bench-runs/, a peer's simulator of an SPL2782-family spindle that is not
+(default tests/data/peer-runs/bench-runs/, a peer's simulator of an SPL2782-family spindle that is not
 the shipped spec), against the truth.
 
     python benchmarks/bench_devruns.py [--runs DIR] [--spec spl2782] [--only dev-01 dev-06]
@@ -33,7 +33,7 @@ from verdicts import (
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
 ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_RUNS = ROOT.parent / "shared" / "bench-runs"
+DEFAULT_RUNS = ROOT / "tests" / "data" / "peer-runs" / "bench-runs"
 
 
 @dataclass(frozen=True)

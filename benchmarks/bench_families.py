@@ -3,7 +3,7 @@ not verdicts on named runs (issue 32 §7).
 
     python benchmarks/bench_families.py [--runs-per-family 50] [--families effect clean ...]
                                         [--workers 2] [--cache DIR] [--json OUT.json]
-                                        [--peers ../shared/bench-runs ../shared/bench-runs-2]
+                                        [--peers tests/data/peer-runs/bench-runs ...]
                                         [--reports DIR] [--summary FILE] [--synth-only]
 
 Families (each run drawn from its seed: the spindle's mismatch to the spec, the cycle, the
@@ -40,6 +40,8 @@ from verdicts import fit_outcome, judge_verdict, named_text, run_verdicts
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
 ROOT = Path(__file__).resolve().parents[1]
+#: the peer's runs, kept in the repository (tests/data/peer-runs/README.md)
+PEER_RUNS = ROOT / "tests" / "data" / "peer-runs"
 CYCLES = ("random", "random-loaded", "random-ramped-load")
 FAMILIES = ("effect", "clean", "outside", "two")
 
@@ -208,8 +210,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--families", nargs="+", default=[*FAMILIES, "peers"],
                     choices=[*FAMILIES, "peers"])
     ap.add_argument("--peers", nargs="*", type=Path,
-                    default=[ROOT.parent / "shared" / "bench-runs",
-                             ROOT.parent / "shared" / "bench-runs-2"])
+                    default=[PEER_RUNS / "bench-runs",
+                             PEER_RUNS / "bench-runs-2"])
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".families-cache")
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")

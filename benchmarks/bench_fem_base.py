@@ -35,7 +35,7 @@ import numpy as np
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
 ROOT = Path(__file__).resolve().parents[1]
-SHARED = ROOT.parent / "shared"
+SHARED = ROOT / "tests" / "data" / "peer-runs"
 PEER_CONTROLS = (SHARED / "bench-runs" / "dev-06.csv", SHARED / "bench-runs" / "dev-09.csv",
                  SHARED / "bench-runs-2" / "dev2-02.csv", SHARED / "bench-runs-2" / "dev2-07.csv")
 CACHE = ROOT / "benchmarks" / ".families-cache"

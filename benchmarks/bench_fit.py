@@ -1,7 +1,7 @@
 """Fit benchmark: a 16 h bench run at about 1 Hz from ingest to report.
 
     python benchmarks/bench_fit.py [--effect fixture_expansion] [--seed 1] [--keep DIR]
-    python benchmarks/bench_fit.py --run ../shared/bench-runs/dev-06.csv
+    python benchmarks/bench_fit.py --run tests/data/peer-runs/bench-runs/dev-06.csv
 
 Makes a synthetic run with ``spindle-verify synth`` (FEM level 1, not timed), or takes
 ``--run``, a bench export such as a peer's development run; then times reading it, one

@@ -12,15 +12,16 @@ Run it on an otherwise idle machine: the figures are the wall time a user waits.
 from __future__ import annotations
 
 import argparse
-import datetime
-import json
 import re
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
+from figures import write_figures
+
 ROOT = Path(__file__).resolve().parents[1]
+
 COMMANDS = {
     "study": ["spindle-verify", "study", "spl2782", "--out", "{tmp}/study"],
     "check": ["spindle-verify", "check", "tests/baselines/spl2782.json", "--quiet"],
@@ -56,15 +57,7 @@ def main(argv: list[str] | None = None) -> None:
             r = rows[name]
             print(f"{name:>6}: {r['wall_s']:.0f} s wall, {r['cpu_s']:.0f} s CPU, "
                   f"{r['peak_MB']} MB peak   ({r['command']})", flush=True)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
-                            capture_output=True, text=True).stdout.strip()
-    doc = {"date": datetime.date.today().isoformat(), "commit": commit,
-           "made_by": "python benchmarks/bench_main_job.py", **rows}
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp_out = args.out.with_suffix(".tmp")
-    tmp_out.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
-    tmp_out.replace(args.out)
-
+    write_figures(args.out, "python benchmarks/bench_main_job.py", rows)
 
 if __name__ == "__main__":
     main()

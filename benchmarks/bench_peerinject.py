@@ -25,7 +25,7 @@ from verdicts import RMS_HEADER, fit_outcome, named_text, read_truth, rms_cells,
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
 ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_RUNS = ROOT.parent / "shared" / "bench-runs"
+DEFAULT_RUNS = ROOT / "tests" / "data" / "peer-runs" / "bench-runs"
 
 #: (effect, parameters, lag channel): magnitudes around and away from the peer's own effect
 #: runs (dev-01 c 0.055 um/krpm^2, dev-04 k -0.72 um/K, dev-03 lag on T1, 400 s fitted)

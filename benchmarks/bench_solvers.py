@@ -17,7 +17,6 @@ as such, not skipped silently. Run it on an idle machine.
 from __future__ import annotations
 
 import argparse
-import datetime
 import json
 import os
 import subprocess
@@ -26,7 +25,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from figures import write_figures
+
 ROOT = Path(__file__).resolve().parents[1]
+
 SOLVERS = ("superlu", "superlu-colamd", "cholmod", "umfpack", "pardiso")
 #: where each optional solver comes from (pip names)
 SOURCES = {"cholmod": "scikit-sparse", "umfpack": "scikit-umfpack", "pardiso": "pypardiso"}
@@ -174,17 +176,10 @@ def main(argv: list[str] | None = None) -> None:
                 else:
                     print(f"{r['matrix']:>17}: {solver:>14}  not installed "
                           f"(pip install {SOURCES[solver]})", flush=True)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
-                            capture_output=True, text=True).stdout.strip()
-    doc = {"date": datetime.date.today().isoformat(), "commit": commit,
-           "made_by": "python benchmarks/bench_solvers.py", "versions": _versions(),
-           "threads": f"{os.cpu_count()} cores; PARDISO (MKL) uses them all, the others one",
-           "rows": rows}
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp_out = args.out.with_suffix(".tmp")
-    tmp_out.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
-    tmp_out.replace(args.out)
-
+    write_figures(args.out, "python benchmarks/bench_solvers.py", {
+        "versions": _versions(),
+        "threads": f"{os.cpu_count()} cores; PARDISO (MKL) uses them all, the others one",
+        "rows": rows})
 
 if __name__ == "__main__":
     main()

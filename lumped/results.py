@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from spindle import plots
-from spindle.outputs import expect_pictures, write_csv, write_json
+from spindle.outputs import expect_pictures, jsonable, write_csv, write_json
 from spindle.results import SteadyTable, TransientTable
 from spindle.units import ZERO_C_K
 
@@ -20,7 +20,7 @@ def _model_info(model) -> dict:
     return {"kind": "lumped", "nodes": model.nodes, "masses": model.n_states}
 
 
-@dataclass
+@dataclass(repr=False)
 class LumpedSteadyResult(SteadyTable):
     """Steady mass temperatures with virtual sensors, growth and energy balance."""
 
@@ -91,7 +91,7 @@ class LumpedSteadyResult(SteadyTable):
         return [out / f for f in files]
 
 
-@dataclass
+@dataclass(repr=False)
 class LumpedTransientResult(TransientTable):
     """Sensor and mass histories of a zero-order-hold run, growth, energy balance."""
 
@@ -108,10 +108,11 @@ class LumpedTransientResult(TransientTable):
     growth_m: dict[str, np.ndarray] = field(default_factory=dict)
 
     def summary(self) -> dict:
-        return {"spec": self.model.spec.name, "kind": "transient", "case": self.case.name,
-                "model": _model_info(self.model), "duration_s": float(self.times_s[-1]),
-                "steps": len(self.times_s) - 1, "energy": self.energy,
-                **self.peaks()}
+        """The run's figures as plain numbers (the JSON summary)."""
+        return jsonable({"spec": self.model.spec.name, "kind": "transient",
+                         "case": self.case.name, "model": _model_info(self.model),
+                         "duration_s": float(self.times_s[-1]),
+                         "steps": len(self.times_s) - 1, "energy": self.energy, **self.peaks()})
 
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         """Summary JSON, sensor time series CSV, PNGs (sensors; T1 and P1 with the band)."""

@@ -15,6 +15,7 @@ import numpy as np
 from lumped.build import LumpedNetwork, build_network
 from lumped.elastic import GrowthChain, KelvinVoigt
 from lumped.results import LumpedSteadyResult, LumpedTransientResult
+from spindle.drive import as_load_case
 from spindle.errors import SolverError
 from spindle.geometry import TOL_M
 from spindle.loads import LoadCase, start_temperature_K, time_grid
@@ -104,9 +105,10 @@ class LumpedModel:
         return np.stack(cols, axis=-1) if cols else np.zeros((*np.shape(t), 0))
 
     # ------------------------------------------------------------------ solves
-    def steady(self, case: LoadCase | None = None, t: float = 0.0) -> LumpedSteadyResult:
-        """Steady state for the inputs of ``case`` at time ``t`` [s]."""
-        case = case or self.spec.default_load_case()
+    def steady(self, case: LoadCase | str | None = None, t: float = 0.0) -> LumpedSteadyResult:
+        """Steady state for the inputs of ``case`` (a LoadCase, a cycle's name or file, or
+        None for the spec's own) at time ``t`` [s]."""
+        case = as_load_case(self.spec, case)
         sys = self.system
         u = self.inputs(case, t)
         n = float(case.speed_rpm(t))
@@ -123,13 +125,15 @@ class LumpedModel:
         return LumpedSteadyResult(self, case, t, n, x, sys.heat_in(T_all, q),
                                   sys.heat_to_fixed(T_all, n), residual, self.chain.growth(x))
 
-    def transient(self, case: LoadCase, dt_s: float, T0: np.ndarray | float | None = None,
+    def transient(self, case: LoadCase | str, dt_s: float, T0: np.ndarray | float | None = None,
                   progress: Callable[[float], None] | None = None) -> LumpedTransientResult:
         """Exact zero-order-hold integration over ``case.duration_s`` on the reference's time
-        grid (every dt_s and every input sample); inputs held at their mid-step values. ``T0``
+        grid (every dt_s [s] and every input sample); inputs held at their mid-step values.
+        ``case``: a LoadCase or a cycle's name or file (``"spl-16h"``). ``T0``
         [K]: the mass temperatures at the start, a uniform one, or None for the case's
         ambient at t = 0; the growth readings are zeroed at the start, as a bench zeroes
         P1."""
+        case = as_load_case(self.spec, case)
         if dt_s <= 0 or case.duration_s <= 0:
             raise SolverError("a transient run needs dt_s > 0 and a duration > 0")
         sys = self.system

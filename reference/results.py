@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from spindle import plots as shared_plots
-from spindle.outputs import atomic_write, expect_pictures
+from spindle.outputs import atomic_write, expect_pictures, jsonable
 from spindle.outputs import write_csv as _write_csv
 from spindle.outputs import write_json as _write_json
 from spindle.results import SteadyTable, TransientTable
@@ -24,7 +24,7 @@ def _mesh_info(model) -> dict:
             "dofs": int(model.basis.N), "h_max_m": model.smesh.h_max_m}
 
 
-@dataclass
+@dataclass(repr=False)
 class SteadyResult(SteadyTable):
     """A steady FEM temperature field with its sensors and energy balance."""
 
@@ -47,8 +47,9 @@ class SteadyResult(SteadyTable):
         return dict(zip(names, (self.model.probe_matrix(pts) @ self.T).tolist(), strict=True))
 
     def summary(self) -> dict:
-        return {**self.steady_summary({"mesh": _mesh_info(self.model)}),
-                "inputs_used": self.model.op.inputs_used(self.case, self.time_s, self.speed_rpm)}
+        return jsonable({**self.steady_summary({"mesh": _mesh_info(self.model)}),
+                         "inputs_used": self.model.op.inputs_used(self.case, self.time_s,
+                                                                  self.speed_rpm)})
 
     def plot(self, ax=None):
         from reference.plots import plot_section
@@ -88,7 +89,7 @@ class SteadyResult(SteadyTable):
         return [out / f for f in files]
 
 
-@dataclass
+@dataclass(repr=False)
 class TransientResult(TransientTable):
     """Sensor histories and saved fields of a theta-method run, with its energy balance."""
 
@@ -111,11 +112,12 @@ class TransientResult(TransientTable):
     elastic: object = None
 
     def summary(self) -> dict:
-        return {"spec": self.model.spec.name, "kind": "transient", "case": self.case.name,
-                "mesh": _mesh_info(self.model), "theta": self.theta,
-                "duration_s": float(self.times_s[-1]), "steps": len(self.times_s) - 1,
-                "energy": self.energy,
-                **self.peaks(), "inputs_used_by_speed": self.inputs_by_speed()}
+        """The run's figures as plain numbers (the JSON summary)."""
+        return jsonable({"spec": self.model.spec.name, "kind": "transient",
+                         "case": self.case.name, "mesh": _mesh_info(self.model),
+                         "theta": self.theta, "duration_s": float(self.times_s[-1]),
+                         "steps": len(self.times_s) - 1, "energy": self.energy,
+                         **self.peaks(), "inputs_used_by_speed": self.inputs_by_speed()})
 
     def inputs_by_speed(self) -> dict[str, dict]:
         """ThermalModel.op.inputs_used at the first output time of each speed the run held

@@ -15,6 +15,7 @@ from meshes import build_mesh
 from reference.elastic import ThermoelasticModel
 from reference.results import SteadyResult, TransientResult
 from reference.thermal import ThermalModel
+from spindle.drive import as_load_case
 from spindle.loads import LoadCase
 from spindle.spec import Spec
 from spindle.spec_reader import as_spec
@@ -56,14 +57,15 @@ class ReferenceModel:
         if self.elastic is not None:
             self.elastic.release()
 
-    def steady(self, case: LoadCase | None = None, t: float = 0.0,
+    def steady(self, case: LoadCase | str | None = None, t: float = 0.0,
                keep_factorisations: bool = True) -> SteadyResult:
-        """The steady state of ``case`` at time ``t`` [s], with the displacement field and the
+        """The steady state of ``case`` (a LoadCase, a cycle's name or file, or None for the
+        spec's own) at time ``t`` [s], with the displacement field and the
         growth readings [m]. ``keep_factorisations=False`` drops the thermal factorisation
         and the elastic load operator before the elastic factorisation is made, and that one
         after (a single solve's peak memory: on spl2782 level 3 they take 0.15, 0.05 and
         0.6 GB); the next solve makes them again."""
-        res = self.thermal.solve_steady(case, t)
+        res = self.thermal.solve_steady(as_load_case(self.spec, case), t)
         if not keep_factorisations:
             self.thermal.release()
         if self.elastic is not None:
@@ -92,13 +94,14 @@ class ReferenceModel:
         omega2 = (self._step_speeds(case, times_s) * RPM_TO_RAD_S) ** 2
         return omega2 * self.elastic.gain(reading)[1]
 
-    def exact_readouts(self, case: LoadCase, dt_s: float, T0: float | None = None,
+    def exact_readouts(self, case: LoadCase | str, dt_s: float, T0: float | None = None,
                        method: str = "krylov", progress: Callable[[int, int], None] | None = None
                        ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray],
                                   dict[str, float]]:
         """(times [s], sensors [K], growth readings [m], each read-out's time error [K or
         m]: the estimate for "krylov", the bound for "cram") on time_grid(case, dt_s), exact
         in time for inputs linear between grid points (ThermalModel.exact_readouts)."""
+        case = as_load_case(self.spec, case)
         gains = self.growth_gains()
         if self.elastic is not None:  # the gains are kept; its LU is not needed (memory)
             self.elastic.release()
@@ -120,12 +123,14 @@ class ReferenceModel:
         return {k: functionals[k] - T_ref * g.sum() + (omega2 * c if self.centrifugal else 0.0)
                 for k, (g, c) in gains.items()}
 
-    def transient(self, case: LoadCase, dt_s: float, theta: float = 1.0,
+    def transient(self, case: LoadCase | str, dt_s: float, theta: float = 1.0,
                   T0: np.ndarray | float | None = None, save_every: int = 0,
                   progress: Callable[[float], None] | None = None) -> TransientResult:
         """The thermal transient (:meth:`ThermalModel.solve_transient`; T0 [K], default the
         case's ambient at t = 0) and its growth readings [m], zeroed at the start
-        (:func:`zeroed_at_start`) as are the displacement fields."""
+        (:func:`zeroed_at_start`) as are the displacement fields. ``case``: a LoadCase or a
+        cycle's name or file (``"spl-16h"``)."""
+        case = as_load_case(self.spec, case)
         gains = self.growth_gains()
         res = self.thermal.solve_transient(case, dt_s, theta, T0, save_every, progress,
                                            functionals={k: g for k, (g, _) in gains.items()})

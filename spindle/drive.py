@@ -66,6 +66,17 @@ def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None) -> Loa
     return cycle.to_load_case(spec, sources, others="zero")
 
 
+def as_load_case(spec: Spec, case: LoadCase | str | Path | None) -> LoadCase:
+    """``case`` as the LoadCase a solver takes: a LoadCase as it is, None as the spec's own
+    case, a cycle's name or file as :func:`load_case` reads it (so that
+    ``model.transient("spl-16h", dt_s=60)`` works as the CLI's ``--cycle spl-16h`` does)."""
+    if case is None:
+        return spec.default_load_case()
+    if isinstance(case, str | Path):
+        return load_case(spec, case)
+    return case
+
+
 def load_case(spec: Spec, name_or_path: str | Path, base: LoadCase | None = None) -> LoadCase:
     """The LoadCase of any cycle a user can name: a shipped cycle name, a cycle TOML, a
     step-table CSV (``speed_rpm, duration_s, ...``: heat from the power balance) or a

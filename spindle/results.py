@@ -32,9 +32,21 @@ def check_plausible(T_K: np.ndarray, relative_imbalance: float, file: str) -> No
                           "apart (docs/spec.md lists plausible ranges)")
 
 
+def _growth_text(growth_um: dict[str, float]) -> str:
+    return "".join(f", {k} {v:.2f} µm" for k, v in growth_um.items())
+
+
 class SteadyTable:
     """Needs ``model.spec``, ``case``, ``time_s``, ``speed_rpm``, ``T``, ``sensors``,
-    ``heat_in_W``, ``heat_out_W``, ``residual`` and ``growth_m``."""
+    ``heat_in_W``, ``heat_out_W``, ``residual`` and ``growth_m``. The result classes are
+    dataclasses made with ``repr=False``, so that this short ``repr`` stands."""
+
+    def __repr__(self) -> str:
+        hot = max(self.sensors.items(), key=lambda kv: kv[1]) if self.sensors else None
+        where = f", hottest sensor {hot[0]} {hot[1] - ZERO_C_K:.1f} °C" if hot else ""
+        return (f"<{type(self).__name__} {self.model.spec.name}, {self.case.name}: "
+                f"{self.speed_rpm:g} rpm, {self.heat_in_W:.0f} W in{where}"
+                f"{_growth_text({k: v * 1e6 for k, v in self.growth_m.items()})}>")
 
     @property
     def energy(self) -> dict[str, float]:
@@ -61,14 +73,16 @@ class SteadyTable:
     def steady_summary(self, about: dict) -> dict:
         """The JSON summary; ``about`` describes the model (mesh, or lumped nodes)."""
         table = self.sensor_table()
-        return {"spec": self.model.spec.name, "kind": "steady", **about,
-                "speed_rpm": self.speed_rpm,
-                "T_ambient_C": float(self.case.T_ambient_K(self.time_s)) - ZERO_C_K,
-                "T_coolant_C": float(self.case.T_coolant_K(self.time_s)) - ZERO_C_K,
-                "relative_residual": self.residual, "energy": self.energy,
-                "T_max_C": float(self.T.max() - ZERO_C_K),
-                "sensors_C": dict(zip(table["sensor"], table["T_C"], strict=True)),
-                "growth_um": {k: v * 1e6 for k, v in self.growth_m.items()}}
+        from spindle.outputs import jsonable  # plain numbers: no np.float64 in a summary
+
+        return jsonable({"spec": self.model.spec.name, "kind": "steady", **about,
+                         "speed_rpm": self.speed_rpm,
+                         "T_ambient_C": float(self.case.T_ambient_K(self.time_s)) - ZERO_C_K,
+                         "T_coolant_C": float(self.case.T_coolant_K(self.time_s)) - ZERO_C_K,
+                         "relative_residual": self.residual, "energy": self.energy,
+                         "T_max_C": float(self.T.max() - ZERO_C_K),
+                         "sensors_C": dict(zip(table["sensor"], table["T_C"], strict=True)),
+                         "growth_um": {k: v * 1e6 for k, v in self.growth_m.items()}})
 
     def to_pandas(self):
         """The sensor table as a DataFrame (needs pandas: pip install 'spindle-verify[data]')."""
@@ -78,7 +92,16 @@ class SteadyTable:
 
 
 class TransientTable:
-    """Needs ``times_s``, ``names``, ``sensor_K``, ``growth_m`` and the energy totals."""
+    """Needs ``model.spec``, ``case``, ``times_s``, ``names``, ``sensor_K``, ``growth_m`` and
+    the energy totals (dataclasses with ``repr=False``, as :class:`SteadyTable`)."""
+
+    def __repr__(self) -> str:
+        peaks = self.peaks()
+        hot = max(peaks["peak_C"].items(), key=lambda kv: kv[1]) if peaks["peak_C"] else None
+        where = f", hottest sensor {hot[0]} peaks at {hot[1]:.1f} °C" if hot else ""
+        return (f"<{type(self).__name__} {self.model.spec.name}, {self.case.name}: "
+                f"{self.times_s[-1] / 3600:.3g} h in {len(self.times_s) - 1} steps{where}"
+                f"{_growth_text(peaks['peak_growth_um']).replace(' µm', ' µm peak')}>")
 
     @property
     def energy(self) -> dict[str, float]:
@@ -126,13 +149,36 @@ class TransientTable:
         return header, rows
 
     def plot(self, ax=None):
+        """The sensors' temperatures over the run, titled, with a legend; without ``ax``, a
+        figure that also shows P1 against the paper's ±1.5 µm band (where the run has P1).
+        Returns the temperatures' axes."""
         from spindle.plots import pyplot
+        from spindle.tolerances import GROWTH_TOLERANCE_M
 
         plt = pyplot()
+        h = self.times_s / 3600
+        growth = ax is None and "P1" in self.growth_m
         if ax is None:
-            _, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
+            fig, axes = plt.subplots(2 if growth else 1, 1, figsize=(10, 7 if growth else 4.5),
+                                     sharex=True, layout="constrained", squeeze=False)
+            ax = axes[0, 0]
         for j, n in enumerate(self.names):
-            ax.plot(self.times_s / 3600, self.sensor_K[:, j] - ZERO_C_K, label=n)
-        ax.set_xlabel("time [h]")
+            ax.plot(h, self.sensor_K[:, j] - ZERO_C_K, label=n, lw=1)
         ax.set_ylabel("temperature [°C]")
+        ax.set_title(f"{self.model.spec.name}: {self.case.name}, {len(self.names)} sensors")
+        ax.legend(fontsize=7, ncols=2 if len(self.names) > 12 else 1, loc="upper left",
+                  bbox_to_anchor=(1.01, 1.0), title="sensor", title_fontsize=8)
+        ax.grid(alpha=0.3)
+        if growth:
+            a2, band = axes[1, 0], GROWTH_TOLERANCE_M * 1e6
+            p1 = self.growth_m["P1"] * 1e6
+            a2.fill_between(h, p1 - band, p1 + band, color="tab:blue", alpha=0.2,
+                            label=f"±{band:g} µm tolerance")
+            a2.plot(h, p1, color="tab:blue", label="P1 axial growth")
+            a2.set_ylabel("P1 [µm]")
+            a2.set_xlabel("time [h]")
+            a2.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+            a2.grid(alpha=0.3)
+        else:
+            ax.set_xlabel("time [h]")
         return ax

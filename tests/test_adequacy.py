@@ -99,12 +99,10 @@ def test_extrapolation_warnings():
     assert not any("above the fit window" in m for m in w)
 
 
-PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"
+PEER_RUNS = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs"
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(not (PEER_RUNS / "dev-09.csv").exists(),
-                    reason="the peer's bench runs are beside the project")
 def test_base_inadequacy_on_a_peer_control_run():
     """On a peer's loaded control run (an SPL2782-family spindle that is not the spec, 26 kW
     peaks), the calibrated base model misses the stator temperature by more than its

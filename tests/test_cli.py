@@ -19,6 +19,16 @@ def test_help():
     assert r.returncode == 0 and "solve" in r.stdout and "mesh" in r.stdout
 
 
+def test_version_is_the_installed_distributions():
+    """--version prints the version pyproject.toml gives the installed package (issue 34)."""
+    import tomllib
+    from pathlib import Path
+
+    meta = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
+    r = run("--version")
+    assert r.returncode == 0 and r.stdout.strip() == f"spindle-verify {meta['project']['version']}"
+
+
 def test_specs_lists_shipped(capsys):
     assert main(["specs"]) == 0
     out = capsys.readouterr().out

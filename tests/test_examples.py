@@ -95,7 +95,7 @@ def test_ex02_lumped_vs_reference(tmp_path, monkeypatch, capsys):
     (docs/harness.md), so with the README's rounding: 4.6 ± 0.12 K and 2.4 ± 0.09 µm. The
     example's hand-written sensor rule gives the harness's errors (the pytest plugin,
     reference level 1) to round-off."""
-    from compare.verify.pytest_plugin import model_error
+    from compare.verify.within import model_error
 
     _run_as_script("ex02_lumped_vs_reference", str(tmp_path), monkeypatch=monkeypatch)
     with open(tmp_path / "errors.csv", newline="") as fh:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"
+PEER_RUNS = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs"
 
 CASES = [
     # (control, effect, parameters, lag channel, why the case is here)
@@ -68,8 +68,6 @@ def _params() -> list:
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(not (PEER_RUNS / "truth.json").exists(),
-                    reason="the peer's bench runs are beside the project")
 @pytest.mark.parametrize(("control", "effect", "params", "channel"), _params())
 def test_fit_names_the_effect_injected_into_a_peer_control(control, effect, params, channel):
     named = _fit(control, effect, tuple(sorted(params.items())), channel)

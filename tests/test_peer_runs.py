@@ -1,4 +1,4 @@
-"""``fit`` on the peer's runs beside the project (../shared/bench-runs/ and bench-runs-2/: two
+"""``fit`` on the peer's runs (tests/data/peer-runs/bench-runs/ and bench-runs-2/: two
 independent simulators of SPL2782-family spindles that are not the shipped spec), against their
 truth.json, with the tool's defaults.
 
@@ -28,7 +28,7 @@ import pytest
 
 from spindle.tolerances import channel_tolerance, edge_scale
 
-SHARED = Path(__file__).resolve().parents[2] / "shared"
+SHARED = Path(__file__).resolve().parent / "data" / "peer-runs"
 FOLDERS = (SHARED / "bench-runs", SHARED / "bench-runs-2")
 #: runs whose verdict is not yet right, with what fit says instead (measured by
 #: ``python benchmarks/bench_families.py --families peers``; docs/figures/fit-families.txt)
@@ -71,7 +71,6 @@ def _truths() -> dict[str, tuple[Path, object]]:
 
 
 TRUTHS = _truths()
-needs_runs = pytest.mark.skipif(not TRUTHS, reason="the peer's bench runs are beside the project")
 
 
 @functools.cache
@@ -93,7 +92,6 @@ def _true_effects(truth) -> list[str]:
 
 
 @pytest.mark.slow
-@needs_runs
 @pytest.mark.parametrize("label", _xfail(KNOWN_WRONG))
 def test_no_wrong_cause_is_named(label):
     doc = _fit(label)
@@ -105,7 +103,6 @@ def test_no_wrong_cause_is_named(label):
 
 
 @pytest.mark.slow
-@needs_runs
 @pytest.mark.parametrize("label", _xfail(KNOWN_NOT_RIGHT))
 def test_the_verdict_is_right(label):
     doc = _fit(label)
@@ -121,7 +118,6 @@ def test_the_verdict_is_right(label):
 
 
 @pytest.mark.slow
-@needs_runs
 @pytest.mark.parametrize("label", _xfail(KNOWN_OVER_TOLERANCE))
 def test_validation_error_within_the_tolerances_where_the_verdict_claims_it(label):
     """Issue 32: a named effect or an adequate base carries the validation RMS within the

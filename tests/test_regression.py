@@ -1,5 +1,5 @@
 """Regression verification (compare/verify/regression.py, spindle-verify baseline / check) and the
-pytest helper (compare/verify/pytest_plugin.py), used here on the shipped specs."""
+pytest helper (spindle_verify.pytest_plugin, compare/verify/within.py), used here on the shipped specs."""
 
 import json
 

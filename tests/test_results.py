@@ -1,6 +1,7 @@
 """Result objects: tables, pictures and files, computed apart from plotting."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -69,3 +70,30 @@ def test_transient_vtu_carries_displacement(tmp_path):
     assert res.growth_m["P1"][-1] * 1e6 == pytest.approx(
         ((ref.elastic.axial_probe(0.5295, 0.05) - ref.elastic.axial_probe(0.5, 0.095))
          @ res.U_fields[-1])[0] * 1e6, rel=1e-9)
+
+
+def test_results_take_cycle_names_and_read_at_a_glance():
+    """issue 34: a model's solves take a cycle's name as the CLI does; a result prints as one
+    line in °C and µm, its summary holds plain numbers, and its plot is titled, has a legend
+    and shows P1 against the ±1.5 µm band."""
+    import lumped
+    from spindle.tolerances import GROWTH_TOLERANCE_M
+
+    model = lumped.build("spl2782", nodes=5)
+    run = model.transient("spl-16h", dt_s=600.0)
+    text = repr(run)
+    # every 600 s and every input sample (the ambient's, every 15 min): more than 96 steps
+    assert re.match(r"<LumpedTransientResult spl2782, spl-16h: 16 h in \d+ steps, ", text)
+    assert "°C" in text and "P1" in text and "µm peak" in text and len(text) < 200
+    assert "object at 0x" not in text
+    steady = model.steady("nominal")
+    assert steady.case.name == "nominal" and "4300 rpm" in repr(steady)
+    summary = steady.summary()
+    assert type(summary["speed_rpm"]) is float and "np.float64" not in str(summary)
+    json.dumps(run.summary(), allow_nan=False)  # plain numbers throughout
+    ax = run.plot()
+    assert "spl-16h" in ax.get_title() and ax.get_legend() is not None
+    p1_ax = ax.figure.axes[1]
+    assert p1_ax.get_ylabel() == "P1 [µm]"
+    labels = [t.get_text() for t in p1_ax.get_legend().get_texts()]
+    assert f"±{GROWTH_TOLERANCE_M * 1e6:g} µm tolerance" in labels

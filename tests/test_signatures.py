@@ -1,6 +1,6 @@
 """Signature tests on a bench run's raw samples (compare.fit.signatures and each effect's own
 test in compare.fit.effects), on analytic signals and on a peer's bench runs
-(../shared/bench-runs, data this project did not make):
+(tests/data/peer-runs/bench-runs, data this project did not make):
 
 - the event signatures around the speed steps: P1's centrifugal jump
   (effects.centrifugal.jump_test) and a sensor's lagging onset (effects.lag.lag_test);
@@ -36,7 +36,7 @@ from compare.fit.signatures import Context, onset_ratio, segments, speed_steps
 from lumped.elastic import first_order_lag
 from spindle.cycles import ramped_steps, random_cycle
 
-PEER_RUNS = Path(__file__).resolve().parents[2] / "shared" / "bench-runs"
+PEER_RUNS = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs"
 CRITERIA = Criteria()
 SHORT = CRITERIA.onset_scales[0]  # the onset scale of the minutes: 2 min over the next 4
 
@@ -151,8 +151,6 @@ def test_the_long_onset_scale_reads_a_slow_lag_on_a_noisy_channel():
                for s in range(20))
 
 
-@pytest.mark.skipif(not (PEER_RUNS / "truth.json").exists(),
-                    reason="the peer's bench runs are beside the project")
 def test_event_signatures_on_the_peer_runs():
     """On a peer's nine runs (an independent simulator): P1 jumps significantly with n^2 only
     on the centrifugal-shortening run, and T1's onset is S-shaped (ratio below 1 by more than
@@ -320,8 +318,6 @@ def test_a_small_speed_step_cuts_a_segment_and_is_no_drift(monkeypatch):
     assert all(abs(d) < 5.0 for d in drifts), drifts  # 4 W noise over 240-900 s windows
 
 
-@pytest.mark.skipif(not (PEER_RUNS / "truth.json").exists(),
-                    reason="the peer's bench runs are beside the project")
 def test_power_signatures_on_the_peer_runs():
     """On the peer's nine runs: the drift only on the preload run, the n^3 term only on the
     windage run (both far beyond 1 %), neither test applicable on the loaded runs. The drift
@@ -560,8 +556,6 @@ def test_ramped_cycle_ramps_within_each_speed_step():
     assert all(s.load_torque_Nm == 0.0 for s in plain.steps)
 
 
-@pytest.mark.skipif(not (PEER_RUNS / "truth.json").exists(),
-                    reason="the peer's bench runs are beside the project")
 def test_coolant_signature_on_the_peer_loaded_runs():
     """The peer's loaded pair: the coolant run's rings follow the motor's loss beyond the
     rotor's path (significant at 1 %), the control's do not (its base-structure bias, R

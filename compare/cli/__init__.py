@@ -13,12 +13,24 @@ import sys
 from spindle.errors import InputError, SpindleVerifyError
 
 
+def package_version() -> str:
+    """The installed distribution's version (pyproject.toml), or "unknown" when the tree
+    runs without being installed."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("spindle-verify")
+    except PackageNotFoundError:
+        return "unknown (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="spindle-verify",
         description="How far can you trust a thermal model of a motor spindle? FEM reference, "
                     "lumped models and the harness that compares them. SPEC is a shipped spec "
                     "name (see 'spindle-verify specs') or a path to a .toml file.")
+    p.add_argument("--version", action="version", version=f"%(prog)s {package_version()}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     from compare.cli import (
         fit,

@@ -16,17 +16,17 @@ import sys
 import tempfile
 from pathlib import Path
 
-from reference import ReferenceModel
-from spindle.drive import load_case
-from spindle.spec_reader import load_spec
-from spindle.units import ZERO_C_K
+import spindle_verify
+
+ZERO_C_K = 273.15  # the models work in K: °C only at the edges
 
 
 def main(out: Path, spec_ref: str = "spl2782", level: int = 1) -> dict:
     """Solve, print, save to ``out``; returns the printed figures (°C, µm, W)."""
-    spec = load_spec(spec_ref)                  # a shipped name, or the path of your TOML
-    case = load_case(spec, "nominal")           # any shipped cycle name or cycle file
-    result = ReferenceModel(spec, level=level).steady(case)  # level 2 is the study's truth
+    # a shipped name or the path of your TOML; any shipped cycle name or cycle file; level 2
+    # is the study's truth
+    result = spindle_verify.solve(spec_ref, "nominal", model=f"fem:{level}")
+    spec, case = result.model.spec, result.case
 
     sensors_C = {n: T - ZERO_C_K for n, T in result.sensors.items()}  # the model works in K
     growth_um = {n: g * 1e6 for n, g in result.growth_m.items()}      # ... and in m

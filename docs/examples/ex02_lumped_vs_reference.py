@@ -6,34 +6,29 @@ Builds the lumped model (eq. 7-13) and the FEM reference from the same spec, sol
 the nominal point, prints the worst sensor temperature error and the P1 error against the
 paper's tolerances (1 K, ±1.5 µm) and writes the per-sensor errors to OUT_DIR/errors.csv.
 ``spindle-verify study`` does this for every node count and FEM level, with grid convergence
-(the README's 4.8 K and 2.7 µm are against its extrapolated reference; level 1 is within
-0.07 K and 0.04 µm of it at these sensors, docs/harness.md); this is the one-case version.
+(its figures are against the extrapolated reference; level 1 is within 0.07 K and 0.04 µm of
+it at these sensors, docs/harness.md); this is the one-case version, with the public API.
 """
 
 from __future__ import annotations
 
+import csv
 import sys
 import tempfile
 from pathlib import Path
 
-import lumped
-from reference import ReferenceModel
-from spindle.drive import load_case
-from spindle.outputs import write_csv
-from spindle.spec_reader import load_spec
-from spindle.tolerances import GROWTH_TOLERANCE_M, TEMPERATURE_TOLERANCE_K
-from spindle.units import ZERO_C_K
+import spindle_verify
 
 # the paper's tolerances (section 3), the growth's in µm as printed
-TOL_TEMP_K, TOL_GROWTH_UM = TEMPERATURE_TOLERANCE_K, GROWTH_TOLERANCE_M * 1e6
+TOL_TEMP_K, TOL_GROWTH_UM = 1.0, 1.5
+ZERO_C_K = 273.15  # the models work in K: °C only at the edges
 
 
 def main(out: Path, nodes: int | str = 11) -> dict:
     """Compare, print, write ``out/errors.csv``; returns the worst errors (K, µm)."""
-    spec = load_spec("spl2782")
-    case = load_case(spec, "nominal")
-    fem = ReferenceModel(spec, level=1).steady(case)   # the reference: FEM, mesh level 1
-    lm = lumped.build(spec, nodes=nodes).steady(case)  # the same spec, the same case
+    fem = spindle_verify.solve("spl2782", "nominal", model="fem:1")  # the reference: level 1
+    lm = spindle_verify.solve("spl2782", "nominal", model=f"lumped:{nodes}")  # the same case
+    spec, case = fem.model.spec, fem.case
 
     # the sensors the harness judges (compare.verify.accuracy): the 11 shaft and 11 housing
     # array sensors and the bearing rings T1, T2
@@ -53,9 +48,11 @@ def main(out: Path, nodes: int | str = 11) -> dict:
           f"({verdict(result['P1_um'], TOL_GROWTH_UM)} ±{TOL_GROWTH_UM:g} µm)")
 
     out.mkdir(parents=True, exist_ok=True)
-    write_csv(out / "errors.csv", ["sensor", "T_fem_C", "T_lumped_C", "error_K"],
-              [(n, fem.sensors[n] - ZERO_C_K, lm.sensors[n] - ZERO_C_K, errors[n])
-               for n in names])
+    with open(out / "errors.csv", "w", newline="", encoding="utf-8") as f:
+        rows = csv.writer(f)
+        rows.writerow(["sensor", "T_fem_C", "T_lumped_C", "error_K"])
+        rows.writerows((n, fem.sensors[n] - ZERO_C_K, lm.sensors[n] - ZERO_C_K, errors[n])
+                       for n in names)
     print(f"wrote {out / 'errors.csv'}")
     return result
 

@@ -1,26 +1,19 @@
-"""A pytest plugin: assert in one line that a model of a spindle stays within a tolerance of
-the FEM reference.
-
-Installed with spindle-verify (entry point ``pytest11``), it gives every test suite the
-``spindle_verify`` fixture::
-
-    def test_my_spindle(spindle_verify):
-        spindle_verify.assert_within("my_spindle.toml", "lumped:11", case="nominal",
-                                     tol_temp_K=1.0, tol_growth_um=1.5)
+"""One model of a spindle against the FEM reference, as one figure each: the worst
+temperature error over the spec's sensors (K; over time for a transient) and the P1 error
+(µm), as compare.verify.accuracy computes them. :func:`model_error` returns them,
+:func:`assert_within` raises ``AssertionError`` when one exceeds its tolerance. The public
+names are ``spindle_verify.model_error`` and ``spindle_verify.assert_within``; the pytest
+fixture ``spindle_verify`` (spindle_verify.pytest_plugin) calls them.
 
 ``model`` is ``"lumped:N"`` (N an integer or paper5 / paper11) or ``"fem:L"`` (mesh level);
 ``case`` a shipped cycle name (``nominal`` is steady, other cycles are transients) or None
 for the spec's own steady load case. The reference is the FEM at ``reference_level``.
-The error is the worst temperature error over the spec's sensors (K; over time for a
-transient) and the P1 error (µm), as in compare.verify.accuracy.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-
-import pytest
 
 from compare.verify.accuracy import (
     TOL_GROWTH_UM,
@@ -35,6 +28,9 @@ from compare.verify.accuracy import (
 
 @dataclass
 class Verdict:
+    """A model's errors against the reference: the worst temperature error [K], the P1 error
+    [µm] (nan where the model has no P1) and the whole row of errors."""
+
     model: str
     worst_temp_K: float
     P1_um: float
@@ -75,31 +71,21 @@ def model_error(spec_ref: str, model: str, case: str | None = None, reference_le
     return Verdict(model, worst_temperature_K(row), row.get("P1_max_um", math.nan), row)
 
 
-class SpindleVerify:
-    """The fixture's object."""
-
-    def error(self, spec: str, model: str, case: str | None = None, reference_level: int = 2,
-              dt_s: float = 120.0) -> Verdict:
-        return model_error(spec, model, case, reference_level, dt_s)
-
-    def assert_within(self, spec: str, model: str, case: str | None = None,
-                      tol_temp_K: float = TOL_TEMP_K, tol_growth_um: float = TOL_GROWTH_UM,
-                      reference_level: int = 2, dt_s: float = 120.0) -> Verdict:
-        v = model_error(spec, model, case, reference_level, dt_s)
-        msgs = []
-        if not v.worst_temp_K <= tol_temp_K:
-            worst = max((k for k in v.row if k.endswith("_max_K")), key=lambda k: v.row[k])
-            msgs.append(f"temperature error {v.worst_temp_K:.3f} K > {tol_temp_K:g} K "
-                        f"(worst: {worst})")
-        if not math.isnan(v.P1_um) and v.P1_um > tol_growth_um:
-            msgs.append(f"P1 error {v.P1_um:.3f} µm > {tol_growth_um:g} µm")
-        if msgs:
-            pytest.fail(f"{model} of {spec} ({case or 'own load case'}) against FEM level "
-                        f"{reference_level}: " + "; ".join(msgs), pytrace=False)
-        return v
-
-
-@pytest.fixture
-def spindle_verify() -> SpindleVerify:
-    """Assert that a model of a spindle stays within a tolerance of the FEM reference."""
-    return SpindleVerify()
+def assert_within(spec: str, model: str, case: str | None = None,
+                  tol_temp_K: float = TOL_TEMP_K, tol_growth_um: float = TOL_GROWTH_UM,
+                  reference_level: int = 2, dt_s: float = 120.0) -> Verdict:
+    """:func:`model_error`, and ``AssertionError`` with a readable message when the worst
+    temperature error exceeds ``tol_temp_K`` [K] or the P1 error ``tol_growth_um`` [µm]
+    (defaults: the paper's 1 K and 1.5 µm). Returns the errors when within."""
+    v = model_error(spec, model, case, reference_level, dt_s)
+    msgs = []
+    if not v.worst_temp_K <= tol_temp_K:
+        worst = max((k for k in v.row if k.endswith("_max_K")), key=lambda k: v.row[k])
+        msgs.append(f"temperature error {v.worst_temp_K:.3f} K > {tol_temp_K:g} K "
+                    f"(worst: {worst})")
+    if not math.isnan(v.P1_um) and v.P1_um > tol_growth_um:
+        msgs.append(f"P1 error {v.P1_um:.3f} µm > {tol_growth_um:g} µm")
+    if msgs:
+        raise AssertionError(f"{model} of {spec} ({case or 'own load case'}) against FEM level "
+                             f"{reference_level}: " + "; ".join(msgs))
+    return v
