@@ -112,9 +112,15 @@ def test_predictor_step_run_and_steady(spl0):
 
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="no C compiler")
 def test_c_export_matches_the_predictor(spl0, tmp_path):
+    """The generated C builds with -std=c99 -Wall -Wextra -pedantic -Werror; at the table's
+    speeds it is the Python predictor to round-off; between them it interpolates within the
+    error it states; outside the table it says so in its status; its losses are the power
+    balance's within the error it states, and rom_step_cnc is rom_losses then rom_step."""
     import ctypes
+    import json
 
-    from reference.rom.export import export
+    from reference.rom.export import STATUS, export
+    from spindle.drive import drive_for
 
     ref, rom, _ = spl0
     case = named_case(ref.spec, "spl-16h")
@@ -123,23 +129,76 @@ def test_c_export_matches_the_predictor(spl0, tmp_path):
     U = rom.inputs(case, t)
     speeds = np.asarray(case.speed_rpm(t), dtype=float)
     pred = ROMPredictor(rom, dt)
-    files = export(pred, np.unique(speeds), tmp_path)
+    drive = drive_for(ref.spec)
+    table = np.arange(0.0, 4500.0, 500.0)  # every 500 rpm: the cycle's 1000..4300 included
+    files = export(pred, np.r_[table, np.unique(speeds)], tmp_path, drive=drive)
     lib = tmp_path / "librom.so"
-    subprocess.run(["gcc", "-O2", "-shared", "-fPIC", "-o", str(lib),
-                    str(tmp_path / "spindle_rom.c"), "-lm"], check=True)
+    subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-O2",
+                    "-shared", "-fPIC", "-o", str(lib), str(tmp_path / "spindle_rom.c"), "-lm"],
+                   check=True)
+    doc = json.loads((tmp_path / "spindle_rom.json").read_text())
     c = ctypes.CDLL(str(lib))
     dbl = ctypes.POINTER(ctypes.c_double)
-    state = np.zeros(rom.n_states)
-    c.rom_initial_state(state.ctypes.data_as(dbl))
-    np.testing.assert_allclose(state, pred.state, rtol=0, atol=1e-12)
-    y = np.zeros(len(rom.sensor_names) + len(rom.readings))
+    p = len(rom.sensor_names) + len(rom.readings)
+
+    def c_run(inputs: np.ndarray, speed: np.ndarray) -> tuple[np.ndarray, list[int]]:
+        state, y, out, status = np.zeros(rom.n_states), np.zeros(p), [], []
+        c.rom_initial_state(state.ctypes.data_as(dbl))
+        for u, n in zip(inputs, speed, strict=True):
+            inp = np.ascontiguousarray(np.r_[u, n])
+            status.append(c.rom_step(state.ctypes.data_as(dbl), inp.ctypes.data_as(dbl),
+                                     y.ctypes.data_as(dbl)))
+            out.append(y.copy())
+        return np.array(out), status
+
+    # at the tabulated speeds: the predictor to round-off
+    state0 = np.zeros(rom.n_states)
+    c.rom_initial_state(state0.ctypes.data_as(dbl))
+    np.testing.assert_allclose(state0, pred.state, rtol=0, atol=1e-12)
+    Y, status = c_run(U, speeds)
+    Yp = np.array([(pred.step(u, n), pred.outputs_now())[1] for u, n in zip(U, speeds,
+                                                                              strict=True)])
+    assert np.abs(Y - Yp).max() < 1e-9 and not any(status)
+    # between table speeds (250 rpm off every entry): within the stated error, measured on a
+    # staircase through the midpoints (another cycle; its ambient and coolant drift besides,
+    # which the factor 2 leaves room for)
+    off = np.clip(speeds + 250.0, 0.0, 4250.0)
+    Y, status = c_run(U, off)
+    exact = ROMPredictor(rom, dt)
+    Ye = np.array([(exact.step(u, n), exact.outputs_now())[1] for u, n in zip(U, off,
+                                                                               strict=True)])
+    ns = len(rom.sensor_names)
+    stated = doc["interpolation"]
+    assert 0 < np.abs(Y - Ye)[:, :ns].max() <= 2 * stated["speed_staircase_K"]
+    assert np.abs(Y - Ye)[:, ns:].max() <= 2 * stated["speed_staircase_m"]
+    assert not any(status)
+    # outside the table: the status says so; the value is held at the table's end
+    _, status = c_run(U[:2], np.array([5000.0, -10.0]))
+    assert status == [STATUS["SPEED_ABOVE"], STATUS["SPEED_BELOW"]]
+    # the losses a CNC's speed and torque give, against the Python power balance
+    heat = np.zeros(len(rom.source_names))
+    c.rom_losses.argtypes = [ctypes.c_double, ctypes.c_double, dbl]
     worst = 0.0
-    for k in range(len(t)):
-        inp = np.ascontiguousarray(np.r_[U[k], speeds[k]])
-        c.rom_step(state.ctypes.data_as(dbl), inp.ctypes.data_as(dbl), y.ctypes.data_as(dbl))
-        pred.step(U[k], speeds[k])
-        worst = max(worst, float(np.abs(y - pred.outputs_now()).max()))
-    assert worst < 1e-9
+    for n, M in [(1000.0, 0.0), (2750.0, 30.0), (4300.0, 84.0), (1234.0, 55.5)]:
+        assert c.rom_losses(n, M, heat.ctypes.data_as(dbl)) == 0
+        want = drive.heat_W(n, M)
+        got = dict(zip(rom.source_names, heat, strict=True))
+        worst = max(worst, max(abs(got[k] - v) for k, v in want.items()))
+    assert worst <= stated["losses_W"] + 1e-9
+    assert c.rom_losses(1000.0, 1e4, heat.ctypes.data_as(dbl)) == STATUS["TORQUE_OUTSIDE"]
+    # the CNC step: the losses, then the step with the ambient and coolant given
+    c.rom_step_cnc.argtypes = [dbl, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                               ctypes.c_double, dbl]
+    s1, s2, y1, y2 = (np.zeros(rom.n_states), np.zeros(rom.n_states), np.zeros(p), np.zeros(p))
+    c.rom_initial_state(s1.ctypes.data_as(dbl))
+    c.rom_initial_state(s2.ctypes.data_as(dbl))
+    for _ in range(5):
+        assert c.rom_step_cnc(s1.ctypes.data_as(dbl), 2750.0, 30.0, 294.0, 293.0,
+                              y1.ctypes.data_as(dbl)) == 0
+        c.rom_losses(2750.0, 30.0, heat.ctypes.data_as(dbl))
+        inp = np.ascontiguousarray(np.r_[heat, 294.0, 293.0, 2750.0])
+        c.rom_step(s2.ctypes.data_as(dbl), inp.ctypes.data_as(dbl), y2.ctypes.data_as(dbl))
+    np.testing.assert_array_equal(y1, y2)
     assert {f.suffix for f in files} == {".npz", ".json", ".h", ".c"}
 
 

@@ -4,6 +4,7 @@ tolerances, checked on held-out cycles, exported for a controller (docs/rom.md).
 from __future__ import annotations
 
 import argparse
+import json
 
 from compare.cli.common import (
     MESH_LEVEL,
@@ -45,6 +46,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.romstudy import rom_study
     from reference.rom.export import export
     from reference.rom.realtime import ROMPredictor
+    from spindle.drive import drive_for
     from spindle.outputs import output_dir, safe_name
     from spindle.spec_reader import load_spec
 
@@ -59,7 +61,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     pred = ROMPredictor(rom, args.sample_time)
     with output_dir(out, inputs=[spec.path], force=args.force) as tmp, progress.pictures():
         files = study.save(tmp, pictures=not args.no_pictures)
-        files += export(pred, speeds, tmp / "controller")
+        files += export(pred, speeds, tmp / "controller", drive=drive_for(spec))
     progress.done()
     r = study.report
     print(f"{spec.name}: ROM of FEM level {study.level} ({study.n_full} DOFs): "
@@ -75,6 +77,11 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
           f"sensor, {args.tol_growth:g} µm on every growth reading)")
     print(f"controller export: {args.sample_time:g} s, {len(speeds)} speeds "
           f"(0..{speeds[-1]:g} rpm every {args.export_speed_step:g} rpm)")
+    interp = json.loads((out / "controller" / "spindle_rom.json").read_text())["interpolation"]
+    print(f"  between speeds (interpolated): outputs within "
+          f"{interp['speed_staircase_K']:.2g} K, {interp['speed_staircase_m'] * 1e6:.2g} µm"
+          + ("" if interp["losses_W"] is None else
+             f"; losses from speed and torque within {interp['losses_W']:.2g} W"))
     print("wrote " + ", ".join(str(out / f.relative_to(tmp)) for f in files))
     return 0
 
