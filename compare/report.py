@@ -20,14 +20,19 @@ CSS = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}
        "th{background:#f2f2f2}img{max-width:100%}figcaption{font-size:12px;color:#555}"
        "td.pass{background:#d9f2d9;color:#145214;font-weight:bold;text-align:center}"
        "td.fail{background:#f8d7d7;color:#7a1010;font-weight:bold;text-align:center}"
+       "td.borderline{background:#fff3cd;color:#6b4e00;font-weight:bold;text-align:center}"
        "p.summary{font-size:15px;background:#f6f6f6;padding:0.6em 0.8em;border-left:4px solid "
        "#888}td:last-child{min-width:12em}")
 
 
-def verdict_cell(ok: bool | None) -> str:
-    """A table cell saying PASS or FAIL in words and colour (n/a without a verdict)."""
+def verdict_cell(ok: bool | None, borderline: bool = False) -> str:
+    """A table cell saying PASS, FAIL or, where the margin is within the reference's own
+    uncertainty, "borderline" (with the side it falls on), in words and colour (n/a without
+    a verdict)."""
     if ok is None:
         return "<td>n/a</td>"
+    if borderline:
+        return f'<td class="borderline">borderline ({"passes" if ok else "fails"})</td>'
     return '<td class="pass">PASS</td>' if ok else '<td class="fail">FAIL</td>'
 
 MISSING = "—"

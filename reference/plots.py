@@ -61,7 +61,8 @@ def revolved_png(model, T: np.ndarray, path: Path, title: str = "",
     pl = pv.Plotter(off_screen=True, window_size=list(window))
     pl.set_background("white")
     pl.add_mesh(solid, scalars="T_C", cmap="inferno", smooth_shading=False,
-                scalar_bar_args={"title": "T [°C]", "color": "black", "vertical": True})
+                scalar_bar_args={"title": "T [°C]", "color": "black", "vertical": True,
+                                 "fmt": "%.0f"})  # whole degrees, not VTK's "122."
     pl.add_text(title, font_size=10, color="black")
     b = solid.bounds
     focal = (0.5 * (b[0] + b[1]), 0.0, 0.0)
@@ -87,13 +88,13 @@ def deformed_png(grid, path: Path, title: str = "", growth_m: dict | None = None
     fig, ax = plt.subplots(figsize=(12, 4.2), layout="constrained")
     ax.triplot(mtri.Triangulation(pts[:, 0] * 1e3, pts[:, 1] * 1e3, tri), color="0.85", lw=0.2)
     moved = pts + scale * d
-    from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.colors import Normalize
 
     uz = np.asarray(grid.point_data["u_z_um"])
-    # a diverging map centred on zero: white is "does not move", red and blue the two ways
+    # a diverging map centred on zero, one scale both ways (a micrometre is the same colour
+    # step forwards and backwards): white is "does not move", red and blue the two ways
     span = max(float(np.abs(uz).max()), 1e-12)
-    norm = TwoSlopeNorm(0.0, vmin=min(float(uz.min()), -1e-3 * span),
-                        vmax=max(float(uz.max()), 1e-3 * span))
+    norm = Normalize(vmin=-span, vmax=span)
     tc = ax.tripcolor(mtri.Triangulation(moved[:, 0] * 1e3, moved[:, 1] * 1e3, tri),
                       uz, shading="gouraud", cmap="coolwarm", norm=norm)
     fig.colorbar(tc, ax=ax, label="axial displacement u_z [µm]", shrink=0.9)

@@ -21,6 +21,22 @@ def pyplot():
     return plt
 
 
+def wrapped(text: str, width_in: float, fontsize: float) -> str:
+    """``text`` broken into lines that fit ``width_in`` inches at ``fontsize`` points (an
+    average glyph is about 0.55 of the font size wide), so that a title is never cut off by
+    its canvas."""
+    import textwrap
+
+    chars = max(int(width_in * 72 / (0.55 * fontsize)), 20)
+    return "\n".join(textwrap.fill(line, chars) for line in text.split("\n"))
+
+
+def levels_text(levels) -> str:
+    """FEM levels as words, not a Python list: "1, 2 and 3" ("1 and 2", "2")."""
+    items = [str(v) for v in levels]
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
 def sensor_profile_png(table, path: Path, title: str = "") -> None:
     """Array sensors (shaft, housing) along z, from a sensor DataFrame-like table."""
     plt = pyplot()

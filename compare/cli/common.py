@@ -121,13 +121,15 @@ def load_case_input(spec: Spec, source: str, base: LoadCase, inputs: list[str]) 
     return case
 
 
-def pass_fail(ok: bool) -> str:
-    """PASS or FAIL for the console: in green or red on a colour terminal, plain words
-    otherwise (a log, a pipe, NO_COLOR set)."""
+def pass_fail(ok: bool, borderline: bool = False) -> str:
+    """PASS, FAIL or "borderline" (the margin within the reference's uncertainty) for the
+    console: in green, red or yellow on a colour terminal, plain words otherwise (a log, a
+    pipe, NO_COLOR set)."""
     import os
     import sys
 
-    word = "PASS" if ok else "FAIL"
+    word = "borderline" if borderline else "PASS" if ok else "FAIL"
     if sys.stdout.isatty() and not os.environ.get("NO_COLOR"):
-        return f"\033[{'32' if ok else '31'};1m{word}\033[0m"
+        colour = "33" if borderline else "32" if ok else "31"
+        return f"\033[{colour};1m{word}\033[0m"
     return word

@@ -30,6 +30,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.accuracy import worst_temperature_K
     from compare.verify.study import run_study
     from spindle.outputs import output_dir, safe_name
+    from spindle.plots import levels_text
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
@@ -47,7 +48,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     conv = result.convergence
     gt = result.ground_truth_level
     print(f"{spec.name}: verification study, {result.runtime_s:.1f} s")
-    print(f"FEM grid convergence ({conv.case_name}, levels {conv.levels}, "
+    print(f"FEM grid convergence ({conv.case_name}, levels {levels_text(conv.levels)}, "
           f"{conv.dofs[-1]} DOFs at the finest): ground truth = "
           + (f"level {gt} (GCI <= {args.threshold:g} % for every quantity)" if gt is not None
              else f"none within {args.threshold:g} %; using level {result.reference_level}"))
@@ -68,7 +69,8 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
             mark = f" ({t['preset'][i]})" if t["preset"][i] else ""
             print(f"  {name + mark:<22} {t['unknowns'][i]:8d} "
                   f"{worst:14.3f} {p1:10.3f} "
-                  f"{t['runtime_s'][i]:10.3f}  {pass_fail(t['meets_tolerances'][i])}")
+                  f"{t['runtime_s'][i]:10.3f}  "
+                  f"{pass_fail(t['meets_tolerances'][i], t['borderline'][i])}")
         slopes = acc.slopes()
         if slopes:
             print("  fitted slopes of error against unknowns: "

@@ -67,6 +67,15 @@ class Criteria:
         "a guess. The open loop names only effects whose test does not apply to the run (or "
         "that have none). Weak evidence then ends in 'nothing named' rather than a name "
         "(False: a silent test vetoes only where its interval excludes the fitted size)")
+    held_out_misfit_unexplained: bool = _c(
+        True, "-", "where nothing is named and the final model misses a channel's tolerance "
+        "on the held-out validation window (open-loop RMS above one tolerance), the run is "
+        "'unexplained' even if no localized form of the competitor is significant: with sensor "
+        "noise a tenth of the tolerance, an RMS of one tolerance on held-out data is not noise "
+        "(the test's false-alarm rate is nil under a correct model), and no effect of the "
+        "library took it up. 'Base inadequate' said the same and pointed at the spec alone; "
+        "the report still gives the adequacy verdict on the spec. False: such runs end "
+        "'nothing named, base inadequate'")
     competitor_step_s: float = _c(
         1800.0, "s", "the time grid of the competitor's windows: half an hour resolves an "
         "event of a few hours, and a 16 h run gives 32 blocks, 528 windows")

@@ -115,6 +115,10 @@ def verdict_lines(doc: dict) -> list[str]:
             lines.append(f"Named: {e['label']}, {vals}. Evidence: {how}.")
         if v["unexplained"]:
             lines.append(f"Something else remains: {v['where']}.")
+    elif v["kind"] == "unexplained" and v.get("basis") == "held-out misfit":
+        lines.append("Unexplained: the calibrated model misses the tolerances on held-out data "
+                     f"and no effect of the library explains it: {v['where']}. A spindle "
+                     "unlike its spec shows the same way: see the base's adequacy below.")
     elif v["kind"] == "unexplained":
         lines.append("Unexplained: no effect of the library explains this run, and something "
                      f"else does: {v['where']}.")
@@ -139,7 +143,8 @@ def report_dict(rep) -> dict:
         "format": REPORT_FORMAT, "run": str(rep.run.path), "spec": rep.spec.name,
         "channels": rep.channels,
         "verdict": {"kind": verdict_kind(rep), "named": [e["label"] for e in effects],
-                    "unexplained": bool(verdict["unexplained"]), "where": verdict.get("where")},
+                    "unexplained": bool(verdict["unexplained"]), "where": verdict.get("where"),
+                    "basis": verdict.get("basis", "")},
         "effects": effects,
         "something_else": verdict,
         "unexplained": {"unexplained": bool(verdict["unexplained"]),

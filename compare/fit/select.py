@@ -135,11 +135,32 @@ class Verdict:
     lr: float
     threshold: float
     unexplained: bool
+    #: channels whose held-out RMS exceeds one tolerance (tolerances), where that made the
+    #: run unexplained (Criteria.held_out_misfit_unexplained) and the competitor did not
+    misses: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def basis(self) -> str:
+        """What made the run unexplained: "something else" (the competitor's test),
+        "held-out misfit" or "" (not unexplained)."""
+        if not self.unexplained:
+            return ""
+        return "held-out misfit" if self.misses else "something else"
+
+    def where(self) -> str | None:
+        h = self.hypothesis
+        if not self.misses:
+            return None if h is None else h.text()
+        text = ", ".join(f"{c} misses its tolerance on the held-out window ({r:.1f} times)"
+                         for c, r in self.misses.items())
+        if h is not None:
+            text += f"; the likeliest single event, not significant alone: {h.text()}"
+        return text
 
     def to_dict(self) -> dict:
         h = self.hypothesis
         return {"unexplained": self.unexplained, "lr": self.lr, "threshold": self.threshold,
-                "where": None if h is None else h.text(),
+                "basis": self.basis, "misses": dict(self.misses), "where": self.where(),
                 "hypothesis": None if h is None else {
                     "kind": h.kind, "where": h.where, "t0_s": h.t0_s, "t1_s": h.t1_s,
                     "amplitude": h.amplitude, "unit": "W" if h.kind == "heat" else "tolerances",
@@ -282,7 +303,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         current = best.fit
         loc = local(cal, current)
     say("fitting something else on the final model")
-    return Selection(base, steps, judged, verdict_on(loc, reg, criteria))
+    return Selection(base, steps, judged, verdict_on(loc, reg, criteria, named=bool(steps)))
 
 
 def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
@@ -332,16 +353,27 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
     return Judgement(ef.label, rnd, None, ef.gain, lr, pv, peak, out, figures)
 
 
-def verdict_on(loc: Local, reg, criteria: Criteria) -> Verdict:
+def verdict_on(loc: Local, reg, criteria: Criteria, named: bool = False) -> Verdict:
     """The competitor on the final model (linearized as ``loc``) stepped to the whole run:
-    unexplained where it is significant (Bonferroni over its hypotheses) and material."""
+    unexplained where it is significant (Bonferroni over its hypotheses) and material; and,
+    with nothing ``named``, where the final model misses a tolerance on held-out data
+    (:func:`held_out_misses`, Criteria.held_out_misfit_unexplained)."""
     rows = np.ones(len(loc.r0), dtype=bool)
     r = loc.residual(loc.step(rows))
     shrink = loc.fit.n_eff / max(loc.fit.n, 1)
     found, tried = scan(reg, r, loc.channel, rows, shrink, top=1)
-    if not found:
-        return Verdict(None, 0.0, math.inf, False)
-    h = found[0]
-    lr = 2.0 * h.gain
-    threshold = chi2_threshold(criteria.alpha, 1, tried)
-    return Verdict(h, lr, threshold, bool(lr > threshold and h.peak >= criteria.material_peak))
+    h = found[0] if found else None
+    lr = 2.0 * h.gain if h is not None else 0.0
+    threshold = chi2_threshold(criteria.alpha, 1, tried) if h is not None else math.inf
+    if h is not None and lr > threshold and h.peak >= criteria.material_peak:
+        return Verdict(h, lr, threshold, True)
+    misses = (held_out_misses(loc.fit.errors)
+              if criteria.held_out_misfit_unexplained and not named else {})
+    return Verdict(h, lr, threshold, bool(misses), misses)
+
+
+def held_out_misses(errors: dict) -> dict[str, float]:
+    """Channels whose open-loop RMS on the validation window exceeds one tolerance, with that
+    RMS in tolerances (``errors``: compare.fit.calibrate.Fit.errors)."""
+    return {c: float(e["rmse_w"]) for c, e in errors.get("validation", {}).items()
+            if e.get("n") and e["rmse_w"] > 1.0}

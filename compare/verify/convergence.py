@@ -215,7 +215,7 @@ class ConvergenceResult:
         labelled in colour with their observed order, the other sensors of the group in grey,
         and a guide of the elements' theoretical order, named. ``ax``: one axes for
         everything, or as many as there are units (None: a new figure)."""
-        from spindle.plots import pyplot
+        from spindle.plots import pyplot, wrapped
 
         plt = pyplot()
         units = sorted({self.units[q] for q in self.values}, key=lambda u: u != "K")
@@ -246,7 +246,7 @@ class ConvergenceResult:
             if drawn:
                 top = float(np.nanmax([e[0] for e in drawn]))
                 a.loglog(h, top * (h / h[0]) ** 3, "k--", lw=1, zorder=2,
-                         label="h³: P2's order on smooth fields (the parts' corners and "
+                         label="h³: P2's order on smooth fields\n(the parts' corners and "
                                "contact interfaces lower it)")
             a.set_xlabel("relative element size h / h0 (level 0 at 1)")
             a.set_ylabel(f"|value − Richardson extrapolation| [{'µm' if unit == 'um' else unit}]")
@@ -255,8 +255,9 @@ class ConvergenceResult:
             a.invert_xaxis()
             a.legend(fontsize=8, loc="lower left")
         fig = axes[0].figure
-        fig.suptitle(f"{self.spec.name}: grid convergence ({self.case_name}); the finest "
-                     f"level's error is its distance to the extrapolated value")
+        fig.suptitle(wrapped(f"{self.spec.name}: grid convergence ({self.case_name}); the "
+                             "finest level's error is its distance to the extrapolated value",
+                             fig.get_size_inches()[0], 12))
         return axes if len(axes) > 1 else axes[0]
 
     def _errors(self, q: str) -> np.ndarray | None:

@@ -31,6 +31,7 @@ from compare.verify.accuracy import (
 from compare.verify.cases import check_level, check_positive, default_cases, save_result
 from spindle.errors import InputError
 from spindle.loads import LoadCase
+from spindle.plots import levels_text
 from spindle.spec import Spec
 
 
@@ -117,14 +118,22 @@ class NodeChoice:
         tol = (f"{self.tol_temp_K:g} K and {self.tol_growth_um:g} µm" if has_p1
                else f"{self.tol_temp_K:g} K (the spec has no P1)")
         cases = ", ".join(c.name for c in self.curves)
+        tried = levels_text(self.nodes).replace(" and ", " or ")
         if self.chosen is not None:
-            return (f"N = {self.chosen} is the smallest node count in {self.nodes} that meets "
-                    f"{tol} on every case ({cases}); its worst errors: {errs(self.chosen)}"
-                    + self._rom_message())
+            return (f"Recommended: N = {self.chosen}, the smallest node count of {tried} that "
+                    f"meets {tol} on every case ({cases}); its worst errors: "
+                    f"{errs(self.chosen)}" + self._rom_message())
         b = self.best()
-        return (f"no N in {self.nodes} meets {'both tolerances' if has_p1 else 'the tolerance'} "
-                f"({tol}) on every case ({cases}); "
-                f"the best is N={b} with {errs(b)}" + self._rom_message())
+        per_case = []
+        for c in self.curves:
+            ok = [n for i, n in enumerate(self.nodes)
+                  if _meets(c.worst_temp_K[i], c.p1_um[i], self.tol_temp_K, self.tol_growth_um)]
+            per_case.append(f"on {c.name} alone N = {ok[0]} does" if ok
+                            else f"on {c.name} none does")
+        return (f"No N of {tried} meets {'both tolerances' if has_p1 else 'the tolerance'} "
+                f"({tol}) on every case ({cases}): {'; '.join(per_case)}. Recommended if a "
+                f"lumped model must serve: N = {b}, the smallest worst error relative to the "
+                f"tolerances ({errs(b)}), knowing it misses them" + self._rom_message())
 
     def _rom_message(self) -> str:
         if not self.rom:
@@ -224,8 +233,8 @@ class NodeChoice:
             ax.grid(alpha=0.3, which="both")
             ax.legend(fontsize=8)
         verdict = (f"chosen N = {self.chosen}" if self.chosen is not None
-                   else f"no N meets {self.tol_temp_K:g} K / {self.tol_growth_um:g} µm "
-                        f"(best N = {self.best()})")
+                   else f"no N meets {self.tol_temp_K:g} K / {self.tol_growth_um:g} µm on "
+                        f"every case (best N = {self.best()})")
         fig.suptitle(f"{self.spec_name}: lumped model against FEM level {self.reference_level}; "
                      f"{verdict}", fontsize=10)
         return fig

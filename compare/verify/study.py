@@ -45,6 +45,7 @@ from compare.verify.accuracy import (
 from compare.verify.convergence import ConvergenceResult, convergence_study
 from spindle.errors import InputError
 from spindle.loads import LoadCase
+from spindle.plots import levels_text
 from spindle.spec import Spec
 
 WARMUP_S = 8 * 3600.0
@@ -79,8 +80,10 @@ class StudyResult:
                 "failures": self.failures}
 
     def verdicts(self) -> list[dict]:
-        """One row per case and model (the lumped presets and eq. 14): ``case``, ``model``,
-        ``passes`` (both tolerances met),
+        """One row per case and model (the paper's models, the lumped presets and eq. 14,
+        and every other lumped model or ROM that passes or is borderline): ``case``,
+        ``model``, ``passes`` (both tolerances met), ``borderline`` (the margin within the
+        reference's uncertainty: the verdict is not decided),
         ``temperature_error_K`` (the worst), ``temperature_margin_K`` (tolerance minus error:
         negative when it fails), ``P1_error_um``, ``P1_margin_um`` (nan without P1), and
         the sentence ``verdict``."""
@@ -90,13 +93,17 @@ class StudyResult:
                 continue
             t = acc.table()
             for i, name in enumerate(t["model"]):
-                if not (t["preset"][i] or t["kind"][i] == "eq14"):
+                paper = bool(t["preset"][i]) or t["kind"][i] == "eq14"
+                other = (t["kind"][i] in ("lumped", "rom")
+                         and (t["meets_tolerances"][i] or t["borderline"][i]))
+                if not (paper or other):
                     continue
                 worst = worst_temperature_K({k: t[k][i] for k in t if k.endswith("_max_K")})
                 p1 = t.get("P1_max_um", [math.nan] * len(t["model"]))[i]
                 out.append({"case": acc.case_name,
                             "model": name + (f" ({t['preset'][i]})" if t["preset"][i] else ""),
                             "passes": bool(t["meets_tolerances"][i]),
+                            "borderline": bool(t["borderline"][i]), "paper": paper,
                             "temperature_error_K": worst,
                             "temperature_margin_K": acc.tol_temp_K - worst,
                             "P1_error_um": p1, "P1_margin_um": acc.tol_growth_um - p1,
@@ -119,12 +126,13 @@ class StudyResult:
             if acc is None:
                 continue
             rows = [v for v in verdicts if v["case"] == acc.case_name]
-            good = [v["model"] for v in rows if v["passes"]]
-            bad = [v["model"] for v in rows if not v["passes"]]
+            paper = [v for v in rows if v["paper"]]
+            good = [v["model"] for v in paper if v["passes"] and not v["borderline"]]
+            bad = [v["model"] for v in paper if not v["passes"] and not v["borderline"]]
+            edge = [v["model"] for v in rows if v["borderline"]]
             kind = "transient" if acc.transient else "steady"
-            t = acc.table()
-            others = [m for i, m in enumerate(t["model"]) if t["meets_tolerances"][i]
-                      and t["kind"][i] in ("lumped", "rom") and not t["preset"][i]]
+            others = [v["model"] for v in rows if not v["paper"] and v["passes"]
+                      and not v["borderline"]]
             sentences.append(
                 f"On the {kind} case {acc.case_name}, "
                 + (f"{', '.join(good)} meet{'s' if len(good) == 1 else ''} both tolerances"
@@ -132,7 +140,10 @@ class StudyResult:
                 + (f"; {', '.join(bad)} fail{'s' if len(bad) == 1 else ''}" if bad and good
                    else f" ({', '.join(bad)} fail)" if bad else "")
                 + (f"; of the other models, {', '.join(others)} "
-                   f"meet{'s' if len(others) == 1 else ''} both" if others else "") + ".")
+                   f"meet{'s' if len(others) == 1 else ''} both" if others else "")
+                + (f"; {', '.join(edge)} {'is' if len(edge) == 1 else 'are'} borderline "
+                   "(within the reference's uncertainty of a tolerance)" if edge else "")
+                + ".")
         return (f"Checked against {truth}, with the paper's tolerances {TOL_TEMP_K:g} K and "
                 f"±{TOL_GROWTH_UM:g} µm. " + " ".join(sentences))
 
@@ -170,7 +181,7 @@ class StudyResult:
         gt = self.ground_truth_level
         gt_text = (f"level {gt} (the coarsest with GCI ≤ {100 * conv.threshold:g} % for every "
                    "sensor and growth reading)" if gt is not None else
-                   f"none of levels {conv.analysed_levels} has GCI ≤ {100 * conv.threshold:g} % "
+                   f"none of levels {levels_text(conv.analysed_levels)} has GCI ≤ {100 * conv.threshold:g} % "
                    f"for every quantity; the finest, level {self.reference_level}, is used")
         flagged = conv.summary()["flagged"]
         parts = [
@@ -182,7 +193,7 @@ class StudyResult:
             "<h2>Verdicts</h2>" + self._verdict_table(),
             self._failures_html(),
             "<h2>1. Grid convergence of the FEM reference</h2>",
-            f"<p>Case: {html.escape(conv.case_name)}; levels {conv.levels} "
+            f"<p>Case: {html.escape(conv.case_name)}; levels {levels_text(conv.levels)} "
             f"({', '.join(f'{d} DOFs' for d in conv.dofs)}). Ground truth: "
             f"{html.escape(gt_text)}. Temperatures as rises above ambient [K], growth in µm. "
             + (f"Flagged: {html.escape(', '.join(f'{q} ({f})' for q, f in flagged.items()))}."
@@ -225,7 +236,7 @@ class StudyResult:
                 "P1 error", "margin to ±1.5 µm"]
         rows = "".join(
             "<tr>" + f"<td>{html.escape(v['case'])}</td><td>{html.escape(v['model'])}</td>"
-            + verdict_cell(v["passes"])
+            + verdict_cell(v["passes"], v["borderline"])
             + "".join(f"<td>{html.escape(x)}</td>" for x in (
                 num(v["temperature_error_K"], "K"), margin(v["temperature_margin_K"], "K"),
                 num(v["P1_error_um"], "µm"), margin(v["P1_margin_um"], "µm"))) + "</tr>"
@@ -272,7 +283,7 @@ def _reference_entry(conv: ConvergenceResult, case: LoadCase) -> tuple[Entry, st
             growth[q] = v * 1e-6
         else:
             sensors[q] = T_amb + v
-    label = f"Richardson extrapolation of FEM levels {conv.levels[-3:]}"
+    label = f"Richardson extrapolation of FEM levels {levels_text(conv.levels[-3:])}"
     if fallback:
         label += f" (finest level for {len(fallback)} flagged quantities)"
     return Entry(label, "reference", 0, 0.0, sensors, growth), label
@@ -415,8 +426,12 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
         if reference is not None:
             got["lumped"].append(rom_rows[1])
     eq14 = eq14_entry(spec, s_case)
+    # the reference's own uncertainty, below which a margin to a tolerance decides nothing:
+    # the extrapolated steady reference is within the finest level's GCI; the transient
+    # reference within its level's (at the nominal point, the hottest) plus its time error
     steady = AccuracyResult(spec, s_case.name, False, ref_entry, label,
-                            ([eq14] if eq14 else []) + got["steady"] + fem)
+                            ([eq14] if eq14 else []) + got["steady"] + fem,
+                            uncertainty=spatial_uncertainty(conv, conv.levels[-1]))
     trans = None
     if reference is not None:
         from spindle.loads import time_grid
@@ -429,7 +444,8 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
                                f"FEM level {ref_level}, {how}; read every {dt_s:g} s"
                                + (" and 1, 2, 4 ... 64 s after each step"
                                   if t_case.extra_times_s else ""),
-                               got["lumped"] + coarse, times_s=time_grid(t_case, dt_s))
+                               got["lumped"] + coarse, times_s=time_grid(t_case, dt_s),
+                               uncertainty=_transient_uncertainty(conv, ref_level, ti))
     ref_res = conv.results[conv.levels.index(ref_level)]
     return StudyResult(spec, conv, steady, trans, gt, ref_level, time.perf_counter() - t0,
                        s_case, ref_res, failures, time_integration)
@@ -501,6 +517,18 @@ def _exact_reference(spec: Spec, case: LoadCase, level: int, dt_s: float, T0: fl
 #: the largest share of the reference's spatial uncertainty its temporal error may take
 #: (issue 33): below it, the time integration adds nothing a verdict could see
 TIME_SHARE_OF_SPATIAL = 0.01
+
+
+def _transient_uncertainty(conv: ConvergenceResult, level: int, time_integration: dict | None
+                           ) -> dict[str, float] | None:
+    """The transient reference's uncertainty [K, um]: its level's spatial uncertainty plus
+    the stated temporal error."""
+    spatial = spatial_uncertainty(conv, level)
+    if spatial is None:
+        return None
+    ti = time_integration or {}
+    return {"K": spatial["K"] + float(ti.get("time_error_K") or 0.0),
+            "um": spatial["um"] + float(ti.get("time_error_um") or 0.0)}
 
 
 def spatial_uncertainty(conv: ConvergenceResult, level: int) -> dict[str, float] | None:
