@@ -2,7 +2,7 @@
 properties they read.
 
 The thermal models need the film coefficient of every convective surface as a function of
-the spindle speed (seed paper, Fig. 5, the power-balance block's second output):
+the spindle speed (the paper, Fig. 5, the power-balance block's second output):
 
 * a shaft rotating in air, Becker (1963) with a Churchill-Chu natural-convection floor
   (:func:`h_rotating_shaft_W_m2K`);

@@ -1,6 +1,6 @@
 """Power balance: spindle inputs -> heat-source powers [W].
 
-The paper's power-balance block (seed paper, section 2.2 and Fig. 5) turns the drive's
+The paper's power-balance block (the paper, section 2.2 and Fig. 5) turns the drive's
 measured inputs (electrical power, speed, load torque) and the winding temperature into the
 heat that the thermal models need:
 
@@ -38,7 +38,7 @@ from spindle.units import ZERO_C_K
 
 #: Reference temperature of eq. 17 (20 degC) [K]
 T20_K = ZERO_C_K + 20.0
-#: Temperature coefficient of copper resistance at 20 degC [1/K] (seed paper eq. 17, ref. [17])
+#: Temperature coefficient of copper resistance at 20 degC [1/K] (the paper's eq. 17, ref. [17])
 ALPHA_CU_20_1_K = 0.00393
 
 
@@ -263,7 +263,7 @@ class MotorLosses:
 
 
 def winding_resistance_ohm(R20_ohm: float, T_K: float, alpha_1_K: float = ALPHA_CU_20_1_K) -> float:
-    """Winding resistance [ohm] at ``T_K`` [K], seed paper eq. 17:
+    """Winding resistance [ohm] at ``T_K`` [K], the paper's eq. 17:
     R(T) = R20 (1 + beta20 (T - 20 degC)), beta20 = 0.00393 1/K for copper (paper ref. [17])."""
     R20 = positive("R20_ohm", R20_ohm)
     T = positive("T_K", T_K)
@@ -274,7 +274,7 @@ def winding_resistance_ohm(R20_ohm: float, T_K: float, alpha_1_K: float = ALPHA_
 
 
 def copper_loss_W(current_A: float, R_ohm: float, phases: int = 3) -> float:
-    """Copper loss [W], seed paper eq. 16 per phase, summed: P_cu = m I^2 R(T), with I the rms
+    """Copper loss [W], the paper's eq. 16 per phase, summed: P_cu = m I^2 R(T), with I the rms
     phase current [A] and R the phase resistance [ohm]."""
     I_ = finite("current_A", current_A)
     return float(phases) * I_**2 * positive("R_ohm", R_ohm)
@@ -287,19 +287,19 @@ def electrical_frequency_Hz(speed_rpm: float, pole_pairs: int) -> float:
 
 
 def hysteresis_loss_W(k_h_W_HzT2: float, f_Hz: float, B_T: float) -> float:
-    """Iron hysteresis loss [W], seed paper eq. 18: Q_h = k_h f B^2 (Steinmetz form with
+    """Iron hysteresis loss [W], the paper's eq. 18: Q_h = k_h f B^2 (Steinmetz form with
     exponent 2, as in the paper), k_h for the whole core [W/(Hz T^2)], f [Hz], B [T]."""
     return non_negative("k_h", k_h_W_HzT2) * non_negative("f_Hz", f_Hz) * finite("B_T", B_T) ** 2
 
 
 def eddy_loss_W(k_e_W_Hz2T2: float, f_Hz: float, B_T: float) -> float:
-    """Iron eddy-current loss [W], seed paper eq. 19: Q_e = k_e f^2 B^2, k_e for the whole
+    """Iron eddy-current loss [W], the paper's eq. 19: Q_e = k_e f^2 B^2, k_e for the whole
     core [W/(Hz^2 T^2)], f [Hz], B [T]."""
     return non_negative("k_e", k_e_W_Hz2T2) * non_negative("f_Hz", f_Hz) ** 2 * finite("B_T", B_T) ** 2
 
 
 def motor_torque_Nm(load_torque_Nm: float, J_kgm2: float = 0.0, dw_dt_rad_s2: float = 0.0) -> float:
-    """Motor (air-gap) torque [N m] from seed paper eq. 15, M - M_L = J dw/dt, i.e.
+    """Motor (air-gap) torque [N m] from the paper's eq. 15, M - M_L = J dw/dt, i.e.
     M = M_L + J dw/dt; M_L [N m] is everything the motor drives (process torque, bearing
     friction, windage), J [kg m2] the inertia of the rotating assembly, dw/dt [rad/s2]."""
     return (finite("load_torque_Nm", load_torque_Nm)

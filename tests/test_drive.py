@@ -126,7 +126,7 @@ def test_shipped_drive_equals_the_former_constants():
     assert d.motor.source.startswith("ASSUMED: pole_pairs 4 (1FE1 PMSM")
     assert d.motor.source.endswith("(magnet and sleeve eddy losses of a PMSM rotor)")
     for b, size in zip(d.bearings.values(), ("7018", "7016"), strict=True):
-        assert b.source.startswith(f"Seed paper (grease-lubricated pairs); {size} dimensions ISO 15; "
+        assert b.source.startswith(f"The paper (grease-lubricated pairs); {size} dimensions ISO 15; "
                                    "CALIBRATED f0 = 0.26 per bearing (docs/paper.md: fitted")
         assert b.source.endswith("25 deg super-precision bearings of this size (M1 is ~8 % of M).")
 

@@ -1,7 +1,7 @@
-"""The seed paper's SPL2782.1 figures, reproduced by the FEM reference, and the calibration
+"""The paper's SPL2782.1 figures, reproduced by the FEM reference, and the calibration
 of the few uncertain parameters of the ``spl2782`` spec against them.
 
-Targets (seed paper, section 3 and 4):
+Targets (the paper, section 3 and 4):
 
 - nominal point (38 kW / 4300 rpm): 5146 W of losses, shaft +41.6 K and housing +46.1 K
   above ambient (volume means, the paper's "average temperatures" of eq. 6), axial growth
