@@ -15,7 +15,10 @@ from typing import Any
 
 #: the look shared by every report.html
 CSS = ("body{font-family:sans-serif;max-width:1200px;margin:2em auto;color:#222}"
-       "table{border-collapse:collapse;font-size:12px;margin:1em 0}"
+       # a table wider than the page scrolls inside its own box (its last columns, the
+       # verdicts, stay reachable in a narrow window)
+       "table{border-collapse:collapse;font-size:12px;margin:1em 0;display:block;"
+       "overflow-x:auto;max-width:100%}"
        "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
        "th{background:#f2f2f2}img{max-width:100%}figcaption{font-size:12px;color:#555}"
        "td.pass{background:#d9f2d9;color:#145214;font-weight:bold;text-align:center}"
@@ -47,10 +50,27 @@ def fmt(v: Any, spec: str = ".4g") -> str:
     return str(v)
 
 
+#: a machine name's unit suffix and how a person reads it (tables for people; JSON and CSV
+#: keep the machine names)
+UNITS = {"K": "K", "C": "°C", "um": "µm", "m": "m", "pct": "%", "s": "s", "W": "W",
+         "rpm": "rpm", "Nm": "N m", "J": "J"}
+
+
+def human_header(name: str) -> str:
+    """A column's machine name as words with its unit: ``GCI_fine_pct`` -> ``GCI fine [%]``,
+    ``P1_max_um`` -> ``P1 max [µm]``, ``meets_tolerances`` -> ``meets tolerances``."""
+    head, _, unit = name.rpartition("_")
+    if head and unit in UNITS:
+        return f"{head.replace('_', ' ')} [{UNITS[unit]}]"
+    return name.replace("_", " ")
+
+
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[Any]],
                    fmts: Sequence[str] | None = None) -> str:
-    """A Markdown table; ``fmts`` gives one format spec per column (default ``.4g``)."""
+    """A Markdown table for people: headers as words with units (:func:`human_header`);
+    ``fmts`` gives one format spec per column (default ``.4g``)."""
     fmts = list(fmts or [".4g"] * len(header))
+    header = [human_header(str(h)) for h in header]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for r in rows:
         lines.append("| " + " | ".join(fmt(v, f) for v, f in zip(r, fmts, strict=True)) + " |")

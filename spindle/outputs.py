@@ -276,13 +276,32 @@ def _replace_folder(new: Path, path: Path, force: bool = False) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
+#: significant digits of a float in a CSV: far beyond any figure the models resolve (their
+#: round-off is 1e-12 relative), and no 19.500000000000057 for 19.5
+CSV_DIGITS = 10
+
+
+def csv_cell(v: Any) -> Any:
+    """A value as a CSV cell: a float to CSV_DIGITS significant digits, a missing value (NaN,
+    None, infinite) empty; anything else as it is (the project's one number format:
+    docs/spec.md, "Outputs")."""
+    if v is None:
+        return ""
+    if isinstance(v, bool | np.bool_):
+        return bool(v)
+    if isinstance(v, float | np.floating):
+        return format(float(v), f".{CSV_DIGITS}g") if math.isfinite(v) else ""
+    return v
+
+
 def write_csv(path: Path, header: list[str], rows) -> None:
-    """A CSV file with a header row, written atomically."""
+    """A CSV file with a header row, written atomically; cells as :func:`csv_cell` makes
+    them."""
     def write(tmp: Path) -> None:
         with open(tmp, "w", newline="", encoding="utf-8") as fh:
             w = csv.writer(fh)
             w.writerow(header)
-            w.writerows(rows)
+            w.writerows([csv_cell(c) for c in r] for r in rows)
 
     atomic_write(path, write)
 

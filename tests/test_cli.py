@@ -192,5 +192,5 @@ def test_sensors_command(tmp_path, capsys):
     assert main(["sensors", "fin-shaft", "--nodes", "3", "11", "--level", "1", "--tol-temp",
                  "30", "--quiet", "--no-pictures", "--out", str(out)]) == 0
     text = capsys.readouterr().out
-    assert "N = 3 is the smallest node count" in text  # 22.6 K on the warm-up < 30 K
+    assert "Recommended: N = 3, the smallest node count" in text  # 22.6 K on the warm-up < 30 K
     assert (out / "nodes.csv").exists()

@@ -27,6 +27,7 @@ if TYPE_CHECKING:
 
 @with_progress("study")
 def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
+    from compare.report import fmt
     from compare.verify.accuracy import worst_temperature_K
     from compare.verify.study import run_study
     from spindle.outputs import output_dir, safe_name
@@ -68,7 +69,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
             p1 = t.get("P1_max_um", [float("nan")] * len(t["model"]))[i]
             mark = f" ({t['preset'][i]})" if t["preset"][i] else ""
             print(f"  {name + mark:<22} {t['unknowns'][i]:8d} "
-                  f"{worst:14.3f} {p1:10.3f} "
+                  f"{fmt(worst, '.3f'):>14} {fmt(p1, '.3f'):>10} "
                   f"{t['runtime_s'][i]:10.3f}  "
                   f"{pass_fail(t['meets_tolerances'][i], t['borderline'][i])}")
         slopes = acc.slopes()
