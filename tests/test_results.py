@@ -97,3 +97,24 @@ def test_results_take_cycle_names_and_read_at_a_glance():
     assert p1_ax.get_ylabel() == "P1 [µm]"
     labels = [t.get_text() for t in p1_ax.get_legend().get_texts()]
     assert f"±{GROWTH_TOLERANCE_M * 1e6:g} µm tolerance" in labels
+
+
+def test_one_number_format_in_csv_and_headers_for_people(tmp_path):
+    """A CSV holds floats to 10 significant digits and a missing value empty; a table for
+    people heads its columns in words with units (docs/spec.md, 'Outputs')."""
+    import csv
+    import math
+
+    from compare.report import human_header, markdown_table
+    from spindle.outputs import write_csv
+
+    write_csv(tmp_path / "t.csv", ["time_s", "P1_um", "ok"],
+              [(19.500000000000057, math.nan, True), (1.0 / 3.0, None, False)])
+    with open(tmp_path / "t.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[1] == ["19.5", "", "True"]
+    assert rows[2] == ["0.3333333333", "", "False"]
+    assert human_header("GCI_fine_pct") == "GCI fine [%]"
+    assert human_header("P1_max_um") == "P1 max [µm]" and human_header("model") == "model"
+    md = markdown_table(["model", "shaft_max_K"], [("eq. 14", math.nan)])
+    assert "| model | shaft max [K] |" in md and "| eq. 14 | — |" in md
