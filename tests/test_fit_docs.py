@@ -7,6 +7,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 DOC = (ROOT / "docs" / "fit.md").read_text(encoding="utf-8")
 
@@ -57,13 +59,16 @@ def test_the_generalisation_figures_are_the_benchmarks_file():
     assert block.strip("`").strip() == generated.strip()
 
 
-def test_the_trade_table_is_the_two_files():
-    """docs/fit.md's table of a rule's trade quotes the rates of the run with the rule off and
-    with it on (the generated summaries), line by line."""
+@pytest.mark.parametrize(("block", "off_file", "on_file"), [
+    ("trade", "fit-families-material-change-off.txt", "fit-families-before-held-out-misfit.txt"),
+    ("trade-held-out", "fit-families-before-held-out-misfit.txt", "fit-families.txt")])
+def test_the_trade_table_is_the_two_files(block, off_file, on_file):
+    """docs/fit.md's tables of a rule's trade quote the rates of the run without the rule and
+    with it (the generated summaries), line by line."""
     figures = ROOT / "docs" / "figures"
-    off = (figures / "fit-families-material-change-off.txt").read_text(encoding="utf-8")
-    on = (figures / "fit-families.txt").read_text(encoding="utf-8")
-    rows = _rows(_block("trade"))
+    off = (figures / off_file).read_text(encoding="utf-8")
+    on = (figures / on_file).read_text(encoding="utf-8")
+    rows = _rows(_block(block))
     assert rows
     for rate, a, b in rows:
         for text, cell in ((off, a), (on, b)):

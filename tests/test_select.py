@@ -148,3 +148,26 @@ def test_a_heat_no_effect_makes_is_unexplained_and_located(setup):
     # on seeds 7 and 8; its amplitude is what the calibrated base leaves (about 40 W: the
     # base parameters take up the rest), so it is not asserted
     assert (h.kind, h.where, h.t0_s, h.t1_s) == ("heat", "housing", 6 * 3600.0, 9 * 3600.0), h
+
+
+def test_a_held_out_misfit_with_nothing_named_is_unexplained_and_says_where():
+    """Criteria.held_out_misfit_unexplained: nothing named and a channel beyond one tolerance
+    on the validation window makes the verdict 'unexplained' (basis "held-out misfit"),
+    naming the channel and its RMS; within the tolerance, or with an effect named, it does
+    not; the competitor's significant event keeps its own basis."""
+    from compare.fit.competitor import Hypothesis
+    from compare.fit.select import Verdict, held_out_misses
+
+    errors = {"fit": {"T1": {"n": 10, "rmse_w": 3.0}},
+              "validation": {"T1": {"n": 10, "rmse_w": 1.3}, "T2": {"n": 10, "rmse_w": 0.4},
+                             "P1": {"n": 0, "rmse_w": 9.0}}}
+    assert held_out_misses(errors) == {"T1": 1.3}  # not the fit window, not an empty channel
+    assert held_out_misses({"validation": {"T1": {"n": 5, "rmse_w": 1.0}}}) == {}
+    h = Hypothesis("heat", "stator", 3600.0, 7200.0, 12.0, 0.8, 40.0, 528)
+    v = Verdict(h, 3.0, 20.0, True, held_out_misses(errors))
+    assert v.basis == "held-out misfit"
+    assert v.where().startswith("T1 misses its tolerance on the held-out window (1.3 times)")
+    assert "not significant alone: a heat of +12 W into the stator, 1.0-2.0 h" in v.where()
+    assert v.to_dict()["basis"] == "held-out misfit"
+    assert Verdict(h, 30.0, 20.0, True).basis == "something else"
+    assert Verdict(h, 3.0, 20.0, False).basis == ""
