@@ -12,6 +12,7 @@ Run it on an otherwise idle machine: the figures are the wall time a user waits.
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import subprocess
 import sys
@@ -57,7 +58,39 @@ def main(argv: list[str] | None = None) -> None:
             r = rows[name]
             print(f"{name:>6}: {r['wall_s']:.0f} s wall, {r['cpu_s']:.0f} s CPU, "
                   f"{r['peak_MB']} MB peak   ({r['command']})", flush=True)
+        study = json.loads((Path(tmp) / "study" / "study.json").read_text(encoding="utf-8"))
+    rows["findings"] = findings(study)
     write_figures(args.out, "python benchmarks/bench_main_job.py", rows)
+
+
+def findings(study: dict) -> dict:
+    """What the README says the study finds, from the study's own study.json: the ground
+    truth's worst GCI, the paper's 11-node model's errors and verdicts per case, the other
+    lumped models that pass or are borderline over the cycle, and the temporal error."""
+    conv = study["convergence"]
+    gt = study["reference_level"]
+    out = {"ground_truth_level": gt,
+           "worst_GCI_pct": conv["worst_GCI_pct_per_level"][str(gt)],
+           "time_error_K": study["time_integration"]["time_error_K"]}
+    for case in ("steady", "transient"):
+        rows = study[case]["models"]
+        eleven = next(r for r in rows if r["preset"] == "paper11")
+        out[case] = {
+            "case": study[case]["case"],
+            "paper11_worst_K": max(v for k, v in eleven.items()
+                                   if k.endswith("_max_K") and v is not None),
+            "paper11_P1_um": eleven["P1_max_um"],
+            "paper11_verdict": _word(eleven),
+            "lumped_passing": [r["model"] for r in rows if r["kind"] == "lumped"
+                               and r["meets_tolerances"] and not r.get("borderline")],
+            "lumped_borderline": [r["model"] for r in rows if r["kind"] == "lumped"
+                                  and r.get("borderline")]}
+    return out
+
+
+def _word(row: dict) -> str:
+    return "borderline" if row.get("borderline") else (
+        "PASS" if row["meets_tolerances"] else "FAIL")
 
 if __name__ == "__main__":
     main()

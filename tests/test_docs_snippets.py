@@ -83,3 +83,51 @@ def solver_table(doc: dict) -> str:
                        else "not installed")
         lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines)
+
+
+def study_findings(doc: dict) -> str:
+    """The README's "What it finds" bullets, from docs/figures/main-job.json's ``findings``
+    (benchmarks/bench_main_job.py reads them from the study's own study.json)."""
+    f = doc["findings"]
+    s, t = f["steady"], f["transient"]
+
+    def verdict(case: dict) -> str:
+        return {"PASS": "meets both tolerances", "FAIL": "fails",
+                "borderline": "is borderline (within the reference's uncertainty)"}[
+            case["paper11_verdict"]]
+
+    def others(case: dict) -> str:
+        passing, edge = case["lumped_passing"], case["lumped_borderline"]
+        parts = []
+        if passing:
+            parts.append(f"{', '.join(passing)} meet{'s' if len(passing) == 1 else ''} them")
+        if edge:
+            parts.append(f"{', '.join(edge)} {'is' if len(edge) == 1 else 'are'} borderline")
+        return "; ".join(parts) if parts else "no other lumped model meets them"
+
+    return "\n".join([
+        f"- **FEM reference.** Ground truth at level {f['ground_truth_level']}, worst grid "
+        f"convergence index {f['worst_GCI_pct']:.2g} %; the transient's temporal error "
+        f"{f['time_error_K']:.1g} K.",
+        f"- **The paper's 11-node model**, at the nominal point ({s['case']}): "
+        f"{s['paper11_worst_K']:.1f} K and {s['paper11_P1_um']:.1f} µm off; it "
+        f"{verdict(s)}. Over the cycle ({t['case']}): {t['paper11_worst_K']:.1f} K and "
+        f"{t['paper11_P1_um']:.1f} µm; it {verdict(t)}.",
+        f"- **More nodes.** At the nominal point {others(s)}: the error stops falling at the "
+        f"model-form floor of one temperature per slice. Over the cycle {others(t)}."])
+
+
+def test_the_readme_quotes_the_study_findings():
+    """The README's findings are those of the study in docs/figures/main-job.json, so a
+    changed result breaks this test instead of leaving stale text."""
+    import json
+
+    doc = json.loads((ROOT / "docs" / "figures" / "main-job.json").read_text(encoding="utf-8"))
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert study_findings(doc) in readme, study_findings(doc)
+
+
+def test_the_readme_is_short():
+    """The README is for users: what the tool is for, the two commands, what it finds, the
+    commands and where to read more; method and history live in docs/ (issue 34)."""
+    assert len((ROOT / "README.md").read_text(encoding="utf-8").splitlines()) <= 150
