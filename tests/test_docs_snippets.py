@@ -96,25 +96,30 @@ def study_findings(doc: dict) -> str:
                 "borderline": "is borderline (within the reference's uncertainty)"}[
             case["paper11_verdict"]]
 
+    def listed(names: list[str]) -> str:
+        return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
     def others(case: dict) -> str:
         passing, edge = case["lumped_passing"], case["lumped_borderline"]
         parts = []
         if passing:
-            parts.append(f"{', '.join(passing)} meet{'s' if len(passing) == 1 else ''} them")
+            parts.append(f"{listed(passing)} meet{'s' if len(passing) == 1 else ''} both "
+                         "tolerances")
         if edge:
-            parts.append(f"{', '.join(edge)} {'is' if len(edge) == 1 else 'are'} borderline")
-        return "; ".join(parts) if parts else "no other lumped model meets them"
+            parts.append(f"{listed(edge)} {'is' if len(edge) == 1 else 'are'} borderline "
+                         "(within the reference's uncertainty of a tolerance)")
+        return "; ".join(parts) if parts else "no lumped model meets both tolerances"
 
     return "\n".join([
         f"- **FEM reference.** Ground truth at level {f['ground_truth_level']}, worst grid "
         f"convergence index {f['worst_GCI_pct']:.2g} %; the transient's temporal error "
         f"{f['time_error_K']:.1g} K.",
-        f"- **The paper's 11-node model**, at the nominal point ({s['case']}): "
+        f"- **The paper's 11-node model**, at the nominal point (`{s['case']}`): "
         f"{s['paper11_worst_K']:.1f} K and {s['paper11_P1_um']:.1f} µm off; it "
-        f"{verdict(s)}. Over the cycle ({t['case']}): {t['paper11_worst_K']:.1f} K and "
+        f"{verdict(s)}. Over the cycle (`{t['case']}`): {t['paper11_worst_K']:.1f} K and "
         f"{t['paper11_P1_um']:.1f} µm; it {verdict(t)}.",
         f"- **More nodes.** At the nominal point {others(s)}: the error stops falling at the "
-        f"model-form floor of one temperature per slice. Over the cycle {others(t)}."])
+        f"model-form floor of one temperature per slice. Over the cycle, {others(t)}."])
 
 
 def test_the_readme_quotes_the_study_findings():
