@@ -31,6 +31,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
+from verdicts import require_files
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
@@ -80,6 +81,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
+    require_files(args.runs, "the runs")
     runs = args.runs or [p for p in PEER_CONTROLS if p.exists()]
     if not args.runs:
         runs += [synthetic_clean(s) for s in range(1, 5)]

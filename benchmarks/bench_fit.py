@@ -17,6 +17,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from verdicts import require_files
+
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
 
@@ -27,6 +29,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--keep", help="keep the run and the report in this folder")
     ap.add_argument("--run", type=Path, help="time this bench export instead of a synthetic run")
     args = ap.parse_args(argv)
+    if args.run is not None:
+        require_files([args.run], "--run")
 
     from compare.fit.greybox import GreyBox
     from compare.fit.report import save_report

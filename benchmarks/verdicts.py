@@ -77,6 +77,16 @@ def named_text(named: Sequence[str], unexplained: bool) -> str:
     return ", ".join(named) or ("unexplained" if unexplained else "nothing")
 
 
+def require_files(paths, what: str) -> None:
+    """End the script with one message and exit status 2, not a traceback, where one of
+    ``paths`` is not a file (``what`` says which argument gave it)."""
+    missing = [str(p) for p in paths if not Path(p).is_file()]
+    if missing:
+        print(f"error: {', '.join(missing)}: not found; {what} must name existing bench "
+              "exports (CSV, docs/bench.md)", file=sys.stderr)
+        sys.exit(2)
+
+
 def read_truth(folder: Path) -> dict:
     """The runs' truth.json of a folder; a missing or broken one ends the script with one
     message and exit status 2, not a traceback."""
