@@ -9,7 +9,10 @@ cycle's name or file (``"nominal"``, ``"spl-16h"``, a cycle TOML or CSV), a
 - :func:`solve`: the FEM reference or a lumped model, steady or over a cycle;
 - :func:`reference_model`, :func:`lumped_model`: the models themselves;
 - :func:`study`: the verification study (grid convergence, accuracy against unknowns);
-- :func:`fit`: a test-bench run: calibrate, and find the effect the model lacks;
+- :func:`fit`: a test-bench run: calibrate, and find the effect the model lacks
+  (``report.save(folder)``); :func:`synth`: a synthetic bench run with effects of your
+  choice; :func:`register_effect`: an effect of your own (a subclass of :class:`Effect`
+  with :class:`Param` parameters) for ``fit`` and ``synth`` to consider;
 - :func:`model_error`, :func:`assert_within`: one model against the reference, for tests
   (the pytest fixture ``spindle_verify`` calls them: spindle_verify.pytest_plugin).
 
@@ -28,13 +31,15 @@ if TYPE_CHECKING:  # the types, for readers and type checkers; imported lazily a
     from lumped.simulation import LumpedModel
     from reference.simulation import ReferenceModel
 
-__all__ = ["FitReport", "LumpedModel", "ReferenceModel", "StudyResult", "Verdict",
-           "__version__", "assert_within", "fit", "lumped_model", "model_error",
-           "reference_model", "solve", "study"]
+__all__ = ["Effect", "FitReport", "LumpedModel", "Param", "ReferenceModel", "StudyResult",
+           "TimeSeries", "Verdict", "__version__", "assert_within", "fit", "lumped_model",
+           "model_error", "reference_model", "register_effect", "solve", "study", "synth",
+           "unregister_effect"]
 
 _TYPES = {"FitReport": "compare.fit.run", "StudyResult": "compare.verify.study",
           "Verdict": "compare.verify.within", "LumpedModel": "lumped.simulation",
-          "ReferenceModel": "reference.simulation"}
+          "ReferenceModel": "reference.simulation", "Effect": "compare.fit.effects",
+          "Param": "compare.fit.params", "TimeSeries": "spindle.loads"}
 
 
 def __getattr__(name: str) -> Any:
@@ -101,6 +106,33 @@ def fit(run: str | Path, spec="spl2782", **options) -> FitReport:
     from spindle.spec_reader import as_spec
 
     return run_fit(run, as_spec(spec), **options)
+
+
+def synth(spec, cycle: str, effect, seed: int, out_csv: str | Path, **options) -> dict:
+    """A synthetic bench run of ``spec`` over ``cycle``: the FEM reference with ``effect``
+    (an effect's name, several in a list, ``"clean"``, or a cause outside the library) of a
+    size drawn from ``seed``, written as a bench CSV to ``out_csv`` with its truth beside it
+    (``RUN.truth.json``; ``fit`` never reads it). Returns the truth. Options as
+    :func:`compare.fit.synth.synth` (``level``, ``dt_s``, ``mismatch``)."""
+    from compare.fit.synth import synth as make
+    from spindle.spec_reader import as_spec
+
+    return make(as_spec(spec), cycle, effect, seed, Path(out_csv), **options)
+
+
+def register_effect(effect) -> None:
+    """Add an effect of your own (an :class:`Effect` instance) to the library that ``fit``
+    and ``synth`` use (docs/examples/ex05_own_effect.py)."""
+    from compare.fit.effects import register
+
+    register(effect)
+
+
+def unregister_effect(name: str) -> None:
+    """Remove the effect ``name`` from the library."""
+    from compare.fit.effects import unregister
+
+    unregister(name)
 
 
 def model_error(spec, model: str, case: str | None = None, reference_level: int = 2,

@@ -47,3 +47,17 @@ def test_assert_within_is_a_plain_function():
     with pytest.raises(AssertionError, match=r"temperature error \d+\.\d+ K > 1 K \(worst: "):
         sv.assert_within("spl2782", "lumped:11", case="nominal", reference_level=1)
     assert sv.model_error("spl2782", "lumped:11", "nominal", 1).worst_temp_K > 1.0
+
+
+def test_the_examples_use_only_the_public_name():
+    """docs/examples/ import the tool as spindle_verify alone (issue 34: the README and the
+    examples use only it), so a user copying them needs no internal module."""
+    import ast
+    from pathlib import Path
+
+    internal = {"compare", "spindle", "reference", "lumped", "meshes"}
+    for path in sorted((Path(__file__).resolve().parents[1] / "docs" / "examples").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                     [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            assert not {n.split(".")[0] for n in names} & internal, (path.name, names)

@@ -271,6 +271,13 @@ class FitReport:
 
         return report_dict(self)
 
+    def save(self, out: str | Path, pictures: bool = True) -> list[Path]:
+        """report.json, report.html, the tables and (``pictures``) the PNGs into ``out``
+        (what ``spindle-verify fit`` writes); the paths written."""
+        from compare.fit.report import save_report
+
+        return save_report(self, Path(out), pictures)
+
 
 def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
             nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,

@@ -21,22 +21,20 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from compare.fit.report import save_report
-from compare.fit.run import run_fit
-from compare.fit.synth import synth
-from spindle.spec_reader import load_spec
+import spindle_verify
 
 
 def main(out: Path, run: Path | None = None, candidates: Sequence[str] | None = None) -> dict:
     """Fit ``run`` (synthesised into ``out/run.csv`` if None) and write the report to ``out``;
     returns report.json's content. ``candidates``: the effects to try (None: all)."""
-    spec = load_spec("spl2782")
     out.mkdir(parents=True, exist_ok=True)
     if run is None:
         run = out / "run.csv"
         # writes run.csv and run.truth.json (what was injected; fit never reads it)
-        synth(spec, "spl-16h", "fixture_expansion", seed=2, out_csv=run, level=0)
-    report = run_fit(run, spec, candidates=list(candidates) if candidates else None)
+        spindle_verify.synth("spl2782", "spl-16h", "fixture_expansion", seed=2, out_csv=run,
+                             level=0)
+    report = spindle_verify.fit(run, spec="spl2782",
+                                candidates=list(candidates) if candidates else None)
     doc = report.to_dict()
 
     print(doc["verdict"]["summary"])  # the verdict first, as `spindle-verify fit` prints it
@@ -50,7 +48,7 @@ def main(out: Path, run: Path | None = None, candidates: Sequence[str] | None = 
             f"{k} = {v:.3g}" for k, v in injected["parameters"].items()))
     for channel, e in doc["error_after"]["validation"].items():
         print(f"  {channel}: open-loop RMS {e['rmse']:.3f} {e['unit']} on the validation window")
-    files = save_report(report, out, pictures=False)  # pictures=True adds the PNGs
+    files = report.save(out, pictures=False)  # pictures=True adds the PNGs
     print(f"wrote {', '.join(f.name for f in files)} to {out}")
     return doc
 

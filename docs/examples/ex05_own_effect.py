@@ -7,7 +7,7 @@ friction torque that barely depends on speed, so it heats the rear bearing's sea
 c * n / 1000 rpm watts. The spindle's spec knows no such seal. The effect is a subclass of
 :class:`compare.fit.effects.Effect` that declares its one parameter (unit, neutral value,
 bounds, source), its heat in the grey box (the ``heat`` hook), its heat in a synthetic FEM
-run (``synth_case``) and a size to draw (``draw``). :func:`compare.fit.effects.register`
+run (``synth_case``) and a size to draw (``draw``). :func:`spindle_verify.register_effect`
 adds it to the library. From then on ``synth`` can inject it, and ``fit`` tries it beside
 the library's own effects and judges it by the same criteria (compare.fit.criteria). It has
 no signature test, so it is named only by the open loop: it must predict held-out blocks,
@@ -25,13 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.fit.effects import Effect, register, unregister
-from compare.fit.params import Param
-from compare.fit.report import save_report
-from compare.fit.run import run_fit
-from compare.fit.synth import synth
-from spindle.loads import TimeSeries
-from spindle.spec_reader import load_spec
+import spindle_verify
+from spindle_verify import Effect, Param, TimeSeries
 
 
 class RearSealFriction(Effect):
@@ -73,17 +68,16 @@ def main(out: Path, seed: int = 4) -> dict:
     """Register the seal, synthesise a level-0 FEM run of the paper's 16 h cycle with it
     into ``out/run.csv``, fit it, write the report to ``out``; returns report.json's content
     with the truth beside it (``doc["truth"]``). The effect leaves the library afterwards."""
-    spec = load_spec("spl2782")
     out.mkdir(parents=True, exist_ok=True)
-    register(RearSealFriction())
+    spindle_verify.register_effect(RearSealFriction())
     try:
-        truth = synth(spec, "spl-16h", "rear_seal_friction", seed=seed, out_csv=out / "run.csv",
-                      level=0)
-        report = run_fit(out / "run.csv", spec)
-        save_report(report, out, pictures=False)
+        truth = spindle_verify.synth("spl2782", "spl-16h", "rear_seal_friction", seed=seed,
+                                     out_csv=out / "run.csv", level=0)
+        report = spindle_verify.fit(out / "run.csv", spec="spl2782")
+        report.save(out, pictures=False)
         doc = report.to_dict()
     finally:
-        unregister("rear_seal_friction")
+        spindle_verify.unregister_effect("rear_seal_friction")
     doc["truth"] = truth
     return doc
 
