@@ -3,7 +3,10 @@ time per transient step and peak memory; then a 16 h cycle at 60 s steps.
 
     python benchmarks/bench_reference.py [SPEC] [--levels 0 1 2 3] [--order 2] [--cycle-level 2]
 
-Each level runs in its own process so that peak memory (ru_maxrss) belongs to that level.
+Each level runs in its own process so that peak memory (VmHWM; getrusage's ru_maxrss would
+carry the parent's over exec) belongs to that level. The figures go to ``--out`` (default
+docs/figures/reference-speed.json), from which docs/commands.md's table is checked
+(tests/test_docs_snippets.py).
 Targets (issue 2, 2-core machine): a steady solve at >= 1e5 DOF in <= 1 s; the 16 h cycle
 on the ground-truth level in <= 30 s.
 """
@@ -12,13 +15,24 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
+import os
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+from figures import write_figures
+
 ROOT = Path(__file__).resolve().parents[1]
+
+
+def _peak_MB() -> float:
+    """This process's peak resident memory [MB] (VmHWM, its own since exec)."""
+    with open(f"/proc/{os.getpid()}/status") as f:
+        for line in f:
+            if line.startswith("VmHWM"):
+                return int(line.split()[1]) / 1024
+    return float("nan")
 
 
 def one_level(spec_name: str, level: int, order: int) -> dict:
@@ -57,7 +71,7 @@ def one_level(spec_name: str, level: int, order: int) -> dict:
     return {"level": level, "elements": c["elements"], "dofs": int(model.basis.N),
             "mesh_s": t_mesh, "assembly_s": t_asm, "factorisation_s": t_fact,
             "substitution_s": t_subst, "steady_solve_s": t_steady, "step_s": t_step,
-            "peak_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
+            "peak_MB": _peak_MB()}
 
 
 def cycle(spec_name: str, level: int, order: int, hours: float = 16.0) -> dict:
@@ -89,7 +103,7 @@ def cycle(spec_name: str, level: int, order: int, hours: float = 16.0) -> dict:
             "setup_s": t_setup, "steady_te_s": t_steady, "cycle_s": t_run,
             "P1_peak_um": float(res.growth_m["P1"].max() * 1e6),
             "relative_imbalance": res.energy["relative_imbalance"],
-            "peak_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
+            "peak_MB": _peak_MB()}
 
 
 def main() -> None:
@@ -98,6 +112,7 @@ def main() -> None:
     ap.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2, 3])
     ap.add_argument("--order", type=int, default=2)
     ap.add_argument("--cycle-level", type=int, default=2)
+    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "figures" / "reference-speed.json")
     ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
@@ -137,6 +152,9 @@ def main() -> None:
           f" + setup {c['setup_s']:.2f} s (target <= 30 s: ratio "
           f"{(c['cycle_s'] + c['setup_s']) / 30:.2f}); energy imbalance "
           f"{c['relative_imbalance']:.1e}; peak {c['peak_MB']:.0f} MB")
+    write_figures(args.out, "python benchmarks/bench_reference.py",
+                  {"spec": args.spec, "order": args.order, "cores": os.cpu_count(),
+                   "python": sys.version.split()[0], "levels": rows, "cycle": c})
 
 
 if __name__ == "__main__":

@@ -136,3 +136,35 @@ def test_the_readme_is_short():
     """The README is for users: what the tool is for, the two commands, what it finds, the
     commands and where to read more; method and history live in docs/ (issue 34)."""
     assert len((ROOT / "README.md").read_text(encoding="utf-8").splitlines()) <= 150
+
+
+def reference_speed_text(doc: dict) -> str:
+    """docs/commands.md's speed table of the reference and its cycle sentence, from
+    docs/figures/reference-speed.json (benchmarks/bench_reference.py)."""
+    def n(v: int) -> str:
+        return f"{v:,}".replace(",", " ")
+
+    lines = ["| level | elements | DOFs (P2) | assembly s | factorisation s | steady solve s "
+             "| step ms | peak MB |", "|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in doc["levels"]:
+        lines.append(f"| {r['level']} | {n(r['elements'])} | {n(r['dofs'])} | "
+                     f"{r['assembly_s']:.2g} | {r['factorisation_s']:.2g} | "
+                     f"{r['steady_solve_s']:.2g} | {r['step_s'] * 1e3:.2g} | "
+                     f"{r['peak_MB']:.0f} |")
+    c, big = doc["cycle"], doc["levels"][-1]
+    lines += ["", f"Steady solve at {n(big['dofs'])} DOFs: **{big['steady_solve_s']:.2f} s** "
+              f"(target ≤ 1 s). 16 h cycle at 60 s steps on level {c['level']} "
+              f"({c['steps']} steps), with the thermoelastic growth at every step: "
+              f"**{c['cycle_s']:.1f} s + {c['setup_s']:.1f} s set-up** (target ≤ 30 s). "
+              f"Measured {doc['date']} at commit {doc['commit']}."]
+    return "\n".join(lines)
+
+
+def test_commands_md_quotes_the_measured_reference_speed():
+    """The speed table of docs/commands.md is docs/figures/reference-speed.json's."""
+    import json
+
+    doc = json.loads((ROOT / "docs" / "figures" / "reference-speed.json").read_text(
+        encoding="utf-8"))
+    text = (ROOT / "docs" / "commands.md").read_text(encoding="utf-8")
+    assert reference_speed_text(doc) in text, reference_speed_text(doc)
