@@ -303,7 +303,7 @@ GENERATOR_KEYS = {
 #: cycles drawn from a seed (:func:`drawn_cycle`) rather than loaded
 RANDOM_CYCLES = ("random", "random-loaded", "random-ramped-load")
 #: the top speed of a drawn cycle [rpm]: the SPL2782 family's bench runs go to 6000 rpm
-#: (a peer's runs in ../shared/bench-runs), above the spl-16h cycle's rated 4300 rpm
+#: (a peer's runs in tests/data/peer-runs/bench-runs), above the spl-16h cycle's rated 4300 rpm
 RANDOM_MAX_SPEED_RPM = 6000.0
 
 
@@ -328,7 +328,7 @@ def random_cycle(rng: np.random.Generator, max_speed_rpm: float, loaded: bool = 
     random (non-monotonic) order over 15-100 % of ``max_speed_rpm`` [rpm], rounded to
     100 rpm, the top speed among them, and a 2 h cool-down; loaded runs hold a process torque
     of 0-40 N m per step. ``ramped`` (a loaded run as a bench logs one, e.g. a peer's
-    ../shared/bench-runs/dev-08): within each speed step the torque ramps from a low level of
+    tests/data/peer-runs/bench-runs/dev-08): within each speed step the torque ramps from a low level of
     5-20 N m up to 10-25 N m above it and back, in 5 min steps (:func:`ramped_steps`). Ambient
     drift and chiller cycling as the shipped cycles."""
     total = duration_h * 3600.0

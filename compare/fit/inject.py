@@ -1,7 +1,7 @@
 """Measurement-side effects injected into a recorded bench run (issue 13: test against data
 this project did not make).
 
-A peer's control run (../shared/bench-runs, truth ``none``) carries the base misfit of a real
+A peer's control run (tests/data/peer-runs/bench-runs, truth ``none``) carries the base misfit of a real
 spindle that the spec describes only approximately: this project's model did not make it.
 The library's effects that act on the measurement alone (``measurement_only``: a centrifugal
 jump, a fixture's term, a sensor's lag) can be added to such a run through their own
@@ -11,7 +11,7 @@ sample-to-sample scatter) is added back after it.
 
 Injected values are rounded to the decimals the column was logged with (the bench's
 quantisation), empty cells stay empty, and a comment line records what was injected. Units:
-um, K, s, rpm, as the bench format (../shared/bench-format.md).
+um, K, s, rpm, as the bench format (tests/data/peer-runs/bench-format.md).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@
 reference (not the lumped model the fit uses) over the cycle with the effects built into the
 physics or the measurement, then samples it the way a bench logs: irregular times (about
 1 Hz), sensor noise and quantisation, a gap, empty cells, comment metadata and an extra
-column, in the bench format (../shared/bench-format.md). The truth (effects, their
+column, in the bench format (tests/data/peer-runs/bench-format.md). The truth (effects, their
 parameters, the seed) goes to ``RUN.truth.json`` beside the CSV; ``fit`` never reads it.
 
 Each effect enters through its own hooks (compare.fit.effects.base.Effect): the spindle (a
