@@ -21,18 +21,9 @@ import sys
 import time
 from pathlib import Path
 
-from figures import write_figures
+from figures import memory_MB, write_figures
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _peak_MB() -> float:
-    """This process's peak resident memory [MB] (VmHWM, its own since exec)."""
-    with open(f"/proc/{os.getpid()}/status") as f:
-        for line in f:
-            if line.startswith("VmHWM"):
-                return int(line.split()[1]) / 1024
-    return float("nan")
 
 
 def one_level(spec_name: str, level: int, order: int) -> dict:
@@ -71,7 +62,7 @@ def one_level(spec_name: str, level: int, order: int) -> dict:
     return {"level": level, "elements": c["elements"], "dofs": int(model.basis.N),
             "mesh_s": t_mesh, "assembly_s": t_asm, "factorisation_s": t_fact,
             "substitution_s": t_subst, "steady_solve_s": t_steady, "step_s": t_step,
-            "peak_MB": _peak_MB()}
+            "peak_MB": memory_MB()}
 
 
 def cycle(spec_name: str, level: int, order: int, hours: float = 16.0) -> dict:
@@ -103,7 +94,7 @@ def cycle(spec_name: str, level: int, order: int, hours: float = 16.0) -> dict:
             "setup_s": t_setup, "steady_te_s": t_steady, "cycle_s": t_run,
             "P1_peak_um": float(res.growth_m["P1"].max() * 1e6),
             "relative_imbalance": res.energy["relative_imbalance"],
-            "peak_MB": _peak_MB()}
+            "peak_MB": memory_MB()}
 
 
 def main() -> None:

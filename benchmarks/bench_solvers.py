@@ -25,23 +25,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from figures import write_figures
+from figures import memory_MB, write_figures
 
 ROOT = Path(__file__).resolve().parents[1]
 
 SOLVERS = ("superlu", "superlu-colamd", "cholmod", "umfpack", "pardiso")
 #: where each optional solver comes from (pip names)
 SOURCES = {"cholmod": "scikit-sparse", "umfpack": "scikit-umfpack", "pardiso": "pypardiso"}
-
-
-def _status_MB(field: str) -> float:
-    """A memory figure of this process from /proc (VmRSS now, VmHWM its peak) [MB]. VmHWM,
-    not getrusage's ru_maxrss, which Linux carries over from the parent across exec."""
-    with open(f"/proc/{os.getpid()}/status") as f:
-        for line in f:
-            if line.startswith(field):
-                return int(line.split()[1]) / 1024
-    return float("nan")
 
 
 def _factoriser(name: str):
@@ -92,7 +82,7 @@ def run_one(matrix: Path, solver: str, repeat: int) -> dict:
     make = _factoriser(solver)
     if make is None:
         return {"solver": solver, "installed": False}
-    base = _status_MB("VmRSS")
+    base = memory_MB("VmRSS")
     best_f = best_s = float("inf")
     for _ in range(repeat):
         # the first solve is counted with the factorisation: PARDISO's factorized() is lazy
@@ -104,7 +94,7 @@ def run_one(matrix: Path, solver: str, repeat: int) -> dict:
         x = solve(b)
         best_s = min(best_s, time.perf_counter() - t)
         del solve
-    peak = _status_MB("VmHWM")
+    peak = memory_MB("VmHWM")
     res = float(np.linalg.norm(A @ x - b) / np.linalg.norm(b))
     return {"solver": solver, "installed": True, "factor_s": round(best_f, 3),
             "solve_ms": round(1e3 * best_s, 1), "peak_MB": round(peak - base),

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import datetime
 import json
+import os
 import subprocess
 from pathlib import Path
 
@@ -23,3 +24,13 @@ def write_figures(path: Path, made_by: str, fields: dict) -> None:
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
     tmp.replace(path)
+
+
+def memory_MB(field: str = "VmHWM") -> float:
+    """A memory figure of this process from /proc [MB]: ``VmHWM`` its peak resident memory
+    since exec (getrusage's ru_maxrss carries the parent's over exec), ``VmRSS`` now."""
+    with open(f"/proc/{os.getpid()}/status") as f:
+        for line in f:
+            if line.startswith(field):
+                return int(line.split()[1]) / 1024
+    return float("nan")

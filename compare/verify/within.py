@@ -40,17 +40,13 @@ class Verdict:
 def model_error(spec_ref: str, model: str, case: str | None = None, reference_level: int = 2,
                 dt_s: float = 120.0) -> Verdict:
     """Errors of ``model`` against the FEM reference on ``case`` (see the module doc)."""
-    from spindle.cycle_files import load_cycle
-    from spindle.drive import cycle_load_case
-    from spindle.spec_reader import load_spec
+    from spindle.drive import as_load_case
+    from spindle.spec_reader import as_spec
 
-    spec = load_spec(spec_ref)
+    spec = as_spec(spec_ref)
     kind, _, size = model.partition(":")
-    if case is None:
-        load, transient = spec.default_load_case(), False
-    else:
-        load = cycle_load_case(spec, load_cycle(case))
-        transient = case != "nominal"
+    load = as_load_case(spec, case)  # None: the spec's own steady case
+    transient = case is not None and case != "nominal"
     dt = dt_s if transient else None
     T0 = float(load.T_ambient_K(0.0)) if transient else None
     ref = fem_entry(spec, reference_level, load, dt, T0)
