@@ -44,6 +44,31 @@ ROOT = Path(__file__).resolve().parents[1]
 PEER_RUNS = ROOT / "tests" / "data" / "peer-runs"
 CYCLES = ("random", "random-loaded", "random-ramped-load")
 FAMILIES = ("effect", "clean", "outside", "two")
+#: the size every effect of the peer's runs has (tests/data/peer-runs/bench-runs-2/README.md:
+#: "every effect moves some channel by at least 1.5 K or 2 um"): the rates are also given on
+#: the drawn runs whose every effect (or cause outside the library) is at least that large
+FLOOR = {"K": 1.5, "um": 2.0}
+
+
+def effect_sizes(truth_doc: dict) -> list[dict] | None:
+    """Each effect's size by channel [K; um for P1] from a truth file (the synthetic sidecar
+    or a peer's truth.json entry, whose ``Tst`` is T_stator), one dict per effect; None
+    where the file gives none (the peer's first batch)."""
+    by_effect = truth_doc.get("effect_size_by_effect")
+    sizes = list(by_effect.values()) if by_effect else (
+        [truth_doc["effect_size_by_channel"]] if truth_doc.get("effect_size_by_channel")
+        else None)
+    if sizes is None:
+        return None
+    return [{("T_stator" if c == "Tst" else c): float(v) for c, v in s.items()} for s in sizes]
+
+
+def at_floor(sizes: list[dict] | None) -> bool | None:
+    """Every effect moves some channel by at least :data:`FLOOR` (None: sizes unknown)."""
+    if sizes is None:
+        return None
+    return all(any(v >= (FLOOR["um"] if c == "P1" else FLOOR["K"]) for c, v in s.items())
+               for s in sizes)
 
 
 @dataclass(frozen=True)
@@ -54,6 +79,7 @@ class FamilyRun:
     spec: str = "spl2782"
     path: str | None = None  # a peer's run (family "peers")
     truth: object = None  # a peer's truth
+    truth_doc: dict | None = None  # a peer's whole truth.json entry (its effect sizes)
     reports: str | None = None  # a folder for each run's report.json (--reports)
     criteria: tuple = ()  # (name, value) pairs set in compare.fit.criteria.Criteria
 
@@ -92,6 +118,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
     t0 = time.perf_counter()
     if case.path:
         run, truth = Path(case.path), case.truth
+        sizes = effect_sizes(case.truth_doc or {})
     else:
         effects, cycle = draw(case.family, case.seed)
         run = Path(case.cache) / f"{case.family}-{case.seed}.csv"
@@ -101,13 +128,15 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
                   mismatch=True)
         doc = json.loads(sidecar.read_text(encoding="utf-8"))
         truth = doc["effect"]
+        sizes = effect_sizes(doc)
         if case.family == "outside":
             truth = "unexplained"
         elif truth == "clean":
             truth = None
     t_synth = time.perf_counter() - t0
     if synth_only:
-        return {"family": case.family, "run": case.label, "truth": truth, "synth_s": t_synth}
+        return {"family": case.family, "run": case.label, "truth": truth, "synth_s": t_synth,
+                "sizes": sizes}
     from compare.fit.criteria import Criteria
 
     rep = run_fit(run, spec, criteria=Criteria().with_options(**dict(case.criteria)))
@@ -126,7 +155,8 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             "named": out["named"], "verdict": out["verdict"],
             "unexplained": out["unexplained"], **verdict,
             "rms_within_tolerance": rms_ok, "validation_rmse": out["validation_rmse"],
-            "fit_s": rep.runtime_s, "synth_s": t_synth}
+            "fit_s": rep.runtime_s, "synth_s": t_synth, "sizes": sizes,
+            "at_floor": at_floor(sizes)}
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float, float]:
@@ -163,14 +193,24 @@ def summary(rows: list[dict]) -> list[str]:
         return lines
 
     out = ["rates (95 % Wilson intervals):"]
+
+    def floor_rate(label: str, hit, of) -> list[str]:
+        """The same rate on the runs whose effects are at least the peer's floor (sizes
+        known; the peer's first batch gives none)."""
+        return rate(f"{label}, at the floor", hit, lambda r: of(r) and r.get("at_floor"))
+
     out += rate("true effect named first (runs with an effect)", lambda r: r["first"],
                 lambda r: r["kind"] in ("effect", "effects"))
     out += rate("nothing named on clean runs", lambda r: not r["named"],
                 lambda r: r["kind"] == "control")
     out += rate("'unexplained' on clean runs (a false alarm)", lambda r: r["unexplained"],
                 lambda r: r["kind"] == "control")
+    out += floor_rate("true effect named first", lambda r: r["first"],
+                      lambda r: r["kind"] in ("effect", "effects"))
     out += rate("unexplained, nothing named (runs outside the library)", lambda r: r["right"],
                 lambda r: r["kind"] == "outside")
+    out += floor_rate("unexplained, nothing named", lambda r: r["right"],
+                      lambda r: r["kind"] == "outside")
     out += rate("a false second effect (after a right first)", lambda r: r["false_second"],
                 lambda r: bool(r["first"]))
     out += rate("a wrong effect named (any run)", lambda r: r["wrong"], lambda r: True)
@@ -257,7 +297,8 @@ def main(argv: list[str] | None = None) -> None:
                 continue
             truth = read_truth(folder)
             cases += [FamilyRun("peers", 0, str(args.cache), path=str(folder / f"{k}.csv"),
-                                truth=v.get("truth"), reports=reports, criteria=criteria)
+                                truth=v.get("truth"), truth_doc=v, reports=reports,
+                                criteria=criteria)
                       for k, v in sorted(truth.items())]
 
     if args.synth_only:

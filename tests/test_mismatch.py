@@ -153,3 +153,64 @@ def test_synth_with_mismatch_records_it(tmp_path, spl):
     assert bench.load_torque_measured
     M = bench.columns["load_torque_Nm"]
     assert set(np.unique(M[np.isfinite(M)])) == {0.0, 20.0}
+
+
+def test_synth_records_each_effects_size_as_the_peers_truth_does(tmp_path, spl):
+    """The truth sidecar gives the largest change the injected effects make in each channel,
+    as the peer's truth.json does (``effect_size_by_channel``; by effect for several). A
+    fixture's term is analytic: P1 moves by k (T_env - T_env(0)), so on a room drifting by
+    2 K its size is |k| 2 K in um, and no temperature moves (the test's tolerance is the
+    sidecar's 4 decimals); a lag on T1 alone moves T1 alone."""
+    from compare.fit.synth import synth
+
+    cycle = tmp_path / "drift.toml"
+    cycle.write_text('[cycle]\nname = "drift"\ndescription = "2 h"\nsource = "test"\n'
+                     'steps = [ { speed_rpm = 3000.0, duration_h = 1.0 },\n'
+                     '  { speed_rpm = 1000.0, duration_h = 1.0 } ]\n'
+                     '[ambient]\nmodel = "drift"\nT_start_C = 20.0\nT_peak_C = 22.0\n'
+                     't_peak_h = 2.0\nT_end_C = 22.0\nsample_s = 60.0\n'
+                     '[coolant]\nT_C = 20.0\n')
+    truths = {"fixture_expansion": {"k_fix_um_K": -1.5},
+              "sensor_lag": {"channel": "T1", "tau_s": 600.0}}
+    one = synth(spl[0], str(cycle), "fixture_expansion", 1, tmp_path / "a.csv", level=0,
+                truths=truths)
+    size = one["effect_size_by_channel"]
+    assert size["P1"] == pytest.approx(1.5 * 2.0, abs=1e-4)
+    assert size["T1"] == size["T2"] == size["T_stator"] == 0.0
+    both = synth(spl[0], str(cycle), list(truths), 1, tmp_path / "b.csv", level=0,
+                 truths=truths)
+    by = both["effect_size_by_effect"]
+    assert by["fixture_expansion"] == size
+    assert by["sensor_lag"]["T1"] > 0.05 and by["sensor_lag"]["P1"] == 0.0
+    assert both["effect_size_by_channel"]["T1"] == pytest.approx(by["sensor_lag"]["T1"])
+    saved = json.loads((tmp_path / "b.truth.json").read_text())
+    assert saved["effect_size_by_effect"] == by
+
+
+def test_outside_causes_of_a_window_act_only_in_it(tmp_path, spl):
+    """The causes outside the library that act for a window of hours: a coolant flow drop
+    leaves the run as it was before its window (the same seed gives the same samples) and
+    changes it after; an enclosure draft changes the spindle but not the logged room
+    temperature, whose sensor hangs elsewhere."""
+    from compare.fit.synth import synth
+    from spindle.bench import read_bench
+
+    cycle = tmp_path / "c.toml"
+    cycle.write_text('[cycle]\nname = "c"\ndescription = "3 h"\nsource = "test"\n'
+                     'steps = [ { speed_rpm = 4000.0, duration_h = 3.0 } ]\n'
+                     '[ambient]\nT_C = 20.0\n[coolant]\nT_C = 20.0\n')
+    window = {"start_h": 1.0, "duration_h": 1.0}
+    truths = {"coolant_flow_drop": {**window, "R_K_W": 0.006},
+              "enclosure_draft": {**window, "delta_K": 6.0}}
+    runs = {}
+    for name in ("clean", *truths):
+        synth(spl[0], str(cycle), name, 3, tmp_path / f"{name}.csv", level=0, truths=truths)
+        runs[name] = read_bench(tmp_path / f"{name}.csv")
+    clean, drop, draft = runs["clean"], runs["coolant_flow_drop"], runs["enclosure_draft"]
+    before = clean.time_s < 3600.0
+    np.testing.assert_array_equal(drop.columns["T1_C"][before], clean.columns["T1_C"][before])
+    late = (clean.time_s > 1.5 * 3600) & (clean.time_s < 2 * 3600)
+    # the water warms by R Q along the jacket: the rings follow by kelvins (> 0.5 K)
+    assert np.nanmean(drop.columns["T1_C"][late] - clean.columns["T1_C"][late]) > 0.5
+    np.testing.assert_array_equal(draft.columns["T_env_C"], clean.columns["T_env_C"])
+    assert np.nanmean(draft.columns["T1_C"][late] - clean.columns["T1_C"][late]) > 0.1

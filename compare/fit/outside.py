@@ -10,15 +10,37 @@ which are laws of the inputs:
 - ``coolant_sensor_offset``: the coolant temperature the bench logs is off from some time on
   (its sensor moved to the chiller's return), so the model is driven with a wrong input;
 - ``bearing_run_in``: fresh grease: the bearings' friction starts high and decays over hours
-  (the motor supplies it, so the logged power carries it).
+  (the motor supplies it, so the logged power carries it);
+- ``enclosure_draft``: the air around the spindle is warmer or colder for a few hours (an
+  enclosure door open, a neighbour's exhaust) while the room sensor, elsewhere, reads on;
+- ``coolant_flow_drop``: the coolant flow falls for a few hours (a filter clogging, then
+  cleaned): the water warms along the jacket as ``coolant_dynamics`` has it, but only then,
+  so no law of the inputs holds for the whole run.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
-from compare.fit.effects.base import Effect
+from compare.fit.effects.base import Effect, Feedback
 from spindle.loads import TimeSeries
+
+#: the ramp [s] at either end of a window of hours: a door opened, a filter clogging
+RAMP_S = 600.0
+
+
+def _window(t_s, start_h: float, duration_h: float) -> np.ndarray:
+    """0 before ``start_h``, 1 for ``duration_h`` after it, 0 again, with linear ramps of
+    :data:`RAMP_S` [s] in between."""
+    t = np.asarray(t_s, dtype=float)
+    a, b = start_h * 3600.0, (start_h + duration_h) * 3600.0
+    return np.clip((t - a) / RAMP_S, 0.0, 1.0) * np.clip((b + RAMP_S - t) / RAMP_S, 0.0, 1.0)
+
+
+def _draw_window(rng) -> dict:
+    return {"start_h": float(rng.uniform(3.0, 10.0)), "duration_h": float(rng.uniform(1.5, 4.0))}
 
 
 class ElectronicsDrift(Effect):
@@ -93,5 +115,53 @@ class BearingRunIn(Effect):
         return case.with_sources(out), {"power_W": drag}
 
 
+class EnclosureDraft(Effect):
+    name = "enclosure_draft"
+
+    def draw(self, rng):
+        return {**_draw_window(rng), "delta_K": float(rng.choice([-1, 1]) * rng.uniform(4.0, 8.0))}
+
+    def synth_case(self, case, spec, truth):
+        t = np.arange(0.0, case.duration_s + 60.0, 60.0)
+
+        def change(ts):
+            return truth["delta_K"] * _window(ts, truth["start_h"], truth["duration_h"])
+
+        air = TimeSeries(tuple(t), tuple(np.asarray(case.T_ambient_K(t)) + change(t)))
+        # the physics sees it; the bench logs the room from the cycle's own load case
+        # (compare.fit.synth.bench_rows), which does not
+        return replace(case, T_ambient_K=air), {}
+
+
+class CoolantFlowDrop(Effect):
+    name = "coolant_flow_drop"
+
+    def draw(self, rng):
+        return {**_draw_window(rng), "R_K_W": float(rng.uniform(0.003, 0.008))}
+
+    def feedback(self, thermal, spec, truth):
+        from reference.thermal import TWO_PI
+
+        rows = [TWO_PI * s.h_W_m2K(0.0) * b for s, _, b in thermal.op.films
+                if s.T_ref == "coolant"]
+        g = np.sum(rows, axis=0)
+        Gs = float(g.sum())
+
+        def apply(case, x, t):
+            return replace(case, T_coolant_K=TimeSeries(tuple(t), tuple(x)))
+
+        def update(readings, case, t):
+            # as coolant_dynamics, with the resistance of the window: Tm = (Ts + R g.T) /
+            # (1 + R sum g)
+            R = truth["R_K_W"] * _window(t, truth["start_h"], truth["duration_h"])
+            return (np.asarray(case.T_coolant_K(t)) + R * readings["coolant_bT"]) / (1.0 + R * Gs)
+
+        def start(readings, case, t):
+            return np.asarray(case.T_coolant_K(t), dtype=float)
+
+        return Feedback({"coolant_bT": g}, apply, update, start)
+
+
 OUTSIDE: dict[str, Effect] = {e.name: e for e in (ElectronicsDrift(), SensorDrift(),
-                                                 CoolantSensorOffset(), BearingRunIn())}
+                                                 CoolantSensorOffset(), BearingRunIn(),
+                                                 EnclosureDraft(), CoolantFlowDrop())}

@@ -148,6 +148,36 @@ def reference_run(spec: Spec, case: LoadCase, injected: Sequence[tuple[str, dict
     return t, ch, instant
 
 
+def _size(run_a, run_b) -> dict[str, float]:
+    """The largest difference between two runs of :func:`reference_run` over the model grid,
+    per channel, the instantaneous additions included [K; um for P1, as the peer's truth.json
+    gives it]."""
+    (t, a, ia), (_, b, ib) = run_a, run_b
+    out = {}
+    for c in a:
+        ya = a[c] + (ia[c](t) if c in ia else 0.0)
+        yb = b[c] + (ib[c](t) if c in ib else 0.0)
+        scale, _, _ = edge_absolute(c)
+        out[c] = round(float(np.max(np.abs(ya - yb))) * scale, 4)
+    return out
+
+
+def effect_sizes(spec: Spec, case: LoadCase, names: Sequence[str], params: dict,
+                 run, level: int, dt_s: float) -> dict:
+    """How much the injected effects change each channel, as a peer's truth.json records it
+    (tests/data/peer-runs): ``effect_size_by_channel``, the largest difference over the run
+    that they make against the same run without them [K; um for P1], and, for several
+    effects, ``effect_size_by_effect``, each alone. ``run``: the run with all of them
+    (:func:`reference_run`'s output). Costs one FEM transient more per effect."""
+    plain = reference_run(spec, case, [], level, dt_s)
+    out: dict = {"effect_size_by_channel": _size(run, plain)}
+    if len(names) > 1:
+        out["effect_size_by_effect"] = {
+            n: _size(reference_run(spec, case, [(n, params[n])], level, dt_s), plain)
+            for n in names}
+    return out
+
+
 def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, power_W,
                rng: np.random.Generator, rate_hz: float = 1.0, torque_Nm=None,
                instant: dict | None = None) -> tuple[list[str], np.ndarray]:
@@ -236,6 +266,9 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
     case = cycle_load_case(spec, cycle, drive)
     t_model, ch, instant = reference_run(spec, case, [(n, params[n]) for n in names], level,
                                          dt_s)
+    if names:
+        truth.update(effect_sizes(spec, case, names, params, (t_model, ch, instant), level,
+                                  dt_s))
     # electrical power: losses plus mechanical output, per step (no-load cycles: losses)
     starts = np.asarray(cycle.boundaries_s[:-1])
     p_el = []

@@ -57,7 +57,8 @@ class SensorLag(Effect):
         return out
 
     def draw(self, rng):
-        return {"channel": str(rng.choice(["T1", "P1"])), "tau_s": float(rng.uniform(400, 900))}
+        return {"channel": str(rng.choice(["T1", "T2", "T_stator", "P1"])),
+                "tau_s": float(rng.uniform(400, 900))}
 
     def synth_measure(self, t_s, channels, case, truth, reference):
         c = truth["channel"]
