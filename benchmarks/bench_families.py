@@ -16,6 +16,11 @@ effect and its size, the noise and sampling; ``synth --mismatch``):
 - ``two``: two different effects of the library together;
 - ``peers``: the peer's runs in the folders of ``--peers`` (a fixed set, each fitted once).
 
+Half the drawn runs (a stream of their own) are logged by exception, as the peer's second bench
+logs (compare.fit.synth.log_on_change: dead bands and heartbeats, rows with a few channels).
+Each drawn run's truth gives its effects' sizes; the rates are also given on the runs whose
+every effect reaches the peer's stated floor, 1.5 K or 2 um in some channel.
+
 The synthetic runs are kept in ``--cache`` (default benchmarks/.families-cache, ignored by
 git) and fitted again on the next call: they do not depend on the fit. Prints per family the
 share of runs with the right verdict, and the issue's rates with 95 % Wilson intervals: the
@@ -88,6 +93,14 @@ class FamilyRun:
         return Path(self.path).stem if self.path else f"{self.family}-{self.seed}"
 
 
+def logs_on_change(family: str, seed: int) -> bool:
+    """Half the drawn runs are logged by exception, as the peer's second bench logs
+    (compare.fit.synth.log_on_change), from a stream of their own."""
+    import numpy as np
+
+    return bool(np.random.default_rng([seed, 5, FAMILIES.index(family)]).random() < 0.5)
+
+
 def draw(family: str, seed: int) -> tuple[list[str], str]:
     """The effects (or cause outside the library) and the cycle of a family's run ``seed``,
     from a stream of its own (the run's other draws are synth's)."""
@@ -126,6 +139,13 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
         if not (run.exists() and sidecar.exists()):
             synth(spec, cycle, effects if len(effects) > 1 else effects[0], case.seed, run,
                   mismatch=True)
+        if logs_on_change(case.family, case.seed):
+            from compare.fit.synth import log_on_change
+
+            thinned = run.with_name(f"{run.stem}-onchange.csv")
+            if not thinned.exists():
+                log_on_change(run, thinned)
+            run = thinned
         doc = json.loads(sidecar.read_text(encoding="utf-8"))
         truth = doc["effect"]
         sizes = effect_sizes(doc)
@@ -156,6 +176,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             "unexplained": out["unexplained"], **verdict,
             "rms_within_tolerance": rms_ok, "validation_rmse": out["validation_rmse"],
             "fit_s": rep.runtime_s, "synth_s": t_synth, "sizes": sizes,
+            "on_change": bool(not case.path and logs_on_change(case.family, case.seed)),
             "at_floor": at_floor(sizes)}
 
 
@@ -234,10 +255,12 @@ def summary(rows: list[dict]) -> list[str]:
                    for c in runs[0]["validation_rmse"]}
         out.append(f"  validation RMS after, median over {f}: " + ", ".join(
             f"{c} {v:.2f} {edge_unit(c, ascii=True)}" for c, v in medians.items()))
-    times = sorted(r["fit_s"] for r in rows)
-    if times:
-        out.append(f"fit time: median {times[len(times) // 2]:.0f} s, max {times[-1]:.0f} s "
-                   f"over {len(times)} runs")
+    for label, pick in (("", lambda r: True),
+                        (" logged on change (drawn)", lambda r: r.get("on_change"))):
+        times = sorted(r["fit_s"] for r in rows if pick(r))
+        if times:
+            out.append(f"fit time{label}: median {times[len(times) // 2]:.0f} s, max "
+                       f"{times[-1]:.0f} s over {len(times)} runs")
     return out
 
 

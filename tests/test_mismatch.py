@@ -214,3 +214,30 @@ def test_outside_causes_of_a_window_act_only_in_it(tmp_path, spl):
     assert np.nanmean(drop.columns["T1_C"][late] - clean.columns["T1_C"][late]) > 0.5
     np.testing.assert_array_equal(draft.columns["T_env_C"], clean.columns["T_env_C"])
     assert np.nanmean(draft.columns["T1_C"][late] - clean.columns["T1_C"][late]) > 0.1
+
+
+def test_log_on_change_reports_by_exception(tmp_path):
+    """The on-change logger of the drawn runs: a channel that holds still reports on its
+    heartbeat only, one that moves reports each time it leaves its dead band, a scan where
+    nothing reports writes no row, and the result reads as a bench export."""
+    from compare.fit.synth import ON_CHANGE, log_on_change
+    from spindle.bench import read_bench
+
+    t = np.arange(0.0, 2400.0, 1.0)  # 40 min: a bench export needs 30 (spindle.bench)
+    band_T1, beat_T2 = ON_CHANGE["T1_C"][0], ON_CHANGE["T2_C"][1]
+    src = tmp_path / "run.csv"
+    rows = [f"{x:.1f},3000,1.0,20.0,20.0,{20.0 + 0.002 * x:.4f},25.0,30.0,0.0" for x in t]
+    src.write_text("# spindle: spl2782\n# rows: 2400\ntime_s,speed_rpm,power_kW,T_env_C,"
+                   "T_coolant_C,T1_C,T2_C,T_stator_C,P1_um\n" + "\n".join(rows) + "\n")
+    n = log_on_change(src, tmp_path / "oc.csv")
+    run = read_bench(tmp_path / "oc.csv")
+    assert n == len(run.time_s) < len(t) / 3  # one scan in three at most
+    t2, _ = run.channel("T2")
+    # the steady T2 reports on its heartbeat: every beat_T2 s to within a 3 s scan
+    assert np.all(np.abs(np.diff(t2) - beat_T2) <= 3.0 + 1e-9)
+    t1, y1 = run.channel("T1")
+    # T1 climbs 0.002 K/s: it reports each time it has moved past its band, which takes
+    # band / rate s, to within a 3 s scan (0.006 K), unless its heartbeat came first
+    steps = np.diff(y1)
+    assert np.all(steps <= band_T1 + 0.006 + 1e-9)
+    assert np.all((steps > band_T1 - 1e-9) | (np.diff(t1) >= ON_CHANGE["T1_C"][1] - 1e-9))
