@@ -68,10 +68,10 @@ def main(argv: list[str] | None = None) -> None:
         ap.error("--R must be > 0, --seed and --level >= 0")
 
     from compare.fit.greybox import GreyBox
-    from compare.fit.mismatch import Mismatch
     from compare.fit.params import default_theta
     from compare.fit.run import greybox_inputs
-    from compare.fit.synth import reference_run, synth
+    from compare.synth.bench import reference_run, synth
+    from compare.synth.mismatch import Mismatch
     from spindle.bench import read_bench
     from spindle.cycles import drawn_cycle
     from spindle.drive import cycle_load_case, drive_for

@@ -46,7 +46,7 @@ class DevRun:
     cv_blocks: int = 5
     fit_fraction: float = 0.6
     #: fit with the spec's geometry, films and contacts perturbed as this seed's mismatch
-    #: (compare.fit.mismatch.draw_mismatch): the runs as if from yet another variant
+    #: (compare.synth.mismatch.draw_mismatch): the runs as if from yet another variant
     spec_seed: int | None = None
 
     @property
@@ -65,7 +65,7 @@ def fit_one(case: DevRun) -> dict:
     t = time.perf_counter()
     spec = load_spec(case.spec)
     if case.spec_seed is not None:
-        from compare.fit.mismatch import perturbed_spec
+        from compare.synth.mismatch import perturbed_spec
 
         spec = perturbed_spec(spec, case.spec_seed)
     rep = run_fit(case.path, spec, base_extra=case.base_extra,

@@ -12,12 +12,12 @@ effect and its size, the noise and sampling; ``synth --mismatch``):
 - ``effect``: one effect of the library, drawn uniformly, on a drawn cycle (random, loaded,
   or ramped load);
 - ``clean``: none;
-- ``outside``: one cause outside the library (compare.fit.outside), drawn uniformly;
+- ``outside``: one cause outside the library (compare.synth.outside), drawn uniformly;
 - ``two``: two different effects of the library together;
 - ``peers``: the peer's runs in the folders of ``--peers`` (a fixed set, each fitted once).
 
 Half the drawn runs (a stream of their own) are logged by exception, as the peer's second bench
-logs (compare.fit.synth.log_on_change: dead bands and heartbeats, rows with a few channels).
+logs (compare.synth.bench.log_on_change: dead bands and heartbeats, rows with a few channels).
 Each drawn run's truth gives its effects' sizes; the rates are also given on the runs whose
 every effect reaches the peer's stated floor, 1.5 K or 2 um in some channel.
 
@@ -95,7 +95,7 @@ class FamilyRun:
 
 def logs_on_change(family: str, seed: int) -> bool:
     """Half the drawn runs are logged by exception, as the peer's second bench logs
-    (compare.fit.synth.log_on_change), from a stream of their own."""
+    (compare.synth.bench.log_on_change), from a stream of their own."""
     import numpy as np
 
     return bool(np.random.default_rng([seed, 5, FAMILIES.index(family)]).random() < 0.5)
@@ -107,7 +107,7 @@ def draw(family: str, seed: int) -> tuple[list[str], str]:
     import numpy as np
 
     from compare.fit.effects import LIBRARY
-    from compare.fit.outside import OUTSIDE
+    from compare.synth.outside import OUTSIDE
 
     rng = np.random.default_rng([seed, 7, FAMILIES.index(family)])
     cycle = str(rng.choice(CYCLES))
@@ -123,7 +123,7 @@ def draw(family: str, seed: int) -> tuple[list[str], str]:
 def one(case: FamilyRun, synth_only: bool = False) -> dict:
     """Synthesise the run (or reuse it from the cache), fit it, judge the verdict."""
     from compare.fit.run import run_fit
-    from compare.fit.synth import synth
+    from compare.synth.bench import synth
     from spindle.spec_reader import load_spec
     from spindle.tolerances import channel_tolerance, edge_scale
 
@@ -140,7 +140,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             synth(spec, cycle, effects if len(effects) > 1 else effects[0], case.seed, run,
                   mismatch=True)
         if logs_on_change(case.family, case.seed):
-            from compare.fit.synth import log_on_change
+            from compare.synth.bench import log_on_change
 
             thinned = run.with_name(f"{run.stem}-onchange.csv")
             if not thinned.exists():

@@ -47,7 +47,7 @@ def synthetic_clean(seed: int) -> Path:
     sys.path.insert(0, str(ROOT / "benchmarks"))
     from bench_families import draw
 
-    from compare.fit.synth import synth
+    from compare.synth.bench import synth
     from spindle.spec_reader import load_spec
 
     path = CACHE / f"clean-{seed}.csv"

@@ -35,7 +35,7 @@ def main(argv: list[str] | None = None) -> None:
     from compare.fit.greybox import GreyBox
     from compare.fit.report import save_report
     from compare.fit.run import greybox_inputs, run_fit
-    from compare.fit.synth import synth
+    from compare.synth.bench import synth
     from spindle.bench import read_bench
     from spindle.drive import drive_for
     from spindle.spec_reader import load_spec

@@ -1,4 +1,4 @@
-"""Effects injected into a peer's control runs (compare/fit/inject.py): held-out-like cases
+"""Effects injected into a peer's control runs (compare/synth/inject.py): held-out-like cases
 whose base misfit is a real one this project did not make, with magnitudes and channels other
 than the peer's own effect runs.
 
@@ -60,9 +60,9 @@ class Injected:
 
 def fit_one(case: Injected) -> dict:
     """Inject, then ``fit``; the figures the table prints."""
-    from compare.fit.inject import inject
     from compare.fit.report import named_effects, selection_trace
     from compare.fit.run import run_fit
+    from compare.synth.inject import inject
     from spindle.spec_reader import load_spec
 
     t = time.perf_counter()
@@ -74,7 +74,7 @@ def fit_one(case: Injected) -> dict:
         run.write_text(text, encoding="utf-8")
         spec = load_spec(case.spec)
         if case.spec_seed is not None:
-            from compare.fit.mismatch import perturbed_spec
+            from compare.synth.mismatch import perturbed_spec
 
             spec = perturbed_spec(spec, case.spec_seed)
         doc = run_fit(run, spec).to_dict()
@@ -102,7 +102,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--spec", default="spl2782")
     ap.add_argument("--spec-mismatch", type=int, default=None, metavar="SEED",
                     help="fit with the spec perturbed as synth's mismatch of this seed "
-                    "(compare.fit.mismatch.perturbed_spec; as bench_devruns.py)")
+                    "(compare.synth.mismatch.perturbed_spec; as bench_devruns.py)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)

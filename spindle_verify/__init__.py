@@ -113,8 +113,8 @@ def synth(spec, cycle: str, effect, seed: int, out_csv: str | Path, **options) -
     (an effect's name, several in a list, ``"clean"``, or a cause outside the library) of a
     size drawn from ``seed``, written as a bench CSV to ``out_csv`` with its truth beside it
     (``RUN.truth.json``; ``fit`` never reads it). Returns the truth. Options as
-    :func:`compare.fit.synth.synth` (``level``, ``dt_s``, ``mismatch``)."""
-    from compare.fit.synth import synth as make
+    :func:`compare.synth.bench.synth` (``level``, ``dt_s``, ``mismatch``)."""
+    from compare.synth.bench import synth as make
     from spindle.spec_reader import as_spec
 
     return make(as_spec(spec), cycle, effect, seed, Path(out_csv), **options)

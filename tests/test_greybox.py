@@ -1,5 +1,5 @@
 """The grey-box model and the fit loop (compare/fit/greybox.py, compare/fit/calibrate.py, compare/fit/run.py,
-compare/fit/synth.py): nesting of every effect, agreement with the lumped model, calibration
+compare/synth/bench.py): nesting of every effect, agreement with the lumped model, calibration
 intervals, and forward selection on data with a known truth."""
 
 import json
@@ -328,7 +328,7 @@ def test_prior_penalty_and_plausibility(setup):
 def test_anderson_solves_a_slow_linear_fixed_point():
     """x = A x + b with contraction 0.95 (plain iteration: ~300 steps to 1e-6): Anderson
     acceleration reaches the exact solution to 1e-8 in a handful of evaluations."""
-    from compare.fit.synth import _anderson
+    from compare.synth.bench import _anderson
 
     rng = np.random.default_rng(0)
     Q = np.linalg.qr(rng.normal(size=(40, 40)))[0]
@@ -345,7 +345,7 @@ def test_synth_coolant_feedback_is_converged(setup):
     temperature equals (Ts + R g.T) / (1 + R sum g) from the final FEM run, to 1e-3 K (the
     solver's tolerance is 1e-4 K), with R = 0.008 K/W where a fixed number of plain
     iterations would leave most of the effect out."""
-    from compare.fit.synth import _fixed_point
+    from compare.synth.bench import _fixed_point
     from reference import ReferenceModel
     from reference.thermal import TWO_PI
 

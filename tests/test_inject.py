@@ -1,4 +1,4 @@
-"""compare.fit.inject: measurement-side effects added to a recorded run."""
+"""compare.synth.inject: measurement-side effects added to a recorded run."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from compare.fit.inject import first_order_lag, inject, injectable
+from compare.synth.inject import first_order_lag, inject, injectable
 from spindle.commented_csv import split_commented_csv
 
 HEADER = "time_s,speed_rpm,power_kW,T_env_C,T_coolant_C,T1_C,T2_C,T_stator_C,P1_um"
@@ -46,7 +46,7 @@ def test_centrifugal_shortening_follows_n_squared_and_keeps_the_format():
     ok = np.isfinite(p1)
     assert np.allclose(p1[ok & (n == 0)], 1.0) and np.allclose(p1[ok & (n == 4000)], 1.0 - 1.6)
     assert math.isnan(p1[7])  # an empty cell stays empty
-    assert "# injected (compare.fit.inject): centrifugal_shortening" in out
+    assert "# injected (compare.synth.inject): centrifugal_shortening" in out
     assert out.splitlines()[:2] == ["# spindle: test", "# bench: none"]
 
 

@@ -75,15 +75,29 @@ def test_features_do_not_import_each_other():
                 assert other not in FEATURES or other == feature, f"{f} imports {mod}"
 
 
+def test_the_synthetic_bench_stands_on_the_fit_never_under_it():
+    """compare/synth makes test data through the effects' own hooks (compare.fit.effects) and
+    may import the fit; the fit never imports the synthetic bench (a fit does not know how
+    its data were made), and no other feature imports it."""
+    for feature in FEATURES:
+        for f in (ROOT / "compare" / feature).rglob("*.py"):
+            for mod, _ in _imports(f):
+                assert not mod.startswith("compare.synth"), f"{f} imports {mod}"
+    for f in (ROOT / "compare" / "synth").rglob("*.py"):
+        for mod, _ in _imports(f):
+            other = mod.split(".")[1] if mod.startswith("compare.") and mod.count(".") else None
+            assert other in (None, "synth", "fit") or other not in FEATURES, (f, mod)
+
+
 def test_the_import_reader_sees_imports_inside_functions(tmp_path):
     """The import reader above sees an import inside a function (where most of this
     project's imports across packages sit: 168 at the count of issue 31) and a relative one
     (so the rules can fail)."""
     f = tmp_path / "x.py"
-    f.write_text("def g():\n    from compare.fit.mismatch import draw_mismatch\n"
+    f.write_text("def g():\n    from compare.synth.mismatch import draw_mismatch\n"
                  "    import lumped.build\n    return draw_mismatch\nfrom . import y\n")
     found = _imports(f)
-    assert ("compare.fit.mismatch", ["draw_mismatch"]) in found
+    assert ("compare.synth.mismatch", ["draw_mismatch"]) in found
     assert ("lumped.build", []) in found
 
 

@@ -1,4 +1,4 @@
-"""Synthetic runs from a spindle the spec describes only approximately (compare.fit.mismatch,
+"""Synthetic runs from a spindle the spec describes only approximately (compare.synth.mismatch,
 issue 13 §2): the mismatch does what it declares, random cycles are what they claim."""
 
 import json
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from compare.fit.greybox import film_groups
-from compare.fit.mismatch import Mismatch, draw_mismatch, perturbed_spec
+from compare.synth.mismatch import Mismatch, draw_mismatch, perturbed_spec
 from spindle.cycles import ramped_steps, random_cycle
 from spindle.drive import drive_for
 from spindle.faces import exposed_faces, surface_faces
@@ -134,7 +134,7 @@ def test_synth_with_mismatch_records_it(tmp_path, spl):
     """A short loaded run on a mismatched spindle: the truth sidecar holds the mismatch and its
     FEM level; the run reads as a bench export and logs the load torque, without which a fit
     would take the whole electrical power for losses."""
-    from compare.fit.synth import synth
+    from compare.synth.bench import synth
     from spindle.bench import read_bench
 
     cycle = tmp_path / "short.toml"
@@ -161,7 +161,7 @@ def test_synth_records_each_effects_size_as_the_peers_truth_does(tmp_path, spl):
     fixture's term is analytic: P1 moves by k (T_env - T_env(0)), so on a room drifting by
     2 K its size is |k| 2 K in um, and no temperature moves (the test's tolerance is the
     sidecar's 4 decimals); a lag on T1 alone moves T1 alone."""
-    from compare.fit.synth import synth
+    from compare.synth.bench import synth
 
     cycle = tmp_path / "drift.toml"
     cycle.write_text('[cycle]\nname = "drift"\ndescription = "2 h"\nsource = "test"\n'
@@ -192,7 +192,7 @@ def test_outside_causes_of_a_window_act_only_in_it(tmp_path, spl):
     leaves the run as it was before its window (the same seed gives the same samples) and
     changes it after; an enclosure draft changes the spindle but not the logged room
     temperature, whose sensor hangs elsewhere."""
-    from compare.fit.synth import synth
+    from compare.synth.bench import synth
     from spindle.bench import read_bench
 
     cycle = tmp_path / "c.toml"
@@ -220,7 +220,7 @@ def test_log_on_change_reports_by_exception(tmp_path):
     """The on-change logger of the drawn runs: a channel that holds still reports on its
     heartbeat only, one that moves reports each time it leaves its dead band, a scan where
     nothing reports writes no row, and the result reads as a bench export."""
-    from compare.fit.synth import ON_CHANGE, log_on_change
+    from compare.synth.bench import ON_CHANGE, log_on_change
     from spindle.bench import read_bench
 
     t = np.arange(0.0, 2400.0, 1.0)  # 40 min: a bench export needs 30 (spindle.bench)

@@ -33,7 +33,7 @@ COOLANT_MISSED = pytest.mark.xfail(strict=True, reason="coolant not named: the f
     pytest.param("coolant_dynamics", 3, ["coolant_dynamics"], marks=COOLANT_MISSED)])
 def test_fit_on_a_mismatched_run(tmp_path, effect, seed, named):
     from compare.fit.run import run_fit
-    from compare.fit.synth import synth
+    from compare.synth.bench import synth
     from spindle.spec_reader import load_spec
 
     spec = load_spec("spl2782")

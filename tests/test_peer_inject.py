@@ -1,5 +1,5 @@
 """``fit`` on the peer's control runs with a measurement-side effect injected
-(compare/fit/inject.py): the base misfit is the peer's real one, not this project's; the
+(compare/synth/inject.py): the base misfit is the peer's real one, not this project's; the
 truth is known exactly. Right: the injected effect (and for a lag, its channel) named alone.
 
 Slow: one fit of 10-20 s per case. ``python benchmarks/bench_peerinject.py`` prints the whole
@@ -45,9 +45,9 @@ KNOWN_MISSED = [
 def _fit(control: str, effect: str, params: tuple, channel: str | None) -> list[str]:
     import tempfile
 
-    from compare.fit.inject import inject
     from compare.fit.report import named_effects
     from compare.fit.run import run_fit
+    from compare.synth.inject import inject
     from spindle.spec_reader import load_spec
 
     text = inject((PEER_RUNS / f"{control}.csv").read_text(encoding="utf-8"), effect,

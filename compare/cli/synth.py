@@ -16,8 +16,8 @@ if TYPE_CHECKING:
 @with_progress("synth")
 def _cmd_synth(args: argparse.Namespace, progress: Progress) -> int:
     from compare.fit.effects import LIBRARY
-    from compare.fit.outside import OUTSIDE
-    from compare.fit.synth import synth
+    from compare.synth.bench import synth
+    from compare.synth.outside import OUTSIDE
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
@@ -45,7 +45,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     sy = subparsers.add_parser("synth", help="a synthetic bench run from the FEM reference with one "
                         "effect injected; the truth goes to RUN.truth.json")
     from compare.fit.effects import LIBRARY
-    from compare.fit.outside import OUTSIDE
+    from compare.synth.outside import OUTSIDE
 
     sy.add_argument("--spec", default="spl2782",
                     help="the spindle the data come from: a shipped name or a spec file "

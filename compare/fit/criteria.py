@@ -76,6 +76,11 @@ class Criteria:
         "library took it up. 'Base inadequate' said the same and pointed at the spec alone; "
         "the report still gives the adequacy verdict on the spec. False: such runs end "
         "'nothing named, base inadequate'")
+    reanchor: bool = _c(
+        False, "-", "the FEM anchor is set again at the calibrated base values and the base "
+        "recalibrated from there: the grey box is then the FEM where the run calibrates it, "
+        "not only at the spec's values, so the lumped model's sensitivities carry only the "
+        "last step (issue 32, item 4). One FEM run and one calibration more")
     competitor_step_s: float = _c(
         1800.0, "s", "the time grid of the competitor's windows: half an hour resolves an "
         "event of a few hours, and a 16 h run gives 32 blocks, 528 windows")

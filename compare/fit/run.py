@@ -191,6 +191,14 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                 inputs, switches = again, moved
                 cal = calibrator(inputs)
                 anchor, base = anchored(cal, base.theta)
+        if criteria.reanchor:
+            from compare.fit.discrepancy import fem_discrepancy_at
+
+            say("anchoring the FEM at the calibrated base values")
+            anchor = fem_discrepancy_at(cal.gb, channels, fem_level, base.theta)
+            cal.gb.discrepancy = anchor.offsets
+            say("calibrating the base model again")
+            base = cal.fit(start=base.theta)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
                            fem_cal_info, switches, placed_by)
 

@@ -66,7 +66,7 @@ class Effect:
     in_conductance: tuple[str, ...] = ()
     #: what the verdict says to look at in the spindle or its spec when the effect is named
     hint: str = ""
-    #: acts on the measurement alone (a recorded run can carry it injected: compare.fit.inject)
+    #: acts on the measurement alone (a recorded run can carry it injected: compare.synth.inject)
     measurement_only: bool = False
 
     # ------------------------------------------------------------------ the grey box

@@ -124,7 +124,7 @@ def inject(text: str, effect: str, params: Mapping[str, float], channel: str | N
     for _ln, c in doc.comments:
         if _ln < header_line:
             out.write(f"#{c}\n")
-    out.write(f"# injected (compare.fit.inject): {what}\n")
+    out.write(f"# injected (compare.synth.inject): {what}\n")
     w = csv.writer(out, lineterminator="\n")
     w.writerow(header)
     w.writerows(rows)

@@ -129,7 +129,7 @@ class EnclosureDraft(Effect):
 
         air = TimeSeries(tuple(t), tuple(np.asarray(case.T_ambient_K(t)) + change(t)))
         # the physics sees it; the bench logs the room from the cycle's own load case
-        # (compare.fit.synth.bench_rows), which does not
+        # (compare.synth.bench.bench_rows), which does not
         return replace(case, T_ambient_K=air), {}
 
 

@@ -11,7 +11,7 @@ Each effect enters through its own hooks (compare.fit.effects.base.Effect): the 
 mount's conductance), the load case (windage's heat, and the drag the logged power carries),
 a feedback from the FEM's own temperatures solved to a fixed point (a preload's friction, the
 coolant's warming), or the measurement (a centrifugal jump, a fixture's term, a lag). Several
-effects can be injected together; causes outside the library (compare.fit.outside) use the
+effects can be injected together; causes outside the library (compare.synth.outside) use the
 same hooks.
 """
 
@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from compare.fit.effects import LIBRARY
-from compare.fit.outside import OUTSIDE
+from compare.synth.outside import OUTSIDE
 from spindle.loads import LoadCase
 from spindle.spec import Spec
 from spindle.tolerances import edge_absolute
@@ -226,15 +226,15 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
           truths: dict[str, dict] | None = None) -> dict:
     """Write the synthetic run and its truth sidecar; returns the truth.
 
-    ``effect``: ``clean``, an effect of the library, a cause outside it (compare.fit.outside),
+    ``effect``: ``clean``, an effect of the library, a cause outside it (compare.synth.outside),
     or several of them (a list: injected together). Their sizes are drawn from the seed
     (each kind's ``draw``) unless ``truths`` gives them (name -> parameters).
     ``cycle_name``: a shipped cycle or cycle file, or ``random`` / ``random-loaded`` /
     ``random-ramped-load`` (a cycle drawn from the seed, :func:`spindle.cycles.drawn_cycle`).
     ``mismatch``: the data come from a spindle that differs from ``spec``
-    (:func:`compare.fit.mismatch.draw_mismatch`, drawn from the seed; its FEM level replaces
+    (:func:`compare.synth.mismatch.draw_mismatch`, drawn from the seed; its FEM level replaces
     ``level``), recorded in the truth."""
-    from compare.fit.mismatch import draw_mismatch
+    from compare.synth.mismatch import draw_mismatch
     from spindle.cycle_files import load_cycle
     from spindle.cycles import RANDOM_CYCLES, drawn_cycle
     from spindle.drive import cycle_load_case, drive_for
