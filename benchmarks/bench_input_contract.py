@@ -4,6 +4,7 @@ the outcomes counted.
 
     python benchmarks/bench_input_contract.py [--specs 200] [--cycles 80] [--bench 60]
                                               [--seed 1] [--json OUT.json]
+                                              [--figures docs/figures/input-contract.json]
 
 Each case writes its files into a fresh folder, runs one command with ``--out`` inside it and
 records: the exit status; whether an exception escaped (a traceback); the number of message
@@ -13,6 +14,8 @@ whether its summary holds an impossible result (a temperature at or below 0 K, o
 Spec mutations that happen to be valid run a level-0 solve and count as accepted. Prints the
 counts; the issue's figures: 100 % of the refused cases clean (exit 2, one line naming field
 and fix), 0 tracebacks, 0 runs past 60 s, 0 impossible results written, 0 inputs modified.
+The counts go to ``--figures`` (JSON with the date and the commit), from which docs/spec.md's
+paragraph is checked (tests/test_docs_figures.py); ``--json`` writes every case's outcome.
 """
 
 from __future__ import annotations
@@ -21,12 +24,15 @@ import argparse
 import contextlib
 import io
 import json
+import os
 import random
 import re
+import sys
 import tempfile
 import time
 from pathlib import Path
 
+from figures import write_figures
 from verdicts import run_verdicts
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -213,6 +219,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--workers", type=int, default=2, help="cases at a time (default 2)")
     ap.add_argument("--json", type=Path, help="also write every case's outcome here")
+    ap.add_argument("--figures", type=Path,
+                    default=ROOT / "docs" / "figures" / "input-contract.json",
+                    help="the counts the docs quote (default docs/figures/input-contract.json)")
     args = ap.parse_args(argv)
     import compare.entry  # noqa: F401  (one BLAS thread, as the command runs)
 
@@ -225,20 +234,42 @@ def main(argv: list[str] | None = None) -> None:
         header="cases where the contract failed:",
         line=lambda r: "" if r["right"] else (f"  ! {r['kind']} {r['label']}: exit {r['exit']} "
                                               f"{r['traceback'] or ''} {r['message']}"))
-    refused = [r for r in rows if r["exit"] != 0]
-    kinds = ", ".join(f"{k} {sum(r['kind'] == k for r in rows)}"
-                      for k in ("spec", "cycle", "bench", "option"))
-    print(f"{len(rows)} cases ({kinds}); {time.perf_counter() - t0:.0f} s")
-    print(f"  accepted (exit 0): {len(rows) - len(refused)}; refused: {len(refused)}")
+    c = counts(rows, time.perf_counter() - t0)
+    kinds = ", ".join(f"{k} {n}" for k, n in c["kinds"].items())
+    print(f"{c['cases']} cases ({kinds}); {c['wall_s']:.0f} s")
+    print(f"  accepted (exit 0): {c['accepted']}; refused: {c['refused']}")
     print(f"  refused cleanly (exit 2, a message naming field and fix): "
-          f"{sum(r['clean'] for r in refused)} of {len(refused)}")
-    print(f"  refusals with more than one message line: {sum(not r['one_line'] for r in refused)}")
-    print(f"  tracebacks: {sum(r['traceback'] is not None for r in rows)}")
-    print(f"  slower than 60 s: {sum(r['seconds'] > 60 for r in rows)} "
-          f"(slowest {max(r['seconds'] for r in rows):.1f} s)")
-    print(f"  impossible results written: {sum(r['impossible'] for r in rows)}")
-    print(f"  inputs modified: {sum(r['inputs_modified'] for r in rows)}")
-    print(f"  files written on a refusal: {sum(r['written_on_refusal'] for r in rows)}")
+          f"{c['refused_cleanly']} of {c['refused']}")
+    print(f"  refusals with more than one message line: {c['refusals_multi_line']}")
+    print(f"  tracebacks: {c['tracebacks']}")
+    print(f"  slower than 60 s: {c['slower_than_60_s']} (slowest {c['slowest_s']:.1f} s)")
+    print(f"  impossible results written: {c['impossible_results']}")
+    print(f"  inputs modified: {c['inputs_modified']}")
+    print(f"  files written on a refusal: {c['written_on_refusal']}")
+    write_figures(args.figures, " ".join(["python benchmarks/bench_input_contract.py",
+                            *(argv if argv is not None else sys.argv[1:])]),
+                  {"seed": args.seed, "cores": os.cpu_count(),
+                   "load_average": round(os.getloadavg()[0], 1), **c})
+    print(f"wrote {args.figures}")
+
+
+def counts(rows: list[dict], wall_s: float) -> dict:
+    """The outcomes counted: cases per kind, accepted and refused, and every way the contract
+    can fail (the figures docs/spec.md quotes)."""
+    refused = [r for r in rows if r["exit"] != 0]
+    return {"cases": len(rows), "wall_s": round(wall_s, 1),
+            "kinds": {k: sum(r["kind"] == k for r in rows)
+                      for k in ("spec", "cycle", "bench", "option")},
+            "accepted": len(rows) - len(refused), "refused": len(refused),
+            "refused_cleanly": sum(r["clean"] for r in refused),
+            "refusals_multi_line": sum(not r["one_line"] for r in refused),
+            "tracebacks": sum(r["traceback"] is not None for r in rows),
+            "slower_than_60_s": sum(r["seconds"] > 60 for r in rows),
+            "slowest_s": max(r["seconds"] for r in rows),
+            "impossible_results": sum(r["impossible"] for r in rows),
+            "inputs_modified": sum(r["inputs_modified"] for r in rows),
+            "written_on_refusal": sum(r["written_on_refusal"] for r in rows)}
+
 
 if __name__ == "__main__":
     main()

@@ -2,9 +2,12 @@
 a whole 16 h cycle at 1 s samples, and the exported C step.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_rom.py [--level 2]
+                                                          [--out docs/figures/rom-speed.json]
 
 Prints the figures and their ratios to the issue's targets (streaming step <= 5 µs, 16 h at
-1 s <= 20 ms, build <= 60 s on 2 cores; the paper's Simulink model: 12 s for the 16 h cycle).
+1 s <= 20 ms, build <= 60 s on 2 cores; the paper's Simulink model: 12 s for the 16 h cycle)
+and writes them to ``--out`` with the date, the commit and the load average, from which
+docs/rom.md quotes them (tests/test_docs_study_figures.py).
 """
 
 from __future__ import annotations
@@ -20,9 +23,15 @@ from pathlib import Path
 
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
+from figures import write_figures  # noqa: E402
+
+#: the issue's targets: build [s] on 2 cores, streaming step [µs], 16 h cycle at 1 s [ms]; the
+#: paper's Simulink run of the 16 h cycle [s]
+TARGETS = {"build_s": 60.0, "step_us": 5.0, "cycle_ms": 20.0, "simulink_s": 12.0}
 
 C_MAIN = r"""
 #include <stdio.h>
@@ -54,12 +63,12 @@ def main() -> None:
     from compare.verify.romstudy import named_case
     from reference import ReferenceModel
     from reference.rom import build_rom
-    from reference.rom.export import export
     from reference.rom.realtime import ROMPredictor
 
     ap = argparse.ArgumentParser()
     ap.add_argument("--level", type=int, default=2)
     ap.add_argument("--spec", default="spl2782")
+    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "figures" / "rom-speed.json")
     args = ap.parse_args()
     t0 = time.perf_counter()
     ref = ReferenceModel(args.spec, args.level)
@@ -75,6 +84,8 @@ def main() -> None:
           f"{tm['build_cpu_excluding_fem']:.1f} s")
     print(f"training FEM run (backward Euler, dt 60 s, 16 h) {tm['fem_training']:.1f} s "
           f"(CPU {tm['fem_training_cpu']:.1f} s)")
+    fig = {"spec": args.spec, "level": args.level, "dofs": rom.n_full, "states": rom.n_states,
+           "targets": TARGETS, "assembly_s": t_asm, "timings_s": dict(tm)}
 
     case = named_case(ref.spec, "spl-16h")
     dt = 1.0
@@ -93,6 +104,8 @@ def main() -> None:
     print(f"streaming step (Python, fused matrix {pred.n + len(pred.O)} x {pred.n + pred.m + 1})"
           f": {best * 1e6:.2f} µs wall, {cpu * 1e6:.2f} µs CPU; target 5 µs: ratio "
           f"{best * 1e6 / 5:.2f} (wall)")
+    fig["step"] = {"wall_us": best * 1e6, "cpu_us": cpu * 1e6,
+                   "matrix": [pred.n + len(pred.O), pred.n + pred.m + 1]}
     best, cpu = 1e9, 1e9
     for _ in range(5):
         p = ROMPredictor(rom, dt, speeds_rpm=np.unique(speeds))
@@ -103,10 +116,23 @@ def main() -> None:
     print(f"whole 16 h cycle at 1 s ({len(t)} samples, ROMPredictor.run): {best * 1e3:.1f} ms "
           f"wall, {cpu * 1e3:.1f} ms CPU; target 20 ms: ratio {best * 1e3 / 20:.2f} (wall); "
           f"the paper's Simulink 12 s: {12 / best:.0f} x faster")
+    fig["cycle"] = {"samples": len(t), "wall_ms": best * 1e3, "cpu_ms": cpu * 1e3}
+    fig["load_average"] = round(os.getloadavg()[0], 1)
+    fig["cores"] = os.cpu_count()
     print(f"load average while measuring: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
-    if shutil.which("gcc") is None:
+    fig["c_step"] = c_step(pred, U, speeds, len(t)) if shutil.which("gcc") else None
+    if fig["c_step"] is None:
         print("C step: no gcc")
-        return
+    write_figures(args.out, "OPENBLAS_NUM_THREADS=1 python benchmarks/bench_rom.py"
+                  + ("" if args.level == 2 else f" --level {args.level}"), fig)
+    print(f"wrote {args.out}")
+
+
+def c_step(pred, U: np.ndarray, speeds: np.ndarray, samples: int) -> dict:
+    """The exported C step's CPU time per sample [ns] (gcc -O2, best of five replays of the
+    cycle) and for the whole cycle [ms]."""
+    from reference.rom.export import export
+
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         export(pred, np.unique(speeds), tmp)
@@ -120,7 +146,9 @@ def main() -> None:
         out = subprocess.run([str(tmp / "bench"), str(tmp / "u.bin")], check=True,
                              capture_output=True, text=True).stdout.split()
         print(f"C step (gcc -O2, {len(np.unique(speeds))} tabulated speeds): {float(out[0]):.0f} ns "
-              f"CPU per sample; a 16 h cycle at 1 s: {float(out[0]) * len(t) * 1e-6:.2f} ms")
+              f"CPU per sample; a 16 h cycle at 1 s: {float(out[0]) * samples * 1e-6:.2f} ms")
+    return {"ns": float(out[0]), "cycle_ms": float(out[0]) * samples * 1e-6,
+            "speeds": len(np.unique(speeds))}
 
 
 if __name__ == "__main__":

@@ -5,8 +5,8 @@ Each example runs as a user runs it (``python docs/examples/NAME.py OUT_DIR``: i
 with runpy, or in a subprocess where it starts pytest itself), or through its ``main`` where
 the test needs an option; the assertions hold its output against the figures the docs
 print, with the tolerance's source beside each. The ```` ```python ```` blocks of README.md
-and docs/*.md run in tests/test_docs_snippets.py; the Python heredoc of docs/bench.md (a
-timing script inside a bash block) runs here.
+and docs/*.md run in tests/test_docs_snippets.py; docs/bench.md's timing script is
+benchmarks/bench_read.py, run by tests/test_docs_figures.py.
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ from __future__ import annotations
 import ast
 import csv
 import json
-import os
 import re
 import runpy
 import subprocess
@@ -179,16 +178,3 @@ def test_ex04_my_pytest_suite(tmp_path):
                   ast.parse((EXAMPLES / "ex04_my_pytest_suite.py").read_text()).body)
     assert n_tests >= 4 and int(suite.get("tests")) == n_tests
     assert suite.get("failures") == suite.get("errors") == suite.get("skipped") == "0"
-
-
-def test_bench_md_timing_script_runs(tmp_path):
-    """docs/bench.md's timing script (a heredoc, run from the repository root) reads both
-    57,600-row files and builds the 960 intervals of its table; timings are not asserted."""
-    text = (ROOT / "docs" / "bench.md").read_text(encoding="utf-8")
-    code = re.search(r"python - <<'PY'\n(.*?)\nPY\n", text, re.S)[1]
-    env = {**os.environ, "TMPDIR": str(tmp_path)}  # its mkdtemp files land in tmp_path
-    r = subprocess.run([sys.executable, "-"], input=code, capture_output=True, text=True,
-                       cwd=ROOT, env=env)
-    assert r.returncode == 0, r.stderr
-    assert r.stdout.count(": 57600 rows, read_bench min") == 2
-    assert "inputs: 960 intervals" in r.stdout

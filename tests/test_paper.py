@@ -4,7 +4,7 @@ The spl-16h peaks T1 = 32.4 degC and P1 = 6.5 µm and the nominal losses 5146 W 
 CALIBRATION TARGETS, not predictions: the shipped bearing friction factor f0 and the film
 factor of the rotating surfaces were fitted to the two peaks (docs/paper.md), and the motor
 parameters to the losses. The test asserts them within the issue's 5 % on FEM level 1, the
-level the fit ran on (level 2 gives +2.0 % and -3.4 %, docs/paper.md).
+level the fit ran on (docs/paper.md's table gives both levels, from docs/figures/paper.json).
 The nominal shaft, housing and growth figures are not met by any plausible parameter set
 (docs/paper.md); the other tests check that the harness reads the figures as documented and
 that each factor acts on the figure it should.
