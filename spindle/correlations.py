@@ -157,7 +157,7 @@ def h_rotating_shaft_W_m2K(speed_rpm: float, d_m: float, *, T_air_K: float = T20
 
     Floor: at low speed the forced value falls below natural convection; the result is
     max(forced, floor), the floor being ``h_floor_W_m2K`` if given, else Churchill-Chu for a
-    surface ``dT_K`` [K] above the air (:func:`h_natural_cylinder_W_m2K`, 4.4 W/m2/K for
+    surface ``dT_K`` [K] above the air (:func:`h_natural_cylinder_W_m2K`, a few W/m2/K for
     d = 0.13 m, dT = 20 K). Non-decreasing in speed.
     """
     w = omega_rad_s(speed_rpm)

@@ -128,7 +128,8 @@ def test_shipped_drive_equals_the_former_constants():
     for b, size in zip(d.bearings.values(), ("7018", "7016"), strict=True):
         assert b.source.startswith(f"The paper (grease-lubricated pairs); {size} dimensions ISO 15; "
                                    "CALIBRATED f0 = 0.26 per bearing (docs/paper.md: fitted")
-        assert b.source.endswith("25 deg super-precision bearings of this size (M1 is ~8 % of M).")
+        assert b.source.endswith("25 deg super-precision bearings of this size (the split of M: "
+                                 "docs/power.md).")
 
 
 def test_drive_file_fields_cover_the_parameter_classes():

@@ -245,7 +245,7 @@ def test_command(tmp_path, capsys):
                                  "--rank-dt", "600", "--out", str(out), "--quiet"])
     assert args.func(args) == 0
     text = capsys.readouterr().out
-    # fin-shaft's N = 5 is 4.4 K off (docs/lumped.md): no N of 2, 3 or 5 meets 1 K, and
+    # fin-shaft's N = 5 is kelvins off (docs/lumped.md): no N of 2, 3 or 5 meets 1 K, and
     # the message says so per case and what it recommends
     assert "No N of 2, 3 or 5 meets the tolerance" in text and "none does" in text
     assert "Recommended if a lumped model must serve: N = 5" in text

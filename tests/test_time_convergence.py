@@ -142,9 +142,8 @@ def test_krylov_integration_is_within_its_estimate_of_cram(name, level):
     """The Krylov read-outs against the CRAM-16 oracle (its own error below 1e-8 K, above)
     on the study's cycle with the jump ladder: the largest difference over the sensors is
     below the stated estimate, and so over the growth read-outs; and the estimate is
-    below 1e-4 K and 1e-4 um, about 1 % of spl2782's spatial GCI at level 2 (0.04 K, 0.016
-    um; docs/verification.md). Measured: fin-shaft 1.4e-6 and 2.3e-6 K under 9e-6 and 8e-6
-    K; spl2782 level 0 5.7e-6 K under 5.2e-5 K, P1 5.7e-13 m under 4.2e-12 m."""
+    below 1e-4 K and 1e-4 um, about 1 % of spl2782's spatial GCI at level 2
+    (docs/verification.md gives the measured figures)."""
     err_K, est_K, err_m, est_m, cram = _krylov_against_cram(name, level)
     assert cram < 1e-8
     assert err_K <= est_K < 1e-4, (err_K, est_K)

@@ -353,7 +353,7 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     the random-loaded:0 cycle, 0.05 K / 0.1 µm) as a row of both tables, integrated in time
     as the reference was. Off by default: on spl2782 it adds 40-100 s (the build and the
     training cycle's FEM run) and the build's candidate vectors (about 0.6 GB at level 2;
-    the study's peak was 1.95 GB with it, docs/rom.md).
+    docs/rom.md gives the measured cost).
     """
     from compare.executor import import_dask, run_cases
 
