@@ -232,6 +232,9 @@ def summary(rows: list[dict]) -> list[str]:
                 lambda r: r["kind"] == "outside")
     out += floor_rate("unexplained, nothing named", lambda r: r["right"],
                       lambda r: r["kind"] == "outside")
+    out += rate("'something else remains' beside a right verdict (a false alarm)",
+                lambda r: r["unexplained"],
+                lambda r: r["right"] and r["kind"] in ("effect", "effects"))
     out += rate("a false second effect (after a right first)", lambda r: r["false_second"],
                 lambda r: bool(r["first"]))
     out += rate("a wrong effect named (any run)", lambda r: r["wrong"], lambda r: True)

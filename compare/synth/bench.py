@@ -79,10 +79,11 @@ def _anderson(G, x0: np.ndarray, tol: float, max_iter: int = 25, memory: int = 5
 
 
 def _fixed_point(ref, case: LoadCase, feedbacks: list, dt_s: float, T0: float,
-                 tol_K: float = 1e-4):
+                 tol_K: float = 1e-4, max_iter: int = 40):
     """(result, the fed-back series, their grid): the transient with every feedback from the
     FEM's own temperatures (compare.fit.effects.base.Feedback), solved to ``tol_K`` [K] on the
-    fed-back series together."""
+    fed-back series together, in at most ``max_iter`` FEM runs (a feedback switched on and off
+    within the run, as a coolant flow drop's, converges more slowly than one that holds)."""
     th = ref.thermal
     functionals = {k: v for fb in feedbacks for k, v in fb.functionals.items()}
     first = th.solve_transient(case, dt_s, 1.0, T0, 0, None, functionals)
@@ -101,7 +102,7 @@ def _fixed_point(ref, case: LoadCase, feedbacks: list, dt_s: float, T0: float,
 
     starts = [fb.start(first.functionals, case, t) for fb in feedbacks]
     sizes = [len(s) for s in starts]
-    x, _, _ = _anderson(G, np.concatenate(starts), tol_K)
+    x, _, _ = _anderson(G, np.concatenate(starts), tol_K, max_iter)
     parts = np.split(x, np.cumsum(sizes)[:-1])
     return ref.transient(apply(x), dt_s, T0=T0), parts, t
 
