@@ -171,3 +171,37 @@ def test_a_held_out_misfit_with_nothing_named_is_unexplained_and_says_where():
     assert v.to_dict()["basis"] == "held-out misfit"
     assert Verdict(h, 30.0, 20.0, True).basis == "something else"
     assert Verdict(h, 3.0, 20.0, False).basis == ""
+
+
+def test_an_unexplained_verdict_says_which_channel_and_which_input():
+    """Issue 32 §3: "unexplained" says where the residual lives: the channel with the largest
+    RMS in the competitor's window and the input its residual follows (the residual
+    diagnostics' largest cross-correlation, with its lag). Here T2's residual is the speed's
+    step delayed by 10 min, two tolerances high; T1 is noise."""
+    from types import SimpleNamespace
+
+    from compare.fit.calibrate import TOLERANCE
+    from compare.fit.report import place_text, residual_place
+    from compare.fit.residuals import diagnose
+
+    g = np.arange(0.0, 4 * 3600.0 + 1.0, 60.0)
+    speed = np.where((g >= 3000.0) & (g < 6600.0), 4000.0, 0.0)
+    rng = np.random.default_rng(0)
+    residual = {"T1": 0.05 * rng.standard_normal(len(g)),
+                "T2": np.where((g >= 3600.0) & (g < 7200.0), 2.0, 0.0)
+                + 0.05 * rng.standard_normal(len(g))}
+    measured = SimpleNamespace(grid_s=g, values={c: r * TOLERANCE[c] for c, r in residual.items()},
+                               mask=lambda c, w: g >= 0.6 * g[-1])
+    rep = SimpleNamespace(
+        measured=measured, channels=["T1", "T2"],
+        selection=SimpleNamespace(final=SimpleNamespace(model={c: np.zeros(len(g))
+                                                               for c in residual})),
+        diagnostics_after=diagnose(residual, 60.0, {"speed": speed}, alpha=0.01))
+    place = residual_place(rep, 3600.0, 7200.0)
+    assert place["channel"] == "T2" and abs(place["rms_tolerances"] - 2.0) < 0.05
+    assert place["input"] == "speed" and place["lag_s"] == 600.0 and place["ccf"] > 0.9
+    assert place_text(place).startswith("the residual is largest in T2 (2.0 tolerances RMS "
+                                        "there) and follows the speed most closely (10 min "
+                                        "after it")
+    # on the validation window (the last 40 %) both channels are noise of 0.05 tolerances
+    assert residual_place(rep)["rms_tolerances"] < 0.1

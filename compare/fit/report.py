@@ -26,6 +26,15 @@ from spindle.tolerances import edge_absolute, edge_scale, edge_unit
 REPORT_FORMAT = "spindle-verify-fit/2"
 
 
+def _place_of(rep, verdict: dict) -> dict | None:
+    """:func:`residual_place` of an unexplained verdict: in the competitor's window, or on
+    the validation window for a held-out misfit; None otherwise."""
+    if not verdict.get("unexplained"):
+        return None
+    h = verdict.get("hypothesis") if verdict.get("basis") == "something else" else None
+    return residual_place(rep, h["t0_s"], h["t1_s"]) if h else residual_place(rep)
+
+
 def p_text(p: float | None) -> str:
     """A p-value as people read it (one below double precision's range is not 0)."""
     if p is None or not math.isfinite(p):
@@ -97,6 +106,11 @@ def _change_text(doc: dict) -> str:
     return ", ".join(parts)
 
 
+def _where_more(v: dict) -> str:
+    text = place_text(v.get("residual"))
+    return f"; {text}" if text else ""
+
+
 def verdict_lines(doc: dict) -> list[str]:
     """The verdict in sentences: what was found, then the error before and after."""
     v = doc["verdict"]
@@ -114,14 +128,15 @@ def verdict_lines(doc: dict) -> list[str]:
                    "explains the run better than something else and than every other effect")
             lines.append(f"Named: {e['label']}, {vals}. Evidence: {how}.")
         if v["unexplained"]:
-            lines.append(f"Something else remains: {v['where']}.")
+            lines.append(f"Something else remains: {v['where']}{_where_more(v)}.")
     elif v["kind"] == "unexplained" and v.get("basis") == "held-out misfit":
         lines.append("Unexplained: the calibrated model misses the tolerances on held-out data "
-                     f"and no effect of the library explains it: {v['where']}. A spindle "
-                     "unlike its spec shows the same way: see the base's adequacy below.")
+                     f"and no effect of the library explains it: {v['where']}{_where_more(v)}. "
+                     "A spindle unlike its spec shows the same way: see the base's adequacy "
+                     "below.")
     elif v["kind"] == "unexplained":
         lines.append("Unexplained: no effect of the library explains this run, and something "
-                     f"else does: {v['where']}.")
+                     f"else does: {v['where']}{_where_more(v)}.")
     elif v["kind"] == "base adequate":
         lines.append("Nothing named, base adequate: the calibrated base model explains the run "
                      "within the tolerances.")
@@ -131,6 +146,49 @@ def verdict_lines(doc: dict) -> list[str]:
                      "time of the run explains the misfit; look at the spec (below).")
     lines.append(f"Validation error before -> after: {_change_text(doc)}.")
     return lines
+
+
+#: the inputs' names in sentences (compare.fit.run diagnoses the residual against these)
+_INPUT_WORDS = {"speed": "the speed", "power": "the drive's power", "T_env": "the room"}
+
+
+def residual_place(rep, t0_s: float | None = None, t1_s: float | None = None) -> dict | None:
+    """Where the final model's residual lives: the channel whose RMS in tolerances is largest
+    over [t0, t1) [s] (default: the validation window), that RMS, and the input its residual
+    follows most closely over the whole run (the largest cross-correlation of the residual
+    diagnostics, with its lag [s]). None where no channel has samples there."""
+    m, final = rep.measured, rep.selection.final
+    g = m.grid_s
+    if t0_s is None:
+        rows = {c: m.mask(c, "validation") for c in rep.channels}
+    else:
+        rows = {c: (g >= t0_s) & (g < t1_s) & np.isfinite(m.values[c]) for c in rep.channels}
+    rms = {c: float(np.sqrt(np.mean(((m.values[c] - final.model[c])[r] / TOLERANCE[c]) ** 2)))
+           for c, r in rows.items() if r.any()}
+    if not rms:
+        return None
+    c = max(rms, key=rms.get)
+    out = {"channel": c, "rms_tolerances": rms[c], "input": None, "lag_s": None, "ccf": None}
+    diag = rep.diagnostics_after.channels.get(c)
+    peak = diag.best("input") if diag is not None else None
+    if peak is not None and peak.beyond_band:
+        out.update(input=peak.name, lag_s=peak.lag_s, ccf=peak.ccf)
+    return out
+
+
+def place_text(place: dict | None) -> str:
+    """:func:`residual_place` in words."""
+    if not place:
+        return ""
+    text = (f"the residual is largest in {place['channel']} ({place['rms_tolerances']:.1f} "
+            "tolerances RMS there)")
+    if place["input"]:
+        lag = place["lag_s"]
+        when = ("at once" if abs(lag) < 1 else
+                f"{abs(lag) / 60:.0f} min {'after' if lag > 0 else 'before'} it")
+        text += (f" and follows {_INPUT_WORDS.get(place['input'], place['input'])} most "
+                 f"closely ({when}, correlation {place['ccf']:+.2f})")
+    return text
 
 
 def report_dict(rep) -> dict:
@@ -144,7 +202,7 @@ def report_dict(rep) -> dict:
         "channels": rep.channels,
         "verdict": {"kind": verdict_kind(rep), "named": [e["label"] for e in effects],
                     "unexplained": bool(verdict["unexplained"]), "where": verdict.get("where"),
-                    "basis": verdict.get("basis", "")},
+                    "basis": verdict.get("basis", ""), "residual": _place_of(rep, verdict)},
         "effects": effects,
         "something_else": verdict,
         "unexplained": {"unexplained": bool(verdict["unexplained"]),
