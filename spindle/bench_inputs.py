@@ -50,6 +50,11 @@ def held(t_samples: np.ndarray, y_samples: np.ndarray, t: np.ndarray) -> np.ndar
     return y_samples[np.clip(idx, 0, len(y_samples) - 1)]
 
 
+#: a logged value holds for at most this many grid steps: a bench that logs on change writes
+#: at least a heartbeat that often, so a longer silence is a gap (compare.fit.criteria's
+#: gap_min_steps says the same)
+HOLD_STEPS = 2.0
+
 #: speed scatter a drive shows around its set speed: a logged speed within this band of the
 #: current operating step belongs to it (the spindle's drive holds 0.1-0.3 % in practice)
 SPEED_BAND_REL = 0.01
@@ -73,20 +78,50 @@ def settled_speed(speed_rpm: np.ndarray, rel: float = SPEED_BAND_REL,
 
 
 def cell_means(t_samples: np.ndarray, y_samples: np.ndarray, edges: np.ndarray,
-               centres: np.ndarray) -> np.ndarray:
-    """Mean of the samples in each cell [edges[i], edges[i+1]) (the last cell closed), one per
-    cell; a cell without samples gets the samples interpolated linearly at ``centres[i]``
-    (the first or last value held outside them). Units of y."""
+               centres: np.ndarray, hold_s: float | None = None) -> np.ndarray:
+    """The mean of a logged signal in each cell [edges[i], edges[i+1]) (the last cell closed),
+    one per cell; a cell without data gets the samples interpolated linearly at
+    ``centres[i]`` (the first or last value held outside them). Units of y.
+
+    ``hold_s`` None: the mean of the samples in the cell. ``hold_s`` [s]: the time mean of the
+    signal as the bench logged it, each sample holding until the next one or for ``hold_s``,
+    whichever comes first (a time not covered so is no data). A bench that logs on change
+    writes a value when it moves: samples then crowd where the signal changes, and their plain
+    mean over a cell weighs the change, not the time; with regular samples the two agree."""
+    t_samples = np.asarray(t_samples, dtype=float)
+    y_samples = np.asarray(y_samples, dtype=float)
     n = len(edges) - 1
-    k = np.searchsorted(edges, t_samples, side="right") - 1
-    k[t_samples == edges[-1]] = n - 1
-    inside = (k >= 0) & (k < n)
-    count = np.bincount(k[inside], minlength=n)
-    total = np.bincount(k[inside], weights=y_samples[inside], minlength=n)
     out = np.interp(centres, t_samples, y_samples)
-    has = count > 0
-    out[has] = total[has] / count[has]
+    if hold_s is None:
+        k = np.searchsorted(edges, t_samples, side="right") - 1
+        k[t_samples == edges[-1]] = n - 1
+        inside = (k >= 0) & (k < n)
+        weight = np.bincount(k[inside], minlength=n).astype(float)
+        total = np.bincount(k[inside], weights=y_samples[inside], minlength=n)
+    else:
+        ends = np.minimum(np.append(t_samples[1:], np.inf), t_samples + hold_s)
+        pts = np.unique(np.concatenate([t_samples, ends[np.isfinite(ends)], edges]))
+        pts = pts[(pts >= edges[0]) & (pts <= edges[-1])]
+        a, b = pts[:-1], pts[1:]
+        mid = 0.5 * (a + b)
+        i = np.searchsorted(t_samples, mid, side="right") - 1
+        j = np.clip(i, 0, len(t_samples) - 1)
+        covered = (i >= 0) & (mid < ends[j])
+        k = np.clip(np.searchsorted(edges, mid, side="right") - 1, 0, n - 1)
+        w = (b - a) * covered
+        weight = np.bincount(k, weights=w, minlength=n)
+        total = np.bincount(k, weights=w * y_samples[j], minlength=n)
+    has = weight > 0
+    out[has] = total[has] / weight[has]
     return out
+
+
+def held_product(t_a: np.ndarray, a: np.ndarray, t_b: np.ndarray, b: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The product of two logged signals, each held between its samples (zero-order hold,
+    :func:`held`), at every time either was logged: (times [s], a b)."""
+    t = np.union1d(t_a, t_b)
+    return t, held(t_a, a, t) * held(t_b, b, t)
 
 
 def interval_heat_W(drive: Drive, speed_rpm: float, load_torque_Nm: float,
@@ -116,11 +151,12 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
     Grid: :func:`bench_grid` (every ``grid_s``, default 60 s, from 0 to the end, plus the run's
     first and last sample). Speed [rpm]: the bench logs it on change, so it is held (the last
     valid sample at or before each grid point; before the first, the first value), a
-    'previous' series on the grid. Ambient and coolant [K]: the mean of the valid samples in
-    the cell around each grid point (half-way to its neighbours), linear between grid points.
-    Power [kW] and load torque [N m] (0 when not measured): the mean of the valid samples in
-    each grid interval [t_i, t_i+1); where an interval or cell has no sample (a gap) the
-    samples are interpolated linearly at its centre. Heat sources [W]: per interval,
+    'previous' series on the grid. Ambient and coolant [K]: the time mean of the logged
+    signal (each sample held until the next, :data:`HOLD_STEPS` grid steps at most:
+    :func:`cell_means`) in the cell around each grid point (half-way to its neighbours),
+    linear between grid points. Power [kW] and load torque [N m] (0 when not measured): the
+    same time mean over each grid interval [t_i, t_i+1); where an interval or cell has no data
+    (a gap) the samples are interpolated linearly at its centre. Heat sources [W]: per interval,
     :func:`interval_heat_W` (the power balance ``drive.heat_W(speed at t_i, torque, power)``),
     held over the interval ('previous' series at t_i); the spec's sources the power balance
     does not feed get 0 W. ``drive`` defaults to the spec's ``[power_balance] preset``; without
@@ -139,11 +175,12 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
 
     ts, ys = _valid(run, "speed_rpm")
     speed = held(ts, ys, grid)
-    T_env = cell_means(*_valid(run, "T_env_C"), dual, grid) + ZERO_C_K
-    T_cool = cell_means(*_valid(run, "T_coolant_C"), dual, grid) + ZERO_C_K
-    power = cell_means(*_valid(run, "power_kW"), grid, mids)
-    torque = (cell_means(*_valid(run, "load_torque_Nm"), grid, mids) if run.load_torque_measured
-              else np.zeros(len(mids)))
+    hold = HOLD_STEPS * float(np.median(np.diff(grid)))
+    T_env = cell_means(*_valid(run, "T_env_C"), dual, grid, hold) + ZERO_C_K
+    T_cool = cell_means(*_valid(run, "T_coolant_C"), dual, grid, hold) + ZERO_C_K
+    power = cell_means(*_valid(run, "power_kW"), grid, mids, hold)
+    torque = (cell_means(*_valid(run, "load_torque_Nm"), grid, mids, hold)
+              if run.load_torque_measured else np.zeros(len(mids)))
 
     heats: list[dict[str, float]] = []
     clipped: list[float] = []

@@ -329,18 +329,22 @@ def test_interval_averages_by_hand(tmp_path, spec):
     drive = drive_for(spec)
     case, grid = inputs(run, spec)
     assert grid[:4].tolist() == [0.0, 60.0, 120.0, 180.0]
-    # power over [60, 120): mean of 1.0, 2.0, 4.5; over [120, 180): no sample -> linear
-    # interpolation of the samples at the interval centre 150 s: 4.5 + (3.0 - 4.5) * 50 / 80
-    p_60, p_120 = (1.0 + 2.0 + 4.5) / 3, 4.5 + (3.0 - 4.5) * 50.0 / 80.0
+    # power: the time mean of the logged signal, each sample held until the next (for two
+    # grid steps, 120 s, at most). Over [60, 120): 1.0 for 15 s, 2.0 for 25 s, 4.5 for 20 s;
+    # over [120, 180): no sample, the one at 100 s holds (80 s after it, within 120 s)
+    p_60, p_120 = (15 * 1.0 + 25 * 2.0 + 20 * 4.5) / 60, 4.5
     for t0, p in ((60.0, p_60), (120.0, p_120)):
         expect = drive.heat_W(4300.0, 0.0, p)
         for name, w in expect.items():
             assert case.sources[name](t0 + 1.0) == pytest.approx(w, rel=1e-12)
-    # ambient at the grid point 60 s: mean over the cell [30, 90) = (20 + 21) / 2, in K
-    assert case.T_ambient_K(60.0) == pytest.approx(20.5 + 273.15)
-    # at 120 s: cell [90, 150) holds only the 100 s sample
-    assert case.T_ambient_K(120.0) == pytest.approx(23.0 + 273.15)
-    assert case.T_ambient_K(90.0) == pytest.approx(0.5 * (20.5 + 23.0) + 273.15)  # linear between
+    # ambient at the grid point 60 s: time mean over the cell [30, 90): the 0 s sample's 26
+    # holds to 60 s, then 20 for 15 s and 21 for 15 s; in K
+    T_60 = (30 * 26.0 + 15 * 20.0 + 15 * 21.0) / 60
+    assert case.T_ambient_K(60.0) == pytest.approx(T_60 + 273.15)
+    # at 120 s: cell [90, 150): 21 to 100 s, then the 100 s sample's 23
+    T_120 = (10 * 21.0 + 50 * 23.0) / 60
+    assert case.T_ambient_K(120.0) == pytest.approx(T_120 + 273.15)
+    assert case.T_ambient_K(90.0) == pytest.approx(0.5 * (T_60 + T_120) + 273.15)  # linear
     assert case.T_ambient_K.interpolation == "linear" and case.T_coolant_K(0.0) == pytest.approx(293.15)
     assert case.name == "run" and case.duration_s == 3602.0 and grid[-1] == 3602.0
 
@@ -354,8 +358,9 @@ def test_no_load_heat_is_the_power_balance_at_each_interval(tmp_path, spec):
     drive = drive_for(spec)
     assert set(case.sources) == {h.name for h in spec.heat_sources}
     for i in (0, 7, 29, 30, 59):
-        # the last interval [3540, 3600] is closed: it holds the samples at both ends
-        n, p = 3000.0 if i < 30 else 6000.0, power[i] if i < 59 else (power[59] + power[60]) / 2
+        # each interval's power is its sample's, held over the interval (the one at its end
+        # starts no time of its own)
+        n, p = 3000.0 if i < 30 else 6000.0, power[i]
         expect = drive.heat_W(n, 0.0, p)
         got = {k: case.sources[k](grid[i]) for k in expect}
         assert got == pytest.approx(expect, rel=1e-12)

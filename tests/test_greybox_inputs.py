@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from compare.fit.run import greybox_inputs
 from spindle.bench import BenchRun
@@ -48,3 +49,29 @@ def test_a_run_without_torque_has_none():
     run = replace(run, columns={**run.columns, "load_torque_Nm": np.zeros_like(run.time_s)},
                   load_torque_measured=False)
     assert np.all(greybox_inputs(run, 60.0).load_torque_Nm == 0.0)
+
+
+def test_an_on_change_log_averages_over_time_not_over_samples():
+    """A bench that logs on change writes samples where the signal moves: a drive at 1 kW for
+    50 s that steps to 5 kW and reports every second after the step (its scatter crossing the
+    dead band) has a time mean of (50 x 1 + 10 x 5) / 60 kW over the minute, while the mean of
+    its 11 samples is 4.6 kW (spindle.bench_inputs.cell_means with a hold). A sample holds for
+    the hold at most: a cell the log never reaches gets the interpolation, not a stale
+    value. With regular samples the two means agree (to the cell's edge sample)."""
+    from spindle.bench_inputs import cell_means
+
+    t = np.array([0.0, *np.arange(50.0, 60.0, 1.0)])
+    y = np.array([1.0, *np.full(10, 5.0)])
+    edges, centres = np.array([0.0, 60.0]), np.array([30.0])
+    assert cell_means(t, y, edges, centres)[0] == pytest.approx(4.636, abs=1e-3)
+    assert cell_means(t, y, edges, centres, hold_s=120.0)[0] == pytest.approx(100.0 / 60.0)
+    # a 5 min silence after the last sample: the second cell is held only for the hold's
+    # 120 s (its first 60 s), the third not at all (it interpolates, here the last value)
+    edges = np.array([0.0, 60.0, 120.0, 180.0, 240.0])
+    out = cell_means(np.array([0.0, 59.0]), np.array([1.0, 3.0]), edges,
+                     0.5 * (edges[1:] + edges[:-1]), hold_s=120.0)
+    assert out[0] == pytest.approx((59 * 1 + 1 * 3) / 60) and out[1] == pytest.approx(3.0)
+    tr = np.arange(0.0, 60.0, 1.0)
+    yr = np.where(tr < 50, 1.0, 5.0)
+    assert cell_means(tr, yr, edges[:2], centres, hold_s=120.0)[0] == pytest.approx(
+        cell_means(tr, yr, edges[:2], centres)[0])

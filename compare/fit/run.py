@@ -31,7 +31,14 @@ from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAM
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
 from spindle.bench import BenchRun, check_against_spec, read_bench
-from spindle.bench_inputs import STANDSTILL_RPM, bench_grid, cell_means, held, settled_speed
+from spindle.bench_inputs import (
+    STANDSTILL_RPM,
+    bench_grid,
+    cell_means,
+    held,
+    held_product,
+    settled_speed,
+)
 from spindle.drive import drive_for
 from spindle.errors import InputError, SolverError
 from spindle.results import check_plausible
@@ -46,34 +53,38 @@ def _valid_samples(run: BenchRun, col: str) -> tuple[np.ndarray, np.ndarray]:
     return run.time_s[ok], y[ok]
 
 
-def greybox_inputs(run: BenchRun, grid_s: float = 60.0) -> Inputs:
+def greybox_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = 2.0) -> Inputs:
     """Per-interval inputs of the grey box on the run's grid (spindle.bench_inputs):
 
     - speed [rpm]: the one logged at the interval's middle (held), settled to the drive's
       scatter band (a step inside an interval is at most half an interval off);
-    - power [kW], ambient and coolant [K]: the mean of the interval's samples;
+    - power [kW], ambient and coolant [K]: the time mean over the interval of the signal as
+      logged, each sample held until the next one, for ``hold_steps`` grid steps at most (a
+      bench that logs on change writes at least a heartbeat that often: Criteria.gap_min_steps);
     - load torque [N m]: the torque that at the middle's speed does the interval's mean
-      mechanical work, mean(M n) / n_mid (the speed held at each torque sample). The losses
-      the power balance takes from the interval are then mean(P_el - M omega), as the
-      samples give them; mean(P_el) - mean(M) omega_mid is not: a 5000 -> 1000 rpm ramp at
-      42 N m inside one interval gives 5271 W of heat where the samples give about 900 W.
+      mechanical work, mean(M n) / n_mid (torque and speed each held). The losses the power
+      balance takes from the interval are then mean(P_el - M omega), as the samples give
+      them; mean(P_el) - mean(M) omega_mid is not: a 5000 -> 1000 rpm ramp at 42 N m inside
+      one interval gives 5271 W of heat where the samples give about 900 W.
     """
     grid = bench_grid(run, grid_s)
     mids = 0.5 * (grid[:-1] + grid[1:])
+    hold = hold_steps * grid_s
     t_n, n = _valid_samples(run, "speed_rpm")
     speed = settled_speed(held(t_n, n, mids))
-    power = cell_means(*_valid_samples(run, "power_kW"), grid, mids)
+    power = cell_means(*_valid_samples(run, "power_kW"), grid, mids, hold)
     if run.load_torque_measured:
         t_m, m = _valid_samples(run, "load_torque_Nm")
-        work = cell_means(t_m, m * held(t_n, n, t_m), grid, mids)  # mean M n [N m rpm]
+        # mean M n [N m rpm], each held
+        work = cell_means(*held_product(t_m, m, t_n, n), grid, mids, hold)
         moving = speed >= STANDSTILL_RPM
         torque = np.where(moving, work / np.where(moving, speed, 1.0),
-                          cell_means(t_m, m, grid, mids))
+                          cell_means(t_m, m, grid, mids, hold))
     else:
         torque = np.zeros(len(mids))
     t_env, y_env = _valid_samples(run, "T_env_C")
-    T_env = cell_means(t_env, y_env, grid, mids) + ZERO_C_K
-    T_cool = cell_means(*_valid_samples(run, "T_coolant_C"), grid, mids) + ZERO_C_K
+    T_env = cell_means(t_env, y_env, grid, mids, hold) + ZERO_C_K
+    T_cool = cell_means(*_valid_samples(run, "T_coolant_C"), grid, mids, hold) + ZERO_C_K
     return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + ZERO_C_K)
 
 
@@ -142,7 +153,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     if drive is None:
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
                          "add [power_balance] preset to the spec")
-    raw = greybox_inputs(run, grid_s)
+    raw = greybox_inputs(run, grid_s, criteria.gap_min_steps)
     measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks)
     inputs, switches = _place_gap_switches(run, spec, drive, raw, measured, channels, nodes,
                                            base_extra, say, criteria)
