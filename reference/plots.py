@@ -54,6 +54,14 @@ def section_png(model, T: np.ndarray, path: Path, title: str = "") -> None:
 def revolved_png(model, T: np.ndarray, path: Path, title: str = "",
                  window: tuple[int, int] = (1400, 800)) -> None:
     """The field revolved to 3-D as a 270 degree cut-away (off-screen pyvista)."""
+    pl = revolved_plotter(model, T, title, window)
+    atomic_write(Path(path), lambda tmp: pl.screenshot(str(tmp)))
+    pl.close()
+
+
+def revolved_plotter(model, T: np.ndarray, title: str = "",
+                     window: tuple[int, int] = (1400, 800)):
+    """The off-screen pyvista plotter of :func:`revolved_png`, camera set, not yet drawn."""
     import pyvista as pv
 
     quiet_vtk()
@@ -70,14 +78,21 @@ def revolved_png(model, T: np.ndarray, path: Path, title: str = "",
     pl.camera_position = [(focal[0] - 0.35 * size, 0.9 * size, 0.7 * size), focal, (0, 0, 1)]
     pl.reset_camera()
     pl.camera.zoom(1.4)
-    atomic_write(Path(path), lambda tmp: pl.screenshot(str(tmp)))
-    pl.close()
+    return pl
 
 
 def deformed_png(grid, path: Path, title: str = "", growth_m: dict | None = None) -> None:
     """Half-section deformed by the displacement, exaggerated so that the largest
     displacement shows as 3 % of the spindle length; colour: axial displacement [µm].
     ``grid`` is a field grid with displacement (reference.fields.add_displacement)."""
+    plt = _pyplot()
+    fig = deformed_figure(grid, title, growth_m)
+    atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=130))
+    plt.close(fig)
+
+
+def deformed_figure(grid, title: str = "", growth_m: dict | None = None):
+    """The matplotlib figure of :func:`deformed_png`."""
     import matplotlib.tri as mtri
 
     plt = _pyplot()
@@ -103,5 +118,4 @@ def deformed_png(grid, path: Path, title: str = "", growth_m: dict | None = None
     ax.set_aspect("equal")
     ax.set_xlabel("z [mm]")
     ax.set_ylabel("r [mm]")
-    atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=130))
-    plt.close(fig)
+    return fig
