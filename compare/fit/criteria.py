@@ -52,21 +52,6 @@ class Criteria:
         "channels: a law of the inputs predicts the blocks it was not fitted on. A quarter is "
         "five times the scatter of the folds' own refits (a few % on a run with nothing to "
         "find)")
-    open_loop_needs_plausible_base: bool = _c(
-        False, "-", "True: an effect is named by the open loop only where, with it, the base "
-        "parameters are jointly plausible (their squared prior z summed within the chi-square "
-        "quantile at alpha, one degree of freedom each), since a base that needs implausible "
-        "values has a form in doubt. Off by default: on 83 drawn and peer runs (docs/fit.md) "
-        "it kept 3 right names and no wrong one from the first round; a base far from its "
-        "spec is common, and the cross-validation and the competitor already guard the "
-        "attribution")
-    signature_must_agree: bool = _c(
-        True, "-", "where an effect's signature test applies to the run and is not "
-        "significant at alpha, the effect is not named by either route: its own test could "
-        "look for it and did not find it, so the open loop's attribution of a misfit to it is "
-        "a guess. The open loop names only effects whose test does not apply to the run (or "
-        "that have none). Weak evidence then ends in 'nothing named' rather than a name "
-        "(False: a silent test vetoes only where its interval excludes the fitted size)")
     held_out_misfit_unexplained: bool = _c(
         True, "-", "where nothing is named and the final model misses a channel's tolerance "
         "on the held-out validation window (open-loop RMS above one tolerance), the run is "

@@ -85,15 +85,6 @@ class Local:
         t = self.prior_rows * (self.z0 + delta[:kb] - self.prior_z)
         return 0.5 * float(t @ t)
 
-    def prior_z_after(self, delta: np.ndarray) -> np.ndarray:
-        """Each free base parameter's distance from its prior centre [prior sd] after the
-        step ``delta`` (0 where it has no prior)."""
-        kb = self.J.shape[1]
-        sd = np.array([self.cal.gb.variant(self.fit.effects).parameters()[k].prior_sd or 0.0
-                       for k in self.fit.free])
-        t = np.where(self.prior_rows > 0, (self.z0 + delta[:kb] - self.prior_z), 0.0)
-        return np.divide(t, sd, out=np.zeros_like(t), where=sd > 0)
-
     def loglik(self, r: np.ndarray, rows: np.ndarray) -> float:
         """The concentrated log-likelihood of residual ``r`` over ``rows`` (as
         compare.fit.calibrate.Calibrator.loglik)."""

@@ -375,7 +375,7 @@ def _criteria_html(doc: dict) -> str:
     """Every judged candidate and each named criterion's outcome."""
     rows = []
     names = ("significant", "material", "signature", "predicts", "beats_something_else",
-             "distinct", "base_plausible")
+             "distinct", "changes_prediction")
     for c in doc.get("candidates", []):
         crit = c["criteria"]
         rows.append([c["candidate"], c["round"], f"{c['gain']:.1f}", p_text(c["p_value"]),

@@ -10,17 +10,19 @@ then refitted to convergence. Every candidate must be
 
 - ``material``: at its estimate it moves one of its channels by ``material_peak`` tolerances;
 - ``significant``: its likelihood-ratio test against the current model at ``alpha``
-  (the likelihood of compare.fit.calibrate), or, on the signature route, ``jointly_significant``:
-  Fisher's combination of that test and the signature's is (a base that absorbs part of an
-  effect its signature shows leaves the fit a small gain);
+  (the likelihood of compare.fit.calibrate; the null is the current model refitted by the
+  same linearized step without the candidate, so that what a base fit stopped short of its
+  optimum gains by one more step counts for no candidate), on both routes: a signature
+  tells which effect a misfit is, the likelihood that the model needs one (an intersection
+  of the two tests, each at ``alpha``; a joint test of the two would name an effect the fit
+  does not want on a signature alone);
 
 and then show that it is *this* effect, by one of two routes:
 
 - **its signature** (``signature``): its test on the raw samples, where one applies, is
   significant at ``alpha``: evidence no misfit of the base model, no other effect and no
   window of something else can give. Where the test applies and is not significant, the
-  effect does not qualify by either route (``Criteria.signature_must_agree``; switched off,
-  only where the test's (1 - alpha) interval excludes the fitted size);
+  effect does not qualify by either route: its own test looked for it and did not find it;
 - **the open loop**, where no signature test applies to the run, all of:
 
   - ``predicts``: it lowers the blocked cross-validated error above the noise floor on its
@@ -34,14 +36,6 @@ and then show that it is *this* effect, by one of two routes:
   - ``distinct``: its penalised gain exceeds that of every other candidate acting on one of
     its channels by half the chi-square quantile of one degree of freedom at ``alpha``
     (3.3 at 1 %): two effects that explain the run alike are a guess, not a finding;
-  - ``base_plausible`` (only with ``Criteria.open_loop_needs_plausible_base``, off by
-    default): with the candidate, the base parameters are jointly plausible: the
-    sum of their squared prior z is within the chi-square quantile at ``alpha`` with one
-    degree of freedom per parameter with a prior (the test of a Gaussian prior's consistency;
-    a parameter-by-parameter test at ``alpha`` would fail one of ten parameters of a right
-    model one time in ten). The open loop attributes what the base model misses to the
-    effect; where the base still needs implausible values beside it, the base's form is in
-    doubt and so is that attribution.
 
 A qualifying candidate joins the model if it adds the most likelihood among those that
 qualify, and the next round judges the rest against the model that holds it (a second effect
@@ -89,12 +83,12 @@ class Judgement:
         c = self.criteria
         if not c["material"] or c["signature"] is False:
             return None
-        if c["signature"] and (c["significant"] or c.get("jointly_significant")):
-            return "signature"
         if not c["significant"]:
             return None
+        if c["signature"]:
+            return "signature"
         open_loop = ("predicts", "beats_something_else", "distinct")
-        optional = ("changes_prediction", "base_plausible")  # None: switched off
+        optional = ("changes_prediction",)  # None: switched off
         ok = all(c.get(k) for k in open_loop) and all(c.get(k) is not False for k in optional)
         return "open loop" if ok else None
 
@@ -185,20 +179,6 @@ def _own(label: str) -> tuple[str, ...]:
     return (channel,) if channel else effect_of(label).channels
 
 
-def _fisher(*p_values: float) -> float:
-    """Fisher's combination of independent p-values (a signature read from the power or a
-    channel's onsets, and the open-loop fit's likelihood ratio)."""
-    from scipy.stats import combine_pvalues
-
-    return float(combine_pvalues([max(p, 1e-300) for p in p_values], method="fisher").pvalue)
-
-
-def _plausible(z: np.ndarray, k: int, alpha: float) -> bool:
-    """The base parameters' prior z (0 where a parameter has none; ``k`` have one) jointly
-    plausible at ``alpha``."""
-    return bool(float(z @ z) <= chi2_threshold(alpha, k)) if k else True
-
-
 def _cv_excess(cv: dict[str, float], floor: Mapping[str, float] | None,
                channels: Sequence[str]) -> float:
     """Cross-validated error above the noise floor on ``channels`` [tolerances squared]."""
@@ -217,31 +197,14 @@ def _signature_start(label: str, signature) -> dict[str, float] | None:
     return {p.name: min(max(par["value"], p.lo + 1e-6 * (p.hi - p.lo)), p.hi)}
 
 
-def signature_outcome(signature, values: Mapping[str, float], alpha: float,
-                      must_agree: bool = False) -> bool | None:
+def signature_outcome(signature, alpha: float) -> bool | None:
     """True where the signature test is significant at ``alpha``; None where it does not
-    apply (or there is none). Where it applies and is not significant: False with
-    ``must_agree`` (Criteria.signature_must_agree: the test did not find the effect);
-    otherwise False only where its (1 - alpha) interval excludes the fitted value (the test
-    had the chance to see an effect of that size and did not), and None where it cannot
-    tell."""
-    from scipy.stats import norm
-
+    apply (or there is none); False where it applies and is not significant: its own test
+    could look for the effect and did not find it, so an attribution of a misfit to it is a
+    guess, and weak evidence ends in 'nothing named' rather than a name."""
     if signature is None or not signature.applies:
         return None
-    if signature.significant(alpha):
-        return True
-    if must_agree:
-        return False
-    par = signature.parameter
-    if not par or par["name"] not in values:
-        return None
-    lo, hi = par["ci95"]
-    widen = float(norm.isf(alpha / 2)) / 1.96
-    centre = par["value"]
-    v = values[par["name"]]
-    return None if centre - widen * (centre - lo) <= v <= centre + widen * (hi - centre) \
-        else False
+    return bool(signature.significant(alpha))
 
 
 def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Criteria,
@@ -274,10 +237,16 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         say(f"round {rnd}: fitting something else")
         shrink = current.n_eff / max(current.n, 1)
         found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit, shrink)
-        g_gain = joint_gain(loc, reg, found)
-        # every candidate's gain, penalised by half ln(n_eff) per parameter (BIC)
+        # the null of every test: the current model refitted by the same step without a
+        # candidate (a nonlinear fit stopped short of its optimum leaves the step a gain of
+        # its own, which is no candidate's)
+        null = NullStep(*loc.gain())
+        null.residual = loc.residual(null.delta)
+        g_gain = joint_gain(loc, reg, found) - null.gain
+        # every candidate's gain over the null, penalised by half ln(n_eff) per parameter (BIC)
         pen = 0.5 * math.log(max(current.n_eff, 2.0))
-        penalised = {lab: f.gain - pen * len(effect_of(lab).params) for lab, f in fits.items()}
+        penalised = {lab: f.gain - null.gain - pen * len(effect_of(lab).params)
+                     for lab, f in fits.items()}
         cv_now = loc.cross_validate(criteria.cv_blocks) if criteria.cv_blocks else None
         round_judged = []
         for lab, ef in fits.items():
@@ -286,7 +255,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
                       and set(_own(other)) & set(_own(lab))]
             round_judged.append(judge(loc, ef, sig.get(lab), criteria, penalised[lab],
                                       g_gain - 3 * pen, max(rivals, default=-math.inf),
-                                      cv_now, rnd))
+                                      cv_now, rnd, null))
         judged += round_judged
         qualified = [j for j in round_judged if j.qualifies]
         if not qualified:
@@ -306,39 +275,48 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
     return Selection(base, steps, judged, verdict_on(loc, reg, criteria, named=bool(steps)))
 
 
+@dataclass
+class NullStep:
+    """The current model refitted by one step of the linearized model without a candidate:
+    its log-posterior gain over the current fit, its step and its residual (every row)."""
+
+    gain: float
+    delta: np.ndarray
+    residual: np.ndarray | None = None
+
+
 def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
-          competitor: float, rival: float, cv_now: dict | None, rnd: int) -> Judgement:
+          competitor: float, rival: float, cv_now: dict | None, rnd: int,
+          null: NullStep | None = None) -> Judgement:
     """The named criteria of one candidate fitted on the linearized model (module
-    docstring). ``penalised``: its gain less half ln(n_eff) per parameter; ``competitor`` and
-    ``rival``: the same of the competitor's best hypothesis and of the best other candidate
-    on its channels."""
+    docstring). ``penalised``: its gain over the ``null`` (the current model refitted by the
+    same step, :class:`NullStep`; None: the current model as it is) less half ln(n_eff) per
+    parameter; ``competitor`` and ``rival``: the same of the competitor's best hypothesis and
+    of the best other candidate on its channels."""
     from scipy.stats import chi2
 
     cal = loc.cal
     k = len(effect_of(ef.label).params)
-    lr = max(2.0 * ef.gain, 0.0)
+    gain = ef.gain - (null.gain if null is not None else 0.0)
+    lr = max(2.0 * gain, 0.0)
     pv = float(chi2.sf(lr, k))
     own = _own(ef.label)
     rows = np.isin(loc.channel, [cal.channels.index(c) for c in own if c in cal.channels])
     peak = float(np.max(np.abs(ef.shift[rows]))) if rows.any() else 0.0
-    # what the fitted model's prediction moves by, the base's re-adjustment included
-    net = float(np.max(np.abs(loc.r0[rows] - ef.residual[rows]))) if rows.any() else 0.0
+    # what the fitted model's prediction moves by against the null, the base's
+    # re-adjustment around the effect included
+    r_null = null.residual if null is not None and null.residual is not None else loc.r0
+    net = float(np.max(np.abs(r_null[rows] - ef.residual[rows]))) if rows.any() else 0.0
     margin = 0.5 * chi2_threshold(criteria.alpha, 1)
     out: dict[str, bool | None] = {
         "significant": pv < criteria.alpha,
         "material": peak >= criteria.material_peak,
-        "signature": signature_outcome(signature, ef.values, criteria.alpha,
-                                       criteria.signature_must_agree),
-        "jointly_significant": (_fisher(signature.p_value, pv) < criteria.alpha
-                                if signature is not None and signature.applies else None),
+        "signature": signature_outcome(signature, criteria.alpha),
         "predicts": None,
         "changes_prediction": (net >= criteria.material_peak
                                if criteria.open_loop_material_change else None),
         "beats_something_else": bool(penalised >= competitor),
         "distinct": bool(penalised >= rival + margin),
-        "base_plausible": (_plausible(loc.prior_z_after(ef.delta),
-                                      int(np.count_nonzero(loc.prior_rows)), criteria.alpha)
-                           if criteria.open_loop_needs_plausible_base else None),
     }
     figures: dict[str, float | None] = {
         "values": ef.values, "penalised_gain": penalised,
@@ -350,7 +328,7 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
         after = _cv_excess(effect_held_out(loc, ef, criteria.cv_blocks), cal.floor, own)
         out["predicts"] = bool(after <= (1.0 - criteria.cv_gain) * before)
         figures.update(cv_before=before, cv_after=after)
-    return Judgement(ef.label, rnd, None, ef.gain, lr, pv, peak, out, figures)
+    return Judgement(ef.label, rnd, None, gain, lr, pv, peak, out, figures)
 
 
 def verdict_on(loc: Local, reg, criteria: Criteria, named: bool = False) -> Verdict:
