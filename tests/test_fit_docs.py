@@ -59,18 +59,76 @@ def test_the_generalisation_figures_are_the_benchmarks_file():
     assert block.strip("`").strip() == generated.strip()
 
 
-@pytest.mark.parametrize(("block", "off_file", "on_file"), [
-    ("trade", "fit-families-material-change-off.txt", "fit-families-before-held-out-misfit.txt"),
-    ("trade-held-out", "fit-families-before-held-out-misfit.txt", "fit-families.txt")])
-def test_the_trade_table_is_the_two_files(block, off_file, on_file):
-    """docs/fit.md's tables of a rule's trade quote the rates of the run without the rule and
-    with it (the generated summaries), line by line."""
-    figures = ROOT / "docs" / "figures"
-    off = (figures / off_file).read_text(encoding="utf-8")
-    on = (figures / on_file).read_text(encoding="utf-8")
-    rows = _rows(_block(block))
-    assert rows
-    for rate, a, b in rows:
-        for text, cell in ((off, a), (on, b)):
-            k, n = (int(x) for x in cell.split(" of "))
-            assert re.search(rf"^  {re.escape(rate)}\s+{k} of\s+{n}\s", text, re.M), (rate, cell)
+def trade_table(doc: dict) -> str:
+    """A rule's trade as docs/fit.md shows it, from the figures file that
+    benchmarks/compare_reports.py wrote: per family, the counts before -> after, then the
+    runs whose verdict changed."""
+    def cell(row: dict, key: str, fmt: str = "{}") -> str:
+        b, a = row["before"][key], row["after"][key]
+        return "—" if b is None or a is None else f"{fmt.format(b)} → {fmt.format(a)}"
+
+    lines = ["| family | runs | right verdict | true effect first | a wrong name | "
+             "unexplained | base RMS [tol] |", "|---|---:|---|---|---|---|---|"]
+    for fam, row in doc["families"].items():
+        lines.append(f"| {fam} | {row['runs']} | {cell(row, 'right')} | {cell(row, 'first')} | "
+                     f"{cell(row, 'wrong')} | {cell(row, 'unexplained')} | "
+                     f"{cell(row, 'base_rms_tol_median', '{:.3f}')} |")
+    lines.append("")
+    if not doc["changed"]:
+        lines.append("No verdict changed.")
+    for c in doc["changed"]:
+        def text(v) -> str:
+            return ", ".join(v) if isinstance(v, list) else v
+        lines.append(f"- {c['run']}: {text(c['before'])} → {text(c['after'])} "
+                     f"({'right' if c['right'][0] else 'not right'} → "
+                     f"{'right' if c['right'][1] else 'not right'})")
+    return "\n".join(lines)
+
+
+#: the trades of docs/fit.md measured with benchmarks/compare_reports.py, by block
+TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
+          "trade-null-step": "fit-trade-null-step.json",
+          "trade-signature-lr": "fit-trade-signature-lr.json",
+          "trade-gap": "fit-trade-gap.json",
+          "trade-reanchor": "fit-trade-reanchor.json"}
+
+
+@pytest.mark.parametrize("block", sorted(TRADES))
+def test_each_trade_is_its_figures_file(block):
+    import json
+
+    from tests.docs_blocks import assert_block
+
+    doc = json.loads((ROOT / "docs" / "figures" / TRADES[block]).read_text(encoding="utf-8"))
+    assert_block("docs/fit.md", block, trade_table(doc))
+
+
+#: issue 32's targets: the summary's line, the bound and its direction
+TARGETS = (("true effect named first (runs with an effect)", 95.0, ">="),
+           ("unexplained, nothing named (runs outside the library)", 90.0, ">="),
+           ("nothing named on clean runs", 95.0, ">="),
+           ("a false second effect (after a right first)", 5.0, "<="),
+           ("a wrong effect named (any run)", 2.0, "<="),
+           ("validation RMS within the tolerances (named or adequate)", 100.0, ">="))
+
+
+def targets_table(summary: str) -> str:
+    """docs/fit.md's table of issue 32's targets from the benchmark's summary file: the rate
+    with its 95 % interval, and whether the rate itself meets the target."""
+    lines = ["| target | issue 32 | measured (95 % interval) | met |", "|---|---|---|---|"]
+    for label, bound, op in TARGETS:
+        m = re.search(rf"^  {re.escape(label)}\s+(\d+) of\s+(\d+)\s+([\d.]+) %\s+"
+                      r"\[\s*([\d.]+),\s*([\d.]+)\]", summary, re.M)
+        assert m, f"the summary has no line '{label}'"
+        k, n, p, lo, hi = m.groups()
+        met = float(p) >= bound if op == ">=" else float(p) <= bound
+        lines.append(f"| {label} | {'≥' if op == '>=' else '≤'} {bound:g} % | {k} of {n}, "
+                     f"{p} % [{lo}, {hi}] | {'yes' if met else 'no'} |")
+    return "\n".join(lines)
+
+
+def test_the_targets_table_is_the_benchmarks_file():
+    from tests.docs_blocks import assert_block
+
+    summary = (ROOT / "docs" / "figures" / "fit-families.txt").read_text(encoding="utf-8")
+    assert_block("docs/fit.md", "targets", targets_table(summary))

@@ -188,3 +188,23 @@ def test_an_unexplained_verdict_says_which_channel_and_which_input():
                                         "after it")
     # on the validation window (the last 40 %) both channels are noise of 0.05 tolerances
     assert residual_place(rep)["rms_tolerances"] < 0.1
+
+
+def test_something_else_is_not_looked_for_where_the_inputs_are_not_known():
+    """A logging gap with an operating change inside: what ran in the gap is a guess until the
+    response to it has settled, so the rows from the gap's start to an hour after its end
+    are left out of the competitor's scan (compare.fit.select.known_inputs); the rest stay."""
+    from types import SimpleNamespace
+
+    from compare.fit.select import known_inputs
+
+    grid = np.arange(0.0, 10 * 3600.0 + 1.0, 60.0)
+    point = np.concatenate([np.arange(len(grid)), np.arange(len(grid))])  # two channels
+    loc = SimpleNamespace(cal=SimpleNamespace(measured=SimpleNamespace(grid_s=grid)),
+                          point=point)
+    gap = (3.0 * 3600.0, 3.5 * 3600.0 + 3600.0)
+    rows = known_inputs(loc, [gap])
+    t = grid[point]
+    assert not rows[(t >= 3.0 * 3600.0) & (t < 4.5 * 3600.0)].any()
+    assert rows[(t < 3.0 * 3600.0) | (t >= 4.5 * 3600.0)].all()
+    assert known_inputs(loc, []).all()

@@ -50,17 +50,13 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec_reader import load_spec
 
     base_extra = _base_extra(args.base_extra)
-    if args.model == "fem" and args.lumped_only:
-        raise InputError("command line", "--model", "--model fem calibrates on the FEM "
-                         "reference, --lumped-only switches the FEM off",
-                         "drop one of the two options")
     spec = load_spec(args.spec)
     default = f"results/{safe_name(spec.name)}/fit-{safe_name(Path(args.run).stem)}"
     out = out_folder(args.out, default, [spec.path, args.run], force=args.force)
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
                   candidates=args.candidates, min_gain=args.min_gain / 100.0,
                   progress=progress.say,
-                  fem_level=None if args.lumped_only else args.fem_level, model=args.model,
+                  fem_level=None if args.lumped_only else args.fem_level,
                   base_extra=base_extra, blocks=args.blocks,
                   cv_blocks=args.cv_blocks)
     with output_dir(out, inputs=[spec.path, args.run], force=args.force) as tmp, progress.pictures():
@@ -105,11 +101,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     fp.add_argument("--lumped-only", action="store_true",
                     help="no FEM anchor and no priors: the lumped model alone, factors from "
                     "1 (faster; effects the base parameters can imitate go unnamed)")
-    fp.add_argument("--model", choices=("lumped", "fem"), default="lumped",
-                    help="model the base parameters are calibrated on (default lumped: the "
-                    "lumped model anchored to the FEM at the spec's values; fast). fem: "
-                    "calibrate the base parameters on the FEM reference itself (minutes), "
-                    "then select effects on the lumped model anchored there")
     fp.add_argument("--base-extra", nargs="+", metavar="PARAM",
                     choices=(*EXTRA_BASE_PARAMS, "none"),
                     help="the extra base parameters to calibrate, for a spindle its spec "
@@ -117,7 +108,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "rings to the coolant), axial_scale (every axial length times s), "
                     "heat_capacity (a factor on every heat capacity), "
                     "friction_exponent (bearing friction times (n / 3000 rpm)^e), or none "
-                    f"(default: {' '.join(DEFAULT_BASE_EXTRA)} with --model lumped; "
+                    f"(default: {' '.join(DEFAULT_BASE_EXTRA)}; "
                     "docs/fit.md)")
     fp.add_argument("--nodes", type=NODE_COUNT, default=11, help="lumped model nodes (default 11)")
     fp.add_argument("--candidates", nargs="+", choices=list(LIBRARY), metavar="EFFECT",

@@ -61,11 +61,6 @@ class Criteria:
         "library took it up. 'Base inadequate' said the same and pointed at the spec alone; "
         "the report still gives the adequacy verdict on the spec. False: such runs end "
         "'nothing named, base inadequate'")
-    reanchor: bool = _c(
-        False, "-", "the FEM anchor is set again at the calibrated base values and the base "
-        "recalibrated from there: the grey box is then the FEM where the run calibrates it, "
-        "not only at the spec's values, so the lumped model's sensitivities carry only the "
-        "last step (issue 32, item 4). One FEM run and one calibration more")
     competitor_step_s: float = _c(
         1800.0, "s", "the time grid of the competitor's windows: half an hour resolves an "
         "event of a few hours, and a 16 h run gives 32 blocks, 528 windows")
@@ -93,12 +88,6 @@ class Criteria:
     refit_nfev: int = _c(
         20, "evaluations", "computing budget of the refit of the candidate that joins the "
         "model, which starts from its Gauss-Newton fit and converges in a few iterations")
-    fem_max_nfev: int = _c(
-        12, "evaluations", "computing budget of --model fem with priors (each evaluation of the "
-        "Jacobian costs six FEM runs; the data cost is flat to 0.1 % by then)")
-    fem_free_nfev: int = _c(
-        5, "evaluations", "computing budget of --model fem without priors (it only sets the "
-        "data's weight against the priors and the noise floor)")
 
     # ---------------------------------------------------------------- input timing
     gap_min_steps: float = _c(
@@ -106,7 +95,9 @@ class Criteria:
         "logging gap (a bench logging on change writes at least a heartbeat per step)")
     gap_judge_s: float = _c(
         3600.0, "s", "an operating change inside a logging gap is placed where the model fits "
-        "the hour after the gap best: long against the rings' settling, short against the run")
+        "the hour after the gap best: long against the rings' settling, short against the run. "
+        "Until that hour is over the inputs are not known (what ran inside the gap is a "
+        "guess), so something else is not looked for in the gap nor in that hour")
     gap_level_s: float = _c(
         300.0, "s", "the speed and power levels either side of a gap are read over five "
         "minutes of samples")

@@ -110,22 +110,3 @@ def fem_discrepancy(gb: GreyBox, channels: tuple[str, ...] | list[str], level: i
     rms = {c: float(np.sqrt(np.mean(offsets[c] ** 2))) for c in channels}
     return Discrepancy(theta, offsets, rms, level, time.perf_counter() - t0)
 
-
-def fem_discrepancy_at(gb: GreyBox, channels: tuple[str, ...] | list[str], level: int,
-                       theta: dict[str, float]) -> Discrepancy:
-    """FEM minus lumped at the base values of ``theta`` (a calibrated base) on ``gb``'s inputs:
-    the FEM with those films, contacts, loss split and friction (compare.fit.femgrey), the
-    lumped model with the same and its extra parameters at their defaults. The anchored grey
-    box is then the FEM at that point, where the spec's anchor makes it the FEM only at the
-    spec's values (Criteria.reanchor)."""
-    from compare.fit.femgrey import FemGreyBox
-    from compare.fit.params import BASE_PARAMS
-
-    t0 = time.perf_counter()
-    at = {k: float(theta[k]) for k in BASE_PARAMS if k in theta}
-    fem = FemGreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, level).simulate(at)
-    lumped = gb.plain().simulate(at)
-    offsets = {c: fem[c] - lumped[c] for c in channels}
-    rms = {c: float(np.sqrt(np.mean(offsets[c] ** 2))) for c in channels}
-    return Discrepancy(at, offsets, rms, level, time.perf_counter() - t0)
-

@@ -23,7 +23,9 @@ from spindle.drive import drive_for
 from spindle.outputs import jsonable
 from spindle.tolerances import edge_absolute, edge_scale, edge_unit
 
-REPORT_FORMAT = "spindle-verify-fit/2"
+#: 3: ``calibration_model`` and ``fem_calibration`` gone with ``--model fem``; the verdict's
+#: ``residual`` (where an unexplained residual lives)
+REPORT_FORMAT = "spindle-verify-fit/3"
 
 
 def _place_of(rep, verdict: dict) -> dict | None:
@@ -220,8 +222,6 @@ def report_dict(rep) -> dict:
         "tolerances": {"temperature_K": TOLERANCE["T1"],
                        "growth_um": TOLERANCE["P1"] * edge_scale("P1")},
         "alpha": rep.criteria.alpha,
-        "calibration_model": rep.calibration_model,
-        "fem_calibration": rep.fem_calibration,
         "base_adequacy": rep.base_adequacy,
         "warnings": rep.warnings,
         "gap_switches": [asdict(g) for g in rep.gap_switches],
@@ -250,8 +250,7 @@ def summary_text(rep) -> str:
     doc = rep.to_dict()
     lines = verdict_lines(doc)
     lines.append(f"{rep.run.path}: {len(rep.run.time_s)} rows, {rep.run.duration_s / 3600:.2f} "
-                 f"h, channels {', '.join(rep.channels)}; calibrated on the "
-                 f"{rep.calibration_model} model; {rep.runtime_s:.1f} s")
+                 f"h, channels {', '.join(rep.channels)}; {rep.runtime_s:.1f} s")
     ad = doc.get("base_adequacy")
     if ad:
         lines.append(f"The base model {ad['statement']}.")
@@ -438,9 +437,5 @@ def _html(rep, doc: dict, out: Path, pngs: Sequence[tuple[str, str]]) -> str:
         f"{html.escape(ad.get('statement', ''))}.</p>",
         "<h2>Calibrated parameters (95 % intervals)</h2>" + params,
         *[html_figure(out / n, c) for n, c in pngs[1:]],
-        f"<p>Channels {', '.join(rep.channels)}; calibration model: "
-        f"<b>{html.escape(rep.calibration_model)}</b>"
-        + (" (the base parameters calibrated on the FEM reference itself, the effects "
-           "selected on the lumped model anchored there)" if rep.calibration_model == "fem"
-           else "") + f"; {rep.runtime_s:.1f} s.</p>",
+        f"<p>Channels {', '.join(rep.channels)}; {rep.runtime_s:.1f} s.</p>",
         "<details><summary>The criteria of this fit</summary>" + crit + "</details>"])

@@ -5,7 +5,7 @@
    logging gap (compare.fit.gaps).
 2. Anchor the grey box to the FEM reference on the run's inputs (compare.fit.discrepancy) and
    calibrate the base parameters with priors around the spec's values on the fit window
-   (compare.fit.calibrate); with ``model="fem"`` on the FEM itself (compare.fit.femgrey).
+   (compare.fit.calibrate).
 3. Read every effect's signature test on the raw samples (compare.fit.signatures, each
    effect's own test), select effects against "something else" by the named criteria
    (compare.fit.select, compare.fit.criteria) and fit "something else" on the final model.
@@ -27,7 +27,7 @@ from compare.fit.criteria import Criteria
 from compare.fit.effects import LIBRARY
 from compare.fit.effects import candidates as candidate_labels
 from compare.fit.greybox import GreyBox, Inputs
-from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, base_params, default_theta
+from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, default_theta
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
 from spindle.bench import BenchRun, check_against_spec, read_bench
@@ -88,21 +88,18 @@ def greybox_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = 2.0)
     return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + ZERO_C_K)
 
 
-def _check_base_extra(base_extra: tuple[str, ...], model: str) -> None:
+def _check_base_extra(base_extra: tuple[str, ...]) -> None:
     unknown = [k for k in base_extra if k not in EXTRA_BASE_PARAMS]
     if unknown:
         raise InputError("command line", "--base-extra", f"unknown parameter {unknown[0]}",
                          f"use {' or '.join(EXTRA_BASE_PARAMS)}")
-    if base_extra and model == "fem":
-        raise InputError("command line", "--base-extra", "the FEM calibration swaps films, "
-                         "contacts and sources only", "drop --base-extra or --model fem")
 
 
 @dataclass
 class BaseCalibration:
     """Where the selection starts: the bench run, its channels, the grey box's inputs, the
     measured data with its windows, the calibrator, the calibrated base fit, the spec's own
-    parameter values, and the FEM anchor and FEM calibration details (None where unused)."""
+    parameter values, and the FEM anchor (None where unused)."""
 
     run: BenchRun
     channels: list[str]
@@ -112,7 +109,6 @@ class BaseCalibration:
     base: Fit
     spec_values: dict[str, float]
     anchor: object | None = None
-    fem_calibration: dict | None = None
     #: compare.fit.gaps.GapSwitch per logging gap with an operating change inside
     gap_switches: list = field(default_factory=list)
     #: which model placed them: the calibrated, anchored one (the lumped path) or the spec's
@@ -121,26 +117,16 @@ class BaseCalibration:
 
 def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, nodes: int = 11,
                    grid_s: float = 60.0, progress: Callable[[str], None] | None = None,
-                   fem_level: int | None = 0, model: str = "lumped",
-                   base_extra: tuple[str, ...] | None = None, blocks: int = 1,
-                   criteria: Criteria | None = None) -> BaseCalibration:
+                   fem_level: int | None = 0, base_extra: tuple[str, ...] | None = None,
+                   blocks: int = 1, criteria: Criteria | None = None) -> BaseCalibration:
     """Read the run, check it against the spec, anchor the grey box to the FEM reference and
     calibrate the base parameters (arguments as :func:`run_fit`)."""
     from compare.fit.discrepancy import fem_discrepancy
 
     criteria = criteria or Criteria()
     say = progress or (lambda _m: None)
-    if model not in ("lumped", "fem"):
-        raise InputError("command line", "--model", f"unknown model '{model}'",
-                         "use lumped or fem")
-    if model == "fem" and fem_level is None:
-        raise InputError("command line", "--model", "--model fem calibrates on the FEM "
-                         "reference, --lumped-only switches the FEM off",
-                         "drop one of the two options")
-    if base_extra is None:  # the default extras, with the lumped calibration only
-        base_extra = DEFAULT_BASE_EXTRA if model == "lumped" else ()
-    base_extra = tuple(base_extra)
-    _check_base_extra(base_extra, model)
+    base_extra = tuple(DEFAULT_BASE_EXTRA if base_extra is None else base_extra)
+    _check_base_extra(base_extra)
     if not 0.2 <= fit_fraction <= 0.9:
         raise InputError("command line", "--fit-fraction", f"{fit_fraction} is outside 0.2..0.9",
                          "fit on 20 % to 90 % of the run, e.g. 0.6")
@@ -176,7 +162,6 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         return anchor, cal.fit_with_prior({**spec_values, **anchor.theta_ref}, start=start)[1]
 
     anchor = None
-    fem_cal_info = None
     placed_by = "the spec's model"
     # an extra whose spec value is its range's bound (a conductance the spec lacks) starts
     # inside its range: a start on the bound can stall there
@@ -186,8 +171,6 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     if fem_level is None:  # the lumped model alone, factors from 1, no priors
         say("calibrating the base model")
         base = cal.fit(start=start)
-    elif model == "fem":
-        base, anchor, fem_cal_info = _calibrate_on_fem(cal, fem_level, say, criteria)
     else:
         anchor, base = anchored(cal, start)
         if switches:
@@ -202,16 +185,8 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                 inputs, switches = again, moved
                 cal = calibrator(inputs)
                 anchor, base = anchored(cal, base.theta)
-        if criteria.reanchor:
-            from compare.fit.discrepancy import fem_discrepancy_at
-
-            say("anchoring the FEM at the calibrated base values")
-            anchor = fem_discrepancy_at(cal.gb, channels, fem_level, base.theta)
-            cal.gb.discrepancy = anchor.offsets
-            say("calibrating the base model again")
-            base = cal.fit(start=base.theta)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
-                           fem_cal_info, switches, placed_by)
+                           switches, placed_by)
 
 
 def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measured: Measured,
@@ -274,8 +249,6 @@ class FitReport:
     anchor: object = None  # compare.fit.discrepancy.Discrepancy; None: lumped alone, no priors
     floor: dict | None = None  # per channel [tolerance units]
     prior_z: dict | None = None  # final base parameters, prior sds from the spec's values
-    calibration_model: str = "lumped"  # "fem": base parameters calibrated on the FEM itself
-    fem_calibration: dict | None = None  # with "fem": FEM runs, seconds, evaluations
     #: compare.fit.adequacy.base_adequacy of the calibrated base model ("with_effects": final)
     base_adequacy: dict | None = None
     #: operating points of the validation window the fit window never saw, gap switches
@@ -301,14 +274,12 @@ class FitReport:
 def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
             nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
             min_gain: float | None = None, progress: Callable[[str], None] | None = None,
-            fem_level: int | None = 0, model: str = "lumped",
-            base_extra: tuple[str, ...] | None = None, blocks: int = 1,
-            cv_blocks: int = 5, criteria: Criteria | None = None) -> FitReport:
-    """The whole loop (module docstring). ``model``: "lumped" calibrates the base parameters
-    on the lumped grey box anchored to the FEM at the spec's values; "fem" calibrates them on
-    the FEM reference itself (level ``fem_level``), then anchors the lumped grey box there.
-    ``base_extra``: names of EXTRA_BASE_PARAMS calibrated with the base (lumped calibration
-    only). ``blocks``: the run is cut into that many blocks, of which about 1 -
+            fem_level: int | None = 0, base_extra: tuple[str, ...] | None = None,
+            blocks: int = 1, cv_blocks: int = 5, criteria: Criteria | None = None) -> FitReport:
+    """The whole loop (module docstring): the base parameters are calibrated on the lumped
+    grey box anchored to the FEM (level ``fem_level``; None: the lumped model alone, no
+    priors) at the spec's values. ``base_extra``: names of EXTRA_BASE_PARAMS calibrated with
+    the base. ``blocks``: the run is cut into that many blocks, of which about 1 -
     ``fit_fraction`` validate, spread over the run (1: the fit window is the first
     ``fit_fraction``). ``alpha``, ``min_gain`` (the cross-validated gain asked, a share) and
     ``cv_blocks`` set the criteria of those names (compare.fit.criteria); ``candidates``:
@@ -324,13 +295,17 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
         raise InputError("command line", "--candidates", f"unknown effect {unknown[0]}",
                          f"use some of {', '.join(LIBRARY)}")
     say = progress or (lambda _m: None)
-    prep = calibrate_base(path, spec, fit_fraction, nodes, grid_s, progress, fem_level, model,
+    prep = calibrate_base(path, spec, fit_fraction, nodes, grid_s, progress, fem_level,
                           base_extra, blocks, criteria)
     run, channels, inputs, measured = prep.run, prep.channels, prep.inputs, prep.measured
     cal, base = prep.cal, prep.base
     say("reading the effects' signatures in the raw samples")
     sig = signature_tests(run, cal.gb, base.theta, channels, criteria)
-    sel = select(cal, base, candidate_labels(channels, candidates), criteria, sig, say)
+    # a logging gap with an operating change: its inputs are not known until the response
+    # to them has settled (Criteria.gap_judge_s, the hour the switch is placed on)
+    unknown = [(g.start_s, g.end_s + criteria.gap_judge_s) for g in prep.gap_switches]
+    sel = select(cal, base, candidate_labels(channels, candidates), criteria, sig, say,
+                 unknown_inputs=unknown)
     final = sel.final
     for fit in (sel.base, final):  # nothing impossible is written (issue 14)
         check_plausible(np.concatenate([fit.model[c] for c in channels if c != "P1"] or
@@ -367,60 +342,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
               "final": local(cal, final).cross_validation_report(criteria.cv_blocks)}
     return FitReport(run, spec, channels, measured, inputs, sel, sig, diag_b, diag_a,
                      time.perf_counter() - t0, criteria, prep.anchor, cal.floor,
-                     cal.prior_z(final) or None, model, prep.fem_calibration, adequacy, warns,
-                     cv, prep.gap_switches)
-
-
-def _calibrate_on_fem(cal: Calibrator, fem_level: int, say: Callable[[str], None],
-                      criteria: Criteria):
-    """The base parameters calibrated on the FEM reference (compare.fit.femgrey) with the same
-    priors, windows and floor as the lumped path; then ``cal``'s grey box anchored to the FEM
-    at the calibrated point, and ``cal`` given the FEM calibrator's priors and floor.
-
-    Returns (the FEM base fit, the anchor at the calibrated point, a summary for the report).
-    """
-    from compare.fit.discrepancy import Discrepancy
-    from compare.fit.femgrey import FemGreyBox
-
-    t0 = time.perf_counter()
-    gb = cal.gb
-    channels = list(cal.channels)
-    theta_spec = default_theta(base_params(gb.drive))
-    plain = gb.plain()
-    say(f"building the FEM reference (level {fem_level}) for the calibration")
-    fem = FemGreyBox(gb.spec, gb.drive, gb.inputs, gb.nodes, fem_level,
-                     progress=lambda m: say("  " + m))
-    # a warm start: the free fit of the lumped grey box anchored at the spec's values, as the
-    # lumped path calibrates it (seconds)
-    fem_spec = fem.simulate(theta_spec)
-    lumped_spec = plain.simulate(theta_spec)
-    gb.discrepancy = {c: fem_spec[c] - lumped_spec[c] for c in channels}
-    say("warm start: calibrating the anchored lumped model")
-    start = cal.fit()
-    fcal = Calibrator(fem, cal.measured, channels, max_nfev=criteria.fem_max_nfev, progress=say)
-    say("calibrating the base parameters on the FEM reference, without priors")
-    # as in the lumped path: the fit without priors sets the data's weight against them
-    free_fit, base = fcal.fit_with_prior(theta_spec, start=start.theta,
-                                         free_nfev=criteria.fem_free_nfev, say=say)
-    theta_cal = {k: base.theta.get(k, p.default) for k, p in BASE_PARAMS.items()}
-    # re-anchor: the lumped model plus [FEM - lumped] at the calibrated point is the FEM
-    # there; the selection of effects runs on it, from the calibrated point
-    fem_cal = fem.simulate(theta_cal)
-    lumped_cal = plain.simulate(theta_cal)
-    offsets = {c: fem_cal[c] - lumped_cal[c] for c in channels}
-    gb.discrepancy = offsets
-    cal.prior, cal.prior_scale, cal.floor = dict(fcal.prior), fcal.prior_scale, fcal.floor
-    seconds = time.perf_counter() - t0
-    anchor = Discrepancy(theta_cal, offsets,
-                         {c: float(np.sqrt(np.mean(offsets[c] ** 2))) for c in channels},
-                         fem_level, seconds)
-    info = {"fem_level": fem_level, "fem_runs": fem.fem_runs,
-            "fem_seconds": fem.fem_seconds, "seconds": seconds,
-            "evaluations": {"free": free_fit.nfev, "with_priors": base.nfev},
-            "max_nfev": {"free": criteria.fem_free_nfev, "with_priors": criteria.fem_max_nfev},
-            "warm_start": {k: start.theta[k] for k in BASE_PARAMS}}
-    say(f"FEM calibration: {fem.fem_runs} FEM runs, {seconds:.0f} s")
-    return base, anchor, info
+                     cal.prior_z(final) or None, adequacy, warns, cv, prep.gap_switches)
 
 
 def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fraction: float,

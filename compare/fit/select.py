@@ -207,11 +207,25 @@ def signature_outcome(signature, alpha: float) -> bool | None:
     return bool(signature.significant(alpha))
 
 
+def known_inputs(loc: Local, unknown_s: Sequence[tuple[float, float]]) -> np.ndarray:
+    """The residual rows of ``loc`` outside the spans [t0, t1) [s] whose inputs are not known
+    (a logging gap with an operating change inside, and the settling after it)."""
+    t = loc.cal.measured.grid_s[loc.point]
+    out = np.ones(len(t), dtype=bool)
+    for a, b in unknown_s:
+        out &= ~((t >= a) & (t < b))
+    return out
+
+
 def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Criteria,
            signatures: Mapping[str, object] | None = None,
-           progress: Callable[[str], None] | None = None) -> Selection:
+           progress: Callable[[str], None] | None = None,
+           unknown_inputs: Sequence[tuple[float, float]] = ()) -> Selection:
     """Forward selection of ``candidates`` (labels) from the calibrated ``base`` (module
-    docstring); ``signatures``: the run's signature tests by label."""
+    docstring); ``signatures``: the run's signature tests by label. ``unknown_inputs``: spans
+    [t0, t1) [s] where the run's inputs are not known (a logging gap with an operating change
+    inside and the settling after it): something else is not looked for there, since the
+    model's misfit there says nothing but that the inputs are not known."""
     say = progress or (lambda _m: None)
     sig = dict(signatures or {})
     current = base
@@ -236,7 +250,8 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
             fits[lab] = max(tries, key=lambda f: f.gain)
         say(f"round {rnd}: fitting something else")
         shrink = current.n_eff / max(current.n, 1)
-        found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit, shrink)
+        found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit & known_inputs(loc, unknown_inputs),
+                        shrink)
         # the null of every test: the current model refitted by the same step without a
         # candidate (a nonlinear fit stopped short of its optimum leaves the step a gain of
         # its own, which is no candidate's)
@@ -272,7 +287,8 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         current = best.fit
         loc = local(cal, current)
     say("fitting something else on the final model")
-    return Selection(base, steps, judged, verdict_on(loc, reg, criteria, named=bool(steps)))
+    return Selection(base, steps, judged, verdict_on(loc, reg, criteria, named=bool(steps),
+                                                     unknown_inputs=unknown_inputs))
 
 
 @dataclass
@@ -331,13 +347,15 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
     return Judgement(ef.label, rnd, None, gain, lr, pv, peak, out, figures)
 
 
-def verdict_on(loc: Local, reg, criteria: Criteria, named: bool = False) -> Verdict:
+def verdict_on(loc: Local, reg, criteria: Criteria, named: bool = False,
+               unknown_inputs: Sequence[tuple[float, float]] = ()) -> Verdict:
     """The competitor on the final model (linearized as ``loc``) stepped to the whole run:
     unexplained where it is significant (Bonferroni over its hypotheses) and material; and,
     with nothing ``named``, where the final model misses a tolerance on held-out data
     (:func:`held_out_misses`, Criteria.held_out_misfit_unexplained)."""
     rows = np.ones(len(loc.r0), dtype=bool)
     r = loc.residual(loc.step(rows))
+    rows = known_inputs(loc, unknown_inputs)
     shrink = loc.fit.n_eff / max(loc.fit.n, 1)
     found, tried = scan(reg, r, loc.channel, rows, shrink, top=1)
     h = found[0] if found else None

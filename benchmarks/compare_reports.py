@@ -1,0 +1,118 @@
+"""A rule's trade, measured: two folders of fit reports (``bench_families.py --reports``) of
+the same runs, before and after a change, compared run by run.
+
+    python benchmarks/compare_reports.py BEFORE_DIR AFTER_DIR [--json OUT.json]
+                                         [--label "what changed"]
+
+Prints, per family and in all, the runs with the right verdict, the true effect named first,
+a wrong name and 'unexplained', before and after; every run whose verdict changed; and the
+median validation RMS of the calibrated base model [tolerances] (the base's misfit, before any
+effect is named). ``--json`` writes the same as a figures file (benchmarks/figures.py) that
+docs/fit.md quotes. The truths are read where bench_families keeps them: the synthetic runs'
+sidecars in benchmarks/.families-cache, the peer's truth.json in tests/data/peer-runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from bench_families import FAMILIES, PEER_RUNS, ROOT
+from verdicts import fit_outcome, judge_verdict, read_truth
+
+CACHE = ROOT / "benchmarks" / ".families-cache"
+COUNTS = ("right", "first", "wrong", "unexplained")
+
+
+def truth_of(run: str, peers: dict) -> object:
+    """A run's truth as bench_families judges it."""
+    if run in peers:
+        return peers[run]
+    doc = json.loads((CACHE / f"{run}.truth.json").read_text(encoding="utf-8"))
+    if run.startswith("outside"):
+        return "unexplained"
+    return None if doc["effect"] == "clean" else doc["effect"]
+
+
+def family_of(run: str) -> str:
+    head = run.split("-")[0]
+    return head if head in FAMILIES else "peers"
+
+
+def outcomes(folder: Path, peers: dict) -> dict[str, dict]:
+    """Per run: the family, the verdict judged against the truth, the named effects and the
+    base's median validation RMS over its channels [tolerances]."""
+    import numpy as np
+
+    out = {}
+    for p in sorted(folder.glob("*.json")):
+        doc = json.loads(p.read_text(encoding="utf-8"))
+        o = fit_outcome(doc)
+        v = judge_verdict(truth_of(p.stem, peers), o["named_plain"], o["unexplained"])
+        base = [e["rmse_tolerances"] for e in doc["error_before"]["validation"].values()]
+        out[p.stem] = {"family": family_of(p.stem), "named": o["named"],
+                       "verdict": o["verdict"], "unexplained": o["unexplained"],
+                       "right": v["right"], "first": bool(v["first"]), "wrong": v["wrong"],
+                       "base_rms_tol": float(np.median(base)) if base else None}
+    return out
+
+
+def compare(before: dict, after: dict) -> dict:
+    """The counts per family (and ``all``) over the runs both folders hold, the runs whose
+    verdict changed, and the median base validation RMS per family."""
+    import numpy as np
+
+    runs = sorted(set(before) & set(after))
+    fams = [f for f in (*FAMILIES, "peers") if any(before[r]["family"] == f for r in runs)]
+    table = {}
+    for f in [*fams, "all"]:
+        mine = [r for r in runs if f == "all" or before[r]["family"] == f]
+        row = {"runs": len(mine)}
+        for tag, x in (("before", before), ("after", after)):
+            row[tag] = {k: int(sum(bool(x[r][k]) for r in mine)) for k in COUNTS}
+            base = [x[r]["base_rms_tol"] for r in mine if x[r]["base_rms_tol"] is not None]
+            row[tag]["base_rms_tol_median"] = round(float(np.median(base)), 4) if base else None
+        table[f] = row
+    changed = [{"run": r, "before": before[r]["named"] or before[r]["verdict"],
+                "after": after[r]["named"] or after[r]["verdict"],
+                "right": [before[r]["right"], after[r]["right"]]}
+               for r in runs if (before[r]["named"], before[r]["verdict"])
+               != (after[r]["named"], after[r]["verdict"])]
+    return {"families": table, "changed": changed}
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("before", type=Path)
+    ap.add_argument("after", type=Path)
+    ap.add_argument("--json", type=Path, help="write the comparison as a figures file")
+    ap.add_argument("--label", default="", help="what changed between the two folders")
+    args = ap.parse_args(argv)
+    for d in (args.before, args.after):
+        if not d.is_dir() or not any(d.glob("*.json")):
+            print(f"error: {d}: no report.json files; give folders written by "
+                  "bench_families.py --reports", file=sys.stderr)
+            raise SystemExit(2)
+    peers = {}
+    for folder in (PEER_RUNS / "bench-runs", PEER_RUNS / "bench-runs-2"):
+        peers.update({k: v.get("truth") for k, v in read_truth(folder).items()})
+    result = compare(outcomes(args.before, peers), outcomes(args.after, peers))
+    for f, row in result["families"].items():
+        b, a = row["before"], row["after"]
+        print(f"{f:8} {row['runs']:4d} runs  " + "  ".join(
+            f"{k} {b[k]} -> {a[k]}" for k in COUNTS)
+            + f"  base RMS {b['base_rms_tol_median']} -> {a['base_rms_tol_median']} tol")
+    for c in result["changed"]:
+        print(f"  {c['run']:14} {c['before']} -> {c['after']}  right {c['right'][0]} -> "
+              f"{c['right'][1]}")
+    if args.json:
+        from figures import write_figures
+
+        write_figures(args.json, "python benchmarks/compare_reports.py "
+                      + " ".join(argv or sys.argv[1:]), {"label": args.label, **result})
+
+
+if __name__ == "__main__":
+    main()
