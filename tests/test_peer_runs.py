@@ -45,12 +45,12 @@ KNOWN_NOT_RIGHT: dict[str, str] = {
 }
 #: runs on which fit names a cause the run does not carry (the worst answer; measured as above)
 KNOWN_WRONG: dict[str, str] = {
-    "dev-08": "a sensor_lag(T_stator) second to the right coolant_dynamics: open loop, 43 % "
-              "of a small cross-validated error",
+    "dev-08": "a sensor_lag(T_stator) second to the right coolant_dynamics, by the open loop "
+              "(its onset test does not apply on this run)",
 }
 #: runs named or adequate whose validation RMS after is above a tolerance (measured as above)
 KNOWN_OVER_TOLERANCE: dict[str, str] = {
-    "dev2-05": "T1 1.24 K with the centrifugal shortening alone (its windage half unnamed)",
+    "dev2-05": "T1 above 1 K with the centrifugal shortening alone (its windage half unnamed)",
 }
 
 
