@@ -90,7 +90,8 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-null-step": "fit-trade-null-step.json",
           "trade-signature-lr": "fit-trade-signature-lr.json",
           "trade-gap": "fit-trade-gap.json",
-          "trade-reanchor": "fit-trade-reanchor.json"}
+          "trade-reanchor": "fit-trade-reanchor.json",
+          "trade-estimate": "fit-trade-estimate.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))

@@ -33,6 +33,8 @@ FOLDERS = (SHARED / "bench-runs", SHARED / "bench-runs-2")
 #: runs whose verdict is not yet right, with what fit says instead (measured by
 #: ``python benchmarks/bench_families.py --families peers``; docs/figures/fit-families.txt)
 KNOWN_NOT_RIGHT: dict[str, str] = {
+    "dev-05": "windage_loss: nothing named (at its fitted value it moves no channel by half "
+              "a tolerance)",
     "dev-07": "mount_conduction: unexplained",
     "dev-08": "coolant_dynamics named, then a false sensor_lag(T_stator) by the open loop",
     "dev2-01": "windage_loss: nothing named",

@@ -208,3 +208,27 @@ def test_something_else_is_not_looked_for_where_the_inputs_are_not_known():
     assert not rows[(t >= 3.0 * 3600.0) & (t < 4.5 * 3600.0)].any()
     assert rows[(t < 3.0 * 3600.0) | (t >= 4.5 * 3600.0)].all()
     assert known_inputs(loc, []).all()
+
+
+def test_a_fitted_effect_is_reported_where_its_gain_was_measured(setup):
+    """fit_effect's estimate is where its last Gauss-Newton step lands, the point whose gain
+    it reports, and its shift is the effect simulated there: with a mount of 3 W/K in the
+    data, fitted from 20 W/K (a tenth into its range), the step from 0 W/K used to be
+    reported as 0 W/K with no shift beside the gain of its landing point. Checked
+    independently of the fit: the shift is the grey box's own difference at the reported
+    value, to round-off (1e-9 tolerances)."""
+    from compare.fit.linear import fit_effect, local, residual_rows
+
+    spec, inp = setup
+    truth = GreyBox(spec, DRIVES["spl2782"], inp, effects=("mount_conduction",))
+    vals = _noisy(truth.simulate({"G_mount_W_K": 3.0, "f0": 0.4}), len(inp.grid_s), 7)
+    cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
+    base = cal.fit()
+    ef = fit_effect(local(cal, base), "mount_conduction")
+    g = ef.values["G_mount_W_K"]
+    assert g > 0.5, ef.values  # the truth is 3 W/K; the bound of no effect is 0
+    gb = cal.gb.variant(base.effects + ("mount_conduction",))
+    at = {v: residual_rows(cal, gb.simulate({**base.theta, "G_mount_W_K": v}))[0]
+          for v in (0.0, g)}
+    np.testing.assert_allclose(ef.shift, at[g] - at[0.0], atol=1e-9)
+    assert np.max(np.abs(ef.shift)) > 0.0

@@ -202,9 +202,10 @@ def local(cal: Calibrator, fit: Fit) -> Local:
 @dataclass
 class EffectFit:
     """An effect fitted to the linearized model: its parameters on the fitted scale ``z``
-    (and in their units, ``values``), the base parameters' step, the residual of every row,
-    the effect's own columns at its estimate, and the log-posterior gain over the fit window
-    (counted in the current fit's effective samples)."""
+    (and in their units, ``values``), the base parameters' step, the residual of every row
+    (linearized) and the log-posterior gain over the fit window (counted in the current
+    fit's effective samples), all at the estimate ``z``; the effect's own columns where its
+    last step was taken from."""
 
     label: str
     z: np.ndarray
@@ -242,10 +243,18 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
         th.update({p.name: _from_z(p, float(v)) for p, v in zip(params, zv, strict=True)})
         return residual_rows(cal, gb.simulate(th))[0]
 
-    r_neutral = at(z_n)
+    simulated: dict[bytes, np.ndarray] = {}
+
+    def at_once(zv: np.ndarray) -> np.ndarray:
+        key = zv.tobytes()
+        if key not in simulated:
+            simulated[key] = at(zv)
+        return simulated[key]
+
+    r_neutral = at_once(z_n)
     best = None
     for _ in range(iterations):
-        r_z = at(z)
+        r_z = at_once(z)
         cols = np.empty((len(r_z), len(params)))
         for i in range(len(params)):
             h = STEP if z[i] + STEP <= hi[i] else -STEP
@@ -257,15 +266,18 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
         step = shifted.step(rows, cols, list(zip(lo - z, hi - z, strict=True)))
         r1 = shifted.residual(step, cols)
         gain = loc.gain_of(r1, step)
-        if best is None or gain > best[0]:
-            best = (gain, z.copy(), step[:kb].copy(), r1, cols, r_z)
         z_new = np.clip(z + step[kb:], lo, hi)
+        # the gain is that of the stepped parameters, so the estimate is where the step lands
+        # (not where it was taken from: a mount fitted from 0 W/K to 3 W/K has the gain of
+        # 3 W/K, and its shift at 0 W/K is nothing)
+        if best is None or gain > best[0]:
+            best = (gain, z_new.copy(), step[:kb].copy(), r1, cols)
         if np.max(np.abs(z_new - z)) < 1e-4 * np.max(hi - lo):
             break
         z = z_new
-    gain, z, delta, r1, cols, r_z = best
+    gain, z, delta, r1, cols = best
     values = {p.name: _from_z(p, float(v)) for p, v in zip(params, z, strict=True)}
-    return EffectFit(label, z, values, delta, r1, cols, float(gain), r_z - r_neutral)
+    return EffectFit(label, z, values, delta, r1, cols, float(gain), at_once(z) - r_neutral)
 
 
 def effect_held_out(loc: Local, ef: EffectFit, blocks: int) -> dict[str, float]:
