@@ -20,6 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import figures  # noqa: F401  (it checks that the checkout's code is the code measured)
 import numpy as np
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)

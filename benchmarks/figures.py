@@ -8,9 +8,47 @@ import datetime
 import json
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+#: the project's top-level packages (pyproject.toml's [tool.setuptools.packages.find])
+PACKAGES = ("spindle", "meshes", "reference", "lumped", "compare", "spindle_verify")
+
+
+def checkout_difference() -> str | None:
+    """None when Python imports this checkout's code, else what differs: a benchmark run as
+    ``python benchmarks/x.py`` puts benchmarks/, not the checkout, on the path, so it measures
+    the installed copy, and a figures file would record HEAD for code that is not HEAD's."""
+    import importlib.util
+
+    for name in PACKAGES:
+        spec = importlib.util.find_spec(name)
+        if spec is None or spec.origin is None:
+            return f"the package {name} is not installed"
+        where = Path(spec.origin).resolve().parent
+        mine = ROOT / name
+        if where == mine:
+            continue
+        for src in sorted(mine.rglob("*.py")):
+            rel = src.relative_to(ROOT)
+            other = where / src.relative_to(mine)
+            if not other.is_file() or other.read_bytes() != src.read_bytes():
+                return f"{rel} differs from the copy Python imports, {other}"
+    return None
+
+
+def require_checkout() -> None:
+    """Exit with status 2 and one message when the imported code is not this checkout's."""
+    diff = checkout_difference()
+    if diff is not None:
+        print(f"benchmarks measure this checkout's code, but {diff}. Install the checkout "
+              f"first: python -m pip install -e {ROOT}", file=sys.stderr)
+        sys.exit(2)
+
+
+# every script of benchmarks/ that writes figures or verdicts measures the checkout's code
+require_checkout()
 
 
 def write_figures(path: Path, made_by: str, fields: dict) -> None:

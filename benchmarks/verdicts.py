@@ -15,6 +15,8 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+import figures  # noqa: F401  (it checks that the checkout's code is the code measured)
+
 #: the channels of a fit's validation RMS, in the order the tables print them
 CHANNELS = ("T1", "T2", "T_stator", "P1")
 RMS_HEADER = "validation RMS after (T1 T2 Tst K, P1 µm)"
