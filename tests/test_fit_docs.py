@@ -91,7 +91,8 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-signature-lr": "fit-trade-signature-lr.json",
           "trade-gap": "fit-trade-gap.json",
           "trade-reanchor": "fit-trade-reanchor.json",
-          "trade-estimate": "fit-trade-estimate.json"}
+          "trade-estimate": "fit-trade-estimate.json",
+          "trade-material-change": "fit-trade-material-change.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
