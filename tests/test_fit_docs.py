@@ -134,3 +134,30 @@ def test_the_targets_table_is_the_benchmarks_file():
 
     summary = (ROOT / "docs" / "figures" / "fit-families.txt").read_text(encoding="utf-8")
     assert_block("docs/fit.md", "targets", targets_table(summary))
+
+
+def _rate(summary: str, label: str) -> tuple[str, str, str]:
+    m = re.search(rf"^  {re.escape(label)}\s+(\d+) of\s+(\d+)\s+([\d.]+) %", summary, re.M)
+    assert m, f"the summary has no line '{label}'"
+    return m.groups()
+
+
+def readme_fit_rates(summary: str) -> str:
+    """The README's sentence on fit's measured rates, from docs/figures/fit-families.txt."""
+    runs = re.search(r"^runs: (.*)$", summary, re.M).group(1)
+    total = sum(int(x) for x in re.findall(r"\w+ (\d+)", runs))
+    wk, wn, wp = _rate(summary, "a wrong effect named (any run)")
+    tk, tn, tp = _rate(summary, "true effect named first (runs with an effect)")
+    ck, cn, _ = _rate(summary, "nothing named on clean runs")
+    ok, on, op = _rate(summary, "unexplained, nothing named (runs outside the library)")
+    assert int(wn) == total
+    return (f"On {total} runs drawn from families and the peer's, it named a wrong cause on "
+            f"{wk} ({wp} %), the true effect first on {tk} of {tn} ({tp} %), nothing on "
+            f"{ck} of {cn} clean runs, and \"unexplained\" on {ok} of {on} runs outside its "
+            f"library ({op} %).")
+
+
+def test_the_readme_quotes_the_measured_rates():
+    summary = (ROOT / "docs" / "figures" / "fit-families.txt").read_text(encoding="utf-8")
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    assert readme_fit_rates(summary) in readme, readme_fit_rates(summary)
