@@ -38,12 +38,12 @@ def test_a_tree_that_differs_from_the_imported_code_is_named(monkeypatch, tmp_pa
     assert diff is not None and diff.startswith("compare/fit/linear.py differs"), diff
 
 
-def test_a_benchmark_refuses_other_code_with_status_2(tmp_path):
+def test_a_benchmark_refuses_other_code_with_status_2(monkeypatch, tmp_path):
     """The same from the command line: one message naming the file and the fix, status 2, no
     traceback (a copy of benchmarks/ beside a changed tree)."""
     shutil.copytree(ROOT / "benchmarks", tmp_path / "benchmarks",
                     ignore=shutil.ignore_patterns("__pycache__", ".families-cache"))
-    for name in ("spindle", "meshes", "reference", "lumped", "compare", "spindle_verify"):
+    for name in _figures(monkeypatch).PACKAGES:
         shutil.copytree(ROOT / name, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
     changed = tmp_path / "spindle" / "outputs.py"
     changed.write_text(changed.read_text(encoding="utf-8") + "\n# changed\n", encoding="utf-8")

@@ -114,15 +114,20 @@ TARGETS = (("true effect named first (runs with an effect)", 95.0, ">="),
            ("validation RMS within the tolerances (named or adequate)", 100.0, ">="))
 
 
+def _rate(summary: str, label: str) -> tuple[str, str, str, str, str]:
+    """The summary line ``label``'s count, runs, rate [%] and 95 % interval, as printed."""
+    m = re.search(rf"^  {re.escape(label)}\s+(\d+) of\s+(\d+)\s+([\d.]+) %\s+"
+                  r"\[\s*([\d.]+),\s*([\d.]+)\]", summary, re.M)
+    assert m, f"the summary has no line '{label}'"
+    return m.groups()
+
+
 def targets_table(summary: str) -> str:
     """docs/fit.md's table of issue 32's targets from the benchmark's summary file: the rate
     with its 95 % interval, and whether the rate itself meets the target."""
     lines = ["| target | issue 32 | measured (95 % interval) | met |", "|---|---|---|---|"]
     for label, bound, op in TARGETS:
-        m = re.search(rf"^  {re.escape(label)}\s+(\d+) of\s+(\d+)\s+([\d.]+) %\s+"
-                      r"\[\s*([\d.]+),\s*([\d.]+)\]", summary, re.M)
-        assert m, f"the summary has no line '{label}'"
-        k, n, p, lo, hi = m.groups()
+        k, n, p, lo, hi = _rate(summary, label)
         met = float(p) >= bound if op == ">=" else float(p) <= bound
         lines.append(f"| {label} | {'≥' if op == '>=' else '≤'} {bound:g} % | {k} of {n}, "
                      f"{p} % [{lo}, {hi}] | {'yes' if met else 'no'} |")
@@ -136,20 +141,16 @@ def test_the_targets_table_is_the_benchmarks_file():
     assert_block("docs/fit.md", "targets", targets_table(summary))
 
 
-def _rate(summary: str, label: str) -> tuple[str, str, str]:
-    m = re.search(rf"^  {re.escape(label)}\s+(\d+) of\s+(\d+)\s+([\d.]+) %", summary, re.M)
-    assert m, f"the summary has no line '{label}'"
-    return m.groups()
 
 
 def readme_fit_rates(summary: str) -> str:
     """The README's sentence on fit's measured rates, from docs/figures/fit-families.txt."""
     runs = re.search(r"^runs: (.*)$", summary, re.M).group(1)
     total = sum(int(x) for x in re.findall(r"\w+ (\d+)", runs))
-    wk, wn, wp = _rate(summary, "a wrong effect named (any run)")
-    tk, tn, tp = _rate(summary, "true effect named first (runs with an effect)")
-    ck, cn, _ = _rate(summary, "nothing named on clean runs")
-    ok, on, op = _rate(summary, "unexplained, nothing named (runs outside the library)")
+    wk, wn, wp, _, _ = _rate(summary, "a wrong effect named (any run)")
+    tk, tn, tp, _, _ = _rate(summary, "true effect named first (runs with an effect)")
+    ck, cn, _, _, _ = _rate(summary, "nothing named on clean runs")
+    ok, on, op, _, _ = _rate(summary, "unexplained, nothing named (runs outside the library)")
     assert int(wn) == total
     return (f"On {total} runs drawn from families and the peer's, it named a wrong cause on "
             f"{wk} ({wp} %), the true effect first on {tk} of {tn} ({tp} %), nothing on "

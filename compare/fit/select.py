@@ -255,8 +255,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         # the null of every test: the current model refitted by the same step without a
         # candidate (a nonlinear fit stopped short of its optimum leaves the step a gain of
         # its own, which is no candidate's)
-        null = NullStep(*loc.gain())
-        null.residual = loc.residual(null.delta)
+        null = NullStep.of(loc)
         g_gain = joint_gain(loc, reg, found) - null.gain
         # every candidate's gain over the null, penalised by half ln(n_eff) per parameter (BIC)
         pen = 0.5 * math.log(max(current.n_eff, 2.0))
@@ -291,29 +290,34 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
                                                      unknown_inputs=unknown_inputs))
 
 
-@dataclass
+@dataclass(frozen=True)
 class NullStep:
     """The current model refitted by one step of the linearized model without a candidate:
     its log-posterior gain over the current fit, its step and its residual (every row)."""
 
     gain: float
     delta: np.ndarray
-    residual: np.ndarray | None = None
+    residual: np.ndarray
+
+    @classmethod
+    def of(cls, loc: Local) -> NullStep:
+        gain, delta = loc.gain()
+        return cls(gain, delta, loc.residual(delta))
 
 
 def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
           competitor: float, rival: float, cv_now: dict | None, rnd: int,
-          null: NullStep | None = None) -> Judgement:
+          null: NullStep) -> Judgement:
     """The named criteria of one candidate fitted on the linearized model (module
     docstring). ``penalised``: its gain over the ``null`` (the current model refitted by the
-    same step, :class:`NullStep`; None: the current model as it is) less half ln(n_eff) per
+    same step, :class:`NullStep`) less half ln(n_eff) per
     parameter; ``competitor`` and ``rival``: the same of the competitor's best hypothesis and
     of the best other candidate on its channels."""
     from scipy.stats import chi2
 
     cal = loc.cal
     k = len(effect_of(ef.label).params)
-    gain = ef.gain - (null.gain if null is not None else 0.0)
+    gain = ef.gain - null.gain
     lr = max(2.0 * gain, 0.0)
     pv = float(chi2.sf(lr, k))
     own = _own(ef.label)
@@ -321,8 +325,7 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
     peak = float(np.max(np.abs(ef.shift[rows]))) if rows.any() else 0.0
     # what the fitted model's prediction moves by against the null, the base's
     # re-adjustment around the effect included
-    r_null = null.residual if null is not None and null.residual is not None else loc.r0
-    net = float(np.max(np.abs(r_null[rows] - ef.residual[rows]))) if rows.any() else 0.0
+    net = float(np.max(np.abs(null.residual[rows] - ef.residual[rows]))) if rows.any() else 0.0
     margin = 0.5 * chi2_threshold(criteria.alpha, 1)
     out: dict[str, bool | None] = {
         "significant": pv < criteria.alpha,
