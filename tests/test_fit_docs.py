@@ -92,7 +92,8 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-gap": "fit-trade-gap.json",
           "trade-reanchor": "fit-trade-reanchor.json",
           "trade-estimate": "fit-trade-estimate.json",
-          "trade-material-change": "fit-trade-material-change.json"}
+          "trade-material-change": "fit-trade-material-change.json",
+          "trade-scan-null": "fit-trade-scan-null.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))

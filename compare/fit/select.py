@@ -42,8 +42,9 @@ qualify, and the next round judges the rest against the model that holds it (a s
 earns its place against the first, not against the base). The selection stops when none
 qualifies. Then the final model is stepped to the whole run (a model calibrated on the fit
 window misses the validation window by its extrapolation, which a window there would take up)
-and the competitor scanned on it: where it is significant (its likelihood-ratio test at
-``alpha`` divided by the number of hypotheses the scan tried) and material, the verdict says
+and the competitor scanned on it: where it is significant (its largest likelihood-ratio
+statistic above the level-``alpha`` critical value of the same scan on white noise, a Monte
+Carlo test) and material, the verdict says
 ``unexplained`` and where.
 """
 
@@ -56,7 +57,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from compare.fit.calibrate import Calibrator, Fit, _from_z, _to_z
-from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan
+from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan, scan_threshold
 from compare.fit.criteria import Criteria, chi2_threshold
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.linear import Local, effect_held_out, fit_effect, local
@@ -353,17 +354,19 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
 def verdict_on(loc: Local, reg, criteria: Criteria, named: bool = False,
                unknown_inputs: Sequence[tuple[float, float]] = ()) -> Verdict:
     """The competitor on the final model (linearized as ``loc``) stepped to the whole run:
-    unexplained where it is significant (Bonferroni over its hypotheses) and material; and,
+    unexplained where it is significant (its scan's largest statistic against the same scan on
+    white noise: compare.fit.competitor.scan_threshold) and material; and,
     with nothing ``named``, where the final model misses a tolerance on held-out data
     (:func:`held_out_misses`, Criteria.held_out_misfit_unexplained)."""
     rows = np.ones(len(loc.r0), dtype=bool)
     r = loc.residual(loc.step(rows))
     rows = known_inputs(loc, unknown_inputs)
     shrink = loc.fit.n_eff / max(loc.fit.n, 1)
-    found, tried = scan(reg, r, loc.channel, rows, shrink, top=1)
+    found, _ = scan(reg, r, loc.channel, rows, shrink, top=1)
     h = found[0] if found else None
     lr = 2.0 * h.gain if h is not None else 0.0
-    threshold = chi2_threshold(criteria.alpha, 1, tried) if h is not None else math.inf
+    threshold = (scan_threshold(reg, loc.channel, rows, criteria.alpha, criteria.scan_null_tail)
+                 if h is not None else math.inf)
     if h is not None and lr > threshold and h.peak >= criteria.material_peak:
         return Verdict(h, lr, threshold, True)
     misses = (held_out_misses(loc.fit.errors)
