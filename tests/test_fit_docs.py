@@ -163,3 +163,24 @@ def test_the_readme_quotes_the_measured_rates():
     summary = (ROOT / "docs" / "figures" / "fit-families.txt").read_text(encoding="utf-8")
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     assert readme_fit_rates(summary) in readme, readme_fit_rates(summary)
+
+
+def test_a_summary_of_saved_rows_names_the_call_that_made_them(tmp_path):
+    """``bench_families.py --rows`` heads its summary with the fitting call the rows came
+    from: a held-out set (other seeds, some families) must say so, or its rates read as the
+    main set's."""
+    import json
+    import subprocess
+    import sys
+
+    rows = json.loads((ROOT / "docs" / "figures" / "fit-families.json").read_text("utf-8"))
+    effect = [r for r in rows if r["family"] == "effect"][:2]
+    for seed, r in zip((1001, 1002), effect, strict=True):
+        r["run"] = f"effect-{seed}"
+    saved, summary = tmp_path / "rows.json", tmp_path / "held-out.txt"
+    saved.write_text(json.dumps(effect), encoding="utf-8")
+    done = subprocess.run([sys.executable, "benchmarks/bench_families.py", "--rows", str(saved),
+                           "--summary", str(summary)], cwd=ROOT, capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr
+    head = summary.read_text(encoding="utf-8").splitlines()[0]
+    assert "--runs-per-family 2 --first-seed 1001 --families effect --json ROWS" in head, head
