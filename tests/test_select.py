@@ -136,8 +136,8 @@ def test_a_heat_no_effect_makes_is_unexplained_and_located(setup):
 def test_a_held_out_misfit_with_nothing_named_is_unexplained_and_says_where():
     """Criteria.held_out_misfit_unexplained: nothing named and a channel beyond one tolerance
     on the validation window makes the verdict 'unexplained' (basis "held-out misfit"),
-    naming the channel and its RMS; within the tolerance, or with an effect named, it does
-    not; the competitor's significant event keeps its own basis."""
+    naming the channel and its RMS; within the tolerance it does not; the competitor's
+    significant event keeps its own basis."""
     from compare.fit.competitor import Hypothesis
     from compare.fit.select import Verdict, held_out_misses
 
@@ -281,3 +281,26 @@ def test_the_verdicts_scan_has_its_stated_level_on_noise_and_is_sharper_than_bon
     assert 5 <= above <= 35, above
     assert crit < chi2_threshold(alpha, 1, tried)
     assert scan_threshold(reg, channel, rows, alpha, tail=10) == crit  # seeded: reproducible
+
+
+def test_a_named_effect_that_leaves_a_held_out_misfit_says_something_else_remains(setup):
+    """Criteria.held_out_misfit_unexplained holds beside a named effect too: fixture_expansion
+    data (as above) whose T1 reads 2 K high on the validation window only (a sensor re-seated
+    after the fit window). The fixture is named, and T1 misses its tolerance on held-out
+    data, so the verdict says something else remains, and where. The competitor is blinded
+    (every input declared unknown, so the scan has no rows) to test this rule alone: it
+    would otherwise find the offset itself."""
+    spec, inp = setup
+    truth = GreyBox(spec, DRIVES["spl2782"], inp, effects=("fixture_expansion",))
+    vals = _noisy(truth.simulate({"k_fix_um_K": 1.5, "f0": 0.4}), len(inp.grid_s), 3)
+    measured = Measured(inp.grid_s, vals)
+    late = inp.grid_s >= measured.split_s
+    vals["T1"] = np.where(late, vals["T1"] + 2.0, vals["T1"])  # 2 tolerances: 1 K each
+    cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
+    sel = select(cal, cal.fit(), candidates(CHANNELS), Criteria(),
+                 unknown_inputs=[(float(inp.grid_s[0]), float(inp.grid_s[-1]) + 1.0)])
+    assert [s.label for s in sel.steps] == ["fixture_expansion"]
+    v = sel.verdict
+    assert v.unexplained and v.basis == "held-out misfit", v.to_dict()
+    assert set(v.misses) == {"T1"} and v.misses["T1"] > 1.0
+    assert not Criteria(held_out_misfit_unexplained=False).held_out_misfit_unexplained

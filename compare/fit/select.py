@@ -287,7 +287,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         current = best.fit
         loc = local(cal, current)
     say("fitting something else on the final model")
-    return Selection(base, steps, judged, verdict_on(loc, reg, criteria, named=bool(steps),
+    return Selection(base, steps, judged, verdict_on(loc, reg, criteria,
                                                      unknown_inputs=unknown_inputs))
 
 
@@ -351,13 +351,13 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
     return Judgement(ef.label, rnd, None, gain, lr, pv, peak, out, figures)
 
 
-def verdict_on(loc: Local, reg, criteria: Criteria, named: bool = False,
+def verdict_on(loc: Local, reg, criteria: Criteria,
                unknown_inputs: Sequence[tuple[float, float]] = ()) -> Verdict:
     """The competitor on the final model (linearized as ``loc``) stepped to the whole run:
     unexplained where it is significant (its scan's largest statistic against the same scan on
-    white noise: compare.fit.competitor.scan_threshold) and material; and,
-    with nothing ``named``, where the final model misses a tolerance on held-out data
-    (:func:`held_out_misses`, Criteria.held_out_misfit_unexplained)."""
+    white noise: compare.fit.competitor.scan_threshold) and material; and, whatever was
+    named, where the final model misses a tolerance on held-out data (:func:`held_out_misses`,
+    Criteria.held_out_misfit_unexplained)."""
     rows = np.ones(len(loc.r0), dtype=bool)
     r = loc.residual(loc.step(rows))
     rows = known_inputs(loc, unknown_inputs)
@@ -369,8 +369,7 @@ def verdict_on(loc: Local, reg, criteria: Criteria, named: bool = False,
                  if h is not None else math.inf)
     if h is not None and lr > threshold and h.peak >= criteria.material_peak:
         return Verdict(h, lr, threshold, True)
-    misses = (held_out_misses(loc.fit.errors)
-              if criteria.held_out_misfit_unexplained and not named else {})
+    misses = held_out_misses(loc.fit.errors) if criteria.held_out_misfit_unexplained else {}
     return Verdict(h, lr, threshold, bool(misses), misses)
 
 
