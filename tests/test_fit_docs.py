@@ -195,3 +195,27 @@ def test_a_summary_of_saved_rows_names_the_call_that_made_them(tmp_path):
     assert done.returncode == 0, done.stdout + done.stderr
     head = summary.read_text(encoding="utf-8").splitlines()[0]
     assert "--runs-per-family 2 --first-seed 1001 --families effect --json ROWS" in head, head
+
+
+def scan_null_table(doc: dict) -> str:
+    """docs/fit.md's table of the verdict's scan against its null, from
+    docs/figures/scan-null.json (benchmarks/scan_null_figures.py)."""
+    return "\n".join([
+        "| | value |", "|---|---|",
+        f"| hypotheses the scan tries | {doc['hypotheses']:,} |",
+        f"| Bonferroni bound at alpha = {doc['alpha']:g} | {doc['bonferroni']:.1f} |",
+        f"| Monte Carlo critical value, seed 0 ({doc['draws']} draws) | "
+        f"{doc['critical_value_seed_0']:.1f} |",
+        f"| ... over {doc['seeds']} seeds | {doc['critical_value_min']:.1f} to "
+        f"{doc['critical_value_max']:.1f} (sd {100 * doc['critical_value_sd_rel']:.1f} %) |",
+        f"| time of one critical value | {doc['seconds_median']:.1f} s |"])
+
+
+def test_the_scan_null_table_is_its_figures_file():
+    import json
+
+    from tests.docs_blocks import assert_block
+
+    doc = json.loads((ROOT / "docs" / "figures" / "scan-null.json").read_text("utf-8"))
+    assert doc["critical_value_max"] < doc["bonferroni"]  # the reason it replaced Bonferroni
+    assert_block("docs/fit.md", "scan-null", scan_null_table(doc))

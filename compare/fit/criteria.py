@@ -70,8 +70,8 @@ class Criteria:
         "scan on white noise (a Monte Carlo test of its largest statistic, which, unlike a "
         "Bonferroni bound over its thousands of overlapping windows, knows they are nearly "
         "the same test): the 10th largest maximum of 10 / alpha - 1 draws (999 at 1 %), so "
-        "the test's level is alpha exactly; its critical value scatters by 2 % (one sd over "
-        "seeds, on a drawn run: 18.7-19.8 against Bonferroni's 22.7)")
+        "the test's level is alpha exactly (its Monte Carlo scatter over seeds and its value "
+        "against the Bonferroni bound: docs/figures/scan-null.json)")
     competitor_masses: tuple[str, ...] = _c(
         ("stator", "rotor", "front_bearing", "rear_bearing", "housing", "cooling_sleeve"),
         "part roles", "where the competitor may put an unexplained heat: one mass of each "
