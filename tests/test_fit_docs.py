@@ -97,7 +97,8 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-material-change": "fit-trade-material-change.json",
           "trade-scan-null": "fit-trade-scan-null.json",
           "trade-misfit-named": "fit-trade-misfit-named.json",
-          "trade-misfit-named-held-out": "fit-trade-misfit-named-held-out.json"}
+          "trade-misfit-named-held-out": "fit-trade-misfit-named-held-out.json",
+          "trade-scan-tail": "fit-trade-scan-tail.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
