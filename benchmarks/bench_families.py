@@ -377,12 +377,11 @@ def _criteria(ap: argparse.ArgumentParser, items: list[str]) -> tuple:
     return tuple(out)
 
 
-def _fitting_options(rows: list[dict], args) -> str:
-    """The options of the fitting call that saved ``rows``, as far as the rows tell: runs per
-    family, the first seed, the families where not all, and the criteria given now."""
-    drawn = [r for r in rows if r["family"] != "peers"]
-    seeds = [int(r["run"].rsplit("-", 1)[1]) for r in drawn]
-    per = {f: sum(r["family"] == f for r in rows) for f in (*FAMILIES, "peers")}
+def _fitting_options(rows: list[dict], per: dict[str, int], args) -> str:
+    """The options of the fitting call that saved ``rows`` (``per``: their runs per family),
+    as far as the rows tell: runs per family, the first seed, the families where not all,
+    and the criteria given now."""
+    seeds = [int(r["run"].rsplit("-", 1)[1]) for r in rows if r["family"] != "peers"]
     out = f"--runs-per-family {max((n for f, n in per.items() if f != 'peers'), default=0)}"
     if seeds and min(seeds) != 1:
         out += f" --first-seed {min(seeds)}"
@@ -401,7 +400,7 @@ def _report(rows: list[dict], args, argv: list[str] | None) -> None:
         runs = {f: sum(r["family"] == f for r in rows) for f in (*FAMILIES, "peers")}
         command = f"python benchmarks/bench_families.py {' '.join(argv or sys.argv[1:])}"
         if args.rows:  # the rates of rows a fitting call saved with --json
-            command = (f"python benchmarks/bench_families.py {_fitting_options(rows, args)} "
+            command = (f"python benchmarks/bench_families.py {_fitting_options(rows, runs, args)} "
                        f"--json ROWS; python benchmarks/bench_families.py --rows ROWS "
                        f"--summary {args.summary}")
         head = [command, "runs: " + ", ".join(f"{f} {n}" for f, n in runs.items() if n)]

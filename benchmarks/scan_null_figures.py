@@ -34,7 +34,7 @@ def main(argv: list[str] | None = None) -> None:
     import numpy as np
 
     import compare.fit.select as select
-    from compare.fit.competitor import scan, scan_threshold
+    from compare.fit.competitor import scan, scan_null_draws, scan_threshold
     from compare.fit.criteria import Criteria, chi2_threshold
     from compare.fit.run import run_fit
     from spindle.spec_reader import load_spec
@@ -61,8 +61,9 @@ def main(argv: list[str] | None = None) -> None:
     _, tried = scan(reg, noise, channel, rows, 1.0, top=1)
     run = args.run.resolve()
     fields = {"run": str(run.relative_to(ROOT)) if run.is_relative_to(ROOT) else str(run),
-              "alpha": criteria.alpha, "draws": round(criteria.scan_null_tail / criteria.alpha)
-              - 1, "hypotheses": tried, "critical_value_seed_0": values[0],
+              "alpha": criteria.alpha,
+              "draws": scan_null_draws(criteria.alpha, criteria.scan_null_tail),
+              "hypotheses": tried, "critical_value_seed_0": values[0],
               "critical_value_min": min(values), "critical_value_max": max(values),
               "critical_value_sd_rel": float(np.std(values) / np.mean(values)),
               "bonferroni": chi2_threshold(criteria.alpha, 1, tried),

@@ -154,8 +154,6 @@ def test_the_targets_table_is_the_benchmarks_files():
         (figures / "fit-families-held-out.txt").read_text(encoding="utf-8")))
 
 
-
-
 def readme_fit_rates(summary: str) -> str:
     """The README's sentence on fit's measured rates, from docs/figures/fit-families.txt."""
     runs = re.search(r"^runs: (.*)$", summary, re.M).group(1)

@@ -303,4 +303,12 @@ def test_a_named_effect_that_leaves_a_held_out_misfit_says_something_else_remain
     v = sel.verdict
     assert v.unexplained and v.basis == "held-out misfit", v.to_dict()
     assert set(v.misses) == {"T1"} and v.misses["T1"] > 1.0
-    assert not Criteria(held_out_misfit_unexplained=False).held_out_misfit_unexplained
+    # the rule switched off, the same final model names its effect alone
+    from compare.fit.competitor import regressors
+    from compare.fit.linear import local
+    from compare.fit.select import verdict_on
+
+    off = Criteria(held_out_misfit_unexplained=False)
+    quiet = verdict_on(local(cal, sel.final), regressors(cal, sel.base, off), off,
+                       unknown_inputs=[(float(inp.grid_s[0]), float(inp.grid_s[-1]) + 1.0)])
+    assert not quiet.unexplained and quiet.misses == {}

@@ -188,27 +188,38 @@ def regressors(cal, fit, criteria) -> Regressors:
     return reg
 
 
+def _window_gram(X: np.ndarray, channel: np.ndarray, rows: np.ndarray, chans: np.ndarray,
+                 i_lo: np.ndarray, i_hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """What the window fits of the column table ``X`` (rows, blocks) need of the table alone,
+    whatever the residual: each channel's row count over ``rows`` and each window's sum of
+    squares per channel, (windows, channels)."""
+    n = np.array([np.sum(rows & (channel == c)) for c in chans], dtype=float)
+    gram = np.empty((X.shape[1], X.shape[1], len(chans)))
+    for j, c in enumerate(chans):
+        m = rows & (channel == c)
+        gram[:, :, j] = X[m].T @ X[m]
+    C = np.pad(np.cumsum(np.cumsum(gram, axis=0), axis=1), ((1, 0), (1, 0), (0, 0)))
+    return n, C[i_hi + 1, i_hi + 1] - C[i_lo, i_hi + 1] - C[i_hi + 1, i_lo] + C[i_lo, i_lo]
+
+
 def _window_fits(X: np.ndarray, R: np.ndarray, channel: np.ndarray, rows: np.ndarray,
-                 chans: np.ndarray, i_lo: np.ndarray, i_hi: np.ndarray):
+                 chans: np.ndarray, i_lo: np.ndarray, i_hi: np.ndarray,
+                 gram: tuple[np.ndarray, np.ndarray] | None = None):
     """Every window [block i_lo, block i_hi] of the column table ``X`` (rows, blocks) fitted
     alone by weighted least squares to each residual column of ``R`` (rows, draws): its
-    amplitude and each channel's residual sums of squares before and after, per draw."""
-    n = np.array([np.sum(rows & (channel == c)) for c in chans], dtype=float)
-    nb = X.shape[1]
-    num = np.empty((nb, len(chans), R.shape[1]))
-    gram = np.empty((nb, nb, len(chans)))
+    concentrated log-likelihood gain and its amplitude, each (windows, draws). ``gram``: the
+    table's :func:`_window_gram`, where it was computed once for many calls."""
+    n, den_w = gram if gram is not None else _window_gram(X, channel, rows, chans, i_lo, i_hi)
+    num = np.empty((X.shape[1], len(chans), R.shape[1]))
     rss0 = np.empty((len(chans), R.shape[1]))
     for j, c in enumerate(chans):
         m = rows & (channel == c)
         num[:, j] = X[m].T @ R[m]
-        gram[:, :, j] = X[m].T @ X[m]
         rss0[j] = np.sum(R[m] ** 2, axis=0)
     rss0 = np.maximum(rss0, 1e-300)
     w = n[:, None] / rss0  # inverse residual variance per channel
     P = np.concatenate([np.zeros((1, *num.shape[1:])), np.cumsum(num, axis=0)])
     num_w = P[i_hi + 1] - P[i_lo]  # (windows, channels, draws)
-    C = np.pad(np.cumsum(np.cumsum(gram, axis=0), axis=1), ((1, 0), (1, 0), (0, 0)))
-    den_w = C[i_hi + 1, i_hi + 1] - C[i_lo, i_hi + 1] - C[i_hi + 1, i_lo] + C[i_lo, i_lo]
     tot_den = den_w @ w  # (windows, draws)
     ok = tot_den > 1e-12 * np.maximum(tot_den.max(axis=0), 1e-300)
     beta = np.where(ok, -np.einsum("kcd,cd->kd", num_w, w) / np.where(ok, tot_den, 1.0), 0.0)
@@ -262,19 +273,27 @@ def scan_threshold(reg: Regressors, channel: np.ndarray, rows: np.ndarray, alpha
     ``shrink``), which puts autocorrelated residuals on the white noise's scale."""
     if alpha <= 0:
         return math.inf
-    draws = max(int(round(tail / alpha)) - 1, tail)
+    draws = scan_null_draws(alpha, tail)
     i_lo, i_hi = np.triu_indices(len(reg.edges) - 1)
     chans = np.unique(channel[rows])
+    tables = [(X, _window_gram(X, channel, rows, chans, i_lo, i_hi))
+              for _kind, _where, X in _tables(reg)]
     rng = np.random.default_rng(seed)
     best = np.full(draws, -np.inf)
     for start in range(0, draws, 250):  # in chunks: the windows' table per draw is large
         noise = rng.standard_normal((len(channel), min(250, draws - start)))
         top = np.full(noise.shape[1], -np.inf)
-        for _kind, _where, X in _tables(reg):
-            top = np.maximum(top, _window_fits(X, noise, channel, rows, chans, i_lo, i_hi)[0]
-                             .max(axis=0))
+        for X, gram in tables:
+            gain = _window_fits(X, noise, channel, rows, chans, i_lo, i_hi, gram)[0]
+            top = np.maximum(top, gain.max(axis=0))
         best[start:start + noise.shape[1]] = top
     return float(2.0 * np.sort(best)[-tail])
+
+
+def scan_null_draws(alpha: float, tail: int) -> int:
+    """How many noise draws :func:`scan_threshold` takes at level ``alpha``: ``tail`` /
+    ``alpha`` - 1, so that its ``tail``-th largest maximum is the exact critical value."""
+    return max(int(round(tail / alpha)) - 1, tail)
 
 
 #: the bounds of the competitor's amplitudes in a joint step (W of heat; tolerances of offset)
