@@ -40,7 +40,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from verdicts import fit_outcome, judge_verdict, named_text, run_verdicts
+from verdicts import fit_outcome, judge_verdict, missed_by, named_text, run_verdicts
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
@@ -175,6 +175,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             "named": out["named"], "verdict": out["verdict"],
             "unexplained": out["unexplained"], **verdict,
             "rms_within_tolerance": rms_ok, "validation_rmse": out["validation_rmse"],
+            "missed_by": missed_by(doc, truth),
             "fit_s": rep.runtime_s, "synth_s": t_synth, "sizes": sizes,
             "on_change": bool(not case.path and logs_on_change(case.family, case.seed)),
             "at_floor": at_floor(sizes)}
@@ -248,6 +249,7 @@ def summary(rows: list[dict]) -> list[str]:
     for name in names:
         out.append(rate_line(f"  {name} named alone", rows, lambda r: r["right"],
                              lambda r, n=name: r["truth"] == n))
+    out += missed_lines(rows, families)
     import numpy as np
 
     from spindle.tolerances import edge_unit
@@ -264,6 +266,34 @@ def summary(rows: list[dict]) -> list[str]:
         if times:
             out.append(f"fit time{label}: median {times[len(times) // 2]:.0f} s, max "
                        f"{times[-1]:.0f} s over {len(times)} runs")
+    return out
+
+
+#: the criteria in the order compare.fit.select asks them (Judgement.route)
+ORDER = ("significant", "material", "signature", "predicts", "beats_something_else", "distinct",
+         "changes_prediction")
+
+
+def missed_lines(rows: list[dict], families: list[str]) -> list[str]:
+    """Why the true effect was not named first: each set of first-round criteria it failed
+    (verdicts.missed_by), with its runs in all and per family. Rows saved before the field
+    existed give no lines."""
+    from collections import Counter
+
+    missed = [r for r in rows if r.get("missed_by")]
+    if not missed or any("missed_by" not in r for r in rows if r["kind"] in ("effect", "effects")):
+        return []
+    def first(r: dict) -> str:
+        return min(r["missed_by"], key=lambda c: ORDER.index(c) if c in ORDER else -1)
+
+    out = [f"  why the true effect was not named first ({len(missed)} runs): the first criterion "
+           "it failed in the first round, in select's order (alone: the only one it failed)"]
+    for reason, n in Counter(first(r) for r in missed).most_common():
+        mine = [r for r in missed if first(r) == reason]
+        alone = sum(len(r["missed_by"]) == 1 for r in mine)
+        per = ", ".join(f"{f} {k}" for f in families
+                        if (k := sum(r["family"] == f for r in mine)))
+        out.append(f"    {reason:40} {n:3d}, alone {alone:3d}   ({per})")
     return out
 
 

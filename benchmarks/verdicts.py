@@ -74,6 +74,30 @@ def judge_verdict(truth, named: list[str], unexplained: bool) -> dict:
             "wrong": wrong}
 
 
+def missed_by(doc: dict, truth) -> list[str] | None:
+    """Why a run's true effect was not named first, read off its report.json (``doc``): the
+    named criteria (compare.fit.select) that the true effect's first-round judgement failed,
+    ``signature`` where its own test vetoed it; ``qualified, another joined first`` where it
+    qualified and a candidate with more likelihood joined instead; ``not a candidate`` where
+    the fit did not try it. Of a per-channel effect (a lag) the judgement with the largest
+    gain counts. None where the run carries no library effect or named a true one first."""
+    from compare.fit.effects import parse_label
+
+    verdict = judge_verdict(truth, [e["name"] for e in doc["effects"]],
+                            bool(doc["verdict"]["unexplained"]))
+    if verdict["kind"] not in ("effect", "effects") or verdict["first"]:
+        return None
+    true = set(truth) if isinstance(truth, list | tuple) else {truth}
+    mine = [c for c in doc.get("candidates", [])
+            if c["round"] == 1 and parse_label(c["candidate"])[0] in true]
+    if not mine:
+        return ["not a candidate"]
+    best = max(mine, key=lambda c: c["gain"])
+    if best["qualifies"]:
+        return ["qualified, another joined first"]
+    return sorted(k for k, v in best["criteria"].items() if v is False)
+
+
 def named_text(named: Sequence[str], unexplained: bool) -> str:
     """The named effects as the tables print them, or 'unexplained' / 'nothing'."""
     return ", ".join(named) or ("unexplained" if unexplained else "nothing")

@@ -218,3 +218,44 @@ def test_the_scan_null_table_is_its_figures_file():
     doc = json.loads((ROOT / "docs" / "figures" / "scan-null.json").read_text("utf-8"))
     assert doc["critical_value_max"] < doc["bonferroni"]  # the reason it replaced Bonferroni
     assert_block("docs/fit.md", "scan-null", scan_null_table(doc))
+
+
+def test_why_a_true_effect_was_missed_is_read_off_its_first_round_criteria():
+    """benchmarks/verdicts.missed_by on hand-written reports: the criteria the true effect
+    failed in round 1 (a lag: its best channel), "qualified, another joined first" where it
+    qualified, None where it was named first or the run has no library effect."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        from verdicts import missed_by
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+
+    def judged(label, rnd, gain, qualifies=False, **failed):
+        crit = {"significant": True, "material": True, "signature": None, "predicts": True,
+                "beats_something_else": True, "distinct": True, "changes_prediction": True}
+        crit.update({k: False for k in failed})
+        return {"candidate": label, "round": rnd, "gain": gain, "criteria": crit,
+                "qualifies": qualifies}
+
+    def report(named, candidates, unexplained=False):
+        return {"effects": [{"name": n} for n in named], "candidates": candidates,
+                "verdict": {"unexplained": unexplained}}
+
+    lag = [judged("sensor_lag(T1)", 1, 2.0, significant=False, material=False),
+           judged("sensor_lag(P1)", 1, 9.0, signature=True),
+           judged("sensor_lag(P1)", 2, 30.0, distinct=False)]
+    assert missed_by(report([], lag), "sensor_lag") == ["signature"]
+    mount = [judged("mount_conduction", 1, 30.0, changes_prediction=False),
+             judged("bearing_preload", 1, 40.0, True)]
+    assert missed_by(report([], mount), "mount_conduction") == ["changes_prediction"]
+    assert missed_by(report(["bearing_preload"], mount), ["mount_conduction", "windage_loss"]) \
+        == ["changes_prediction"]
+    preload_second = [judged("bearing_preload", 1, 40.0, True)]
+    assert missed_by(report(["windage_loss"], preload_second), "bearing_preload") == [
+        "qualified, another joined first"]
+    assert missed_by(report([], []), "windage_loss") == ["not a candidate"]
+    assert missed_by(report(["mount_conduction"], mount), "mount_conduction") is None
+    assert missed_by(report([], mount, unexplained=True), "unexplained") is None
+    assert missed_by(report([], mount), None) is None

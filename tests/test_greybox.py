@@ -414,3 +414,28 @@ def test_cross_validation_of_the_true_model_is_at_the_noise(setup):
     wrong = cal.fit(free=["h_air"], start={"f0": 0.2})
     cv_wrong = local(cal, wrong).cross_validation_report(4)
     assert cv_wrong["pooled"]["T1"]["rmse"] > 3 * sd["T1"]
+
+
+def test_a_parameter_the_run_does_not_determine_leaves_the_others_identifiable():
+    """A Jacobian column of zeros (a conductance at a value where it does nothing, as
+    G_seat_W_K near 0 on its log scale) makes that parameter not identifiable, and only it:
+    the other parameters' intervals are those of the same least squares without the column,
+    computed here independently as s^2 (J^T J)^-1 of the reduced Jacobian (tolerance: float
+    round-off of a well-conditioned 2 x 2 inverse)."""
+    from compare.fit.calibrate import _intervals
+    from compare.fit.params import Param
+
+    rng = np.random.default_rng(3)
+    n = 200
+    J = np.column_stack([rng.normal(size=n), rng.normal(size=n), np.zeros(n)])
+    r = rng.normal(scale=0.1, size=n)
+    params = {k: Param(k, "-", 0.5, 0.0, 1.0, k, log=False) for k in ("a", "b", "c")}
+    free = ["a", "b", "c"]
+    z = np.array([0.5, 0.5, 0.5])  # mid-range: no interval is cut by a bound
+    ci, _, ident = _intervals(J, r, n, float(n), free, params, z)
+    assert ident == {"a": True, "b": True, "c": False}
+    s2 = float(r @ r) / (n - 3)
+    sd = np.sqrt(np.diag(np.linalg.inv(J[:, :2].T @ J[:, :2]) * s2))
+    for i, k in enumerate(("a", "b")):
+        half = 0.5 * (ci[k][1] - ci[k][0])
+        assert half == pytest.approx(1.96 * sd[i] * (params[k].hi - params[k].lo), rel=1e-9)

@@ -89,7 +89,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "simulated over it (default 5; 0: none)")
     fp.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
                     help="the level of every test: an effect's likelihood-ratio test, the "
-                    "signature tests, the competitor's (divided by its hypotheses) and the "
+                    "signature tests, the competitor's scan (against the same scan on noise) and the "
                     "plausible range of the base parameters (default 0.01)")
     fp.add_argument("--min-gain", type=number(0.0, 100.0), default=25.0,
                     help="an effect judged by the open-loop fit must remove at least this "

@@ -11,8 +11,9 @@
   variance, inflated by n / n_eff for the residual's autocorrelation (n_eff = n / tau_int with
   tau_int the integrated autocorrelation time, see :func:`effective_samples`), 95 % intervals;
   correlations; a parameter is
-  reported not identifiable when its interval spans more than its bounds' range or the
-  information matrix is numerically singular.
+  reported not identifiable when its interval spans more than its bounds' range (a direction
+  the information matrix does not determine counts with an eigenvalue of 1e-12 of the largest:
+  it takes the parameters that share it out of their bounds, and leaves the others alone).
 - **Priors** (when :meth:`Calibrator.set_prior` is called, as ``fit`` does): each base
   parameter is Gaussian around the spec's value on its fitted scale, with the width
   ``Param.prior_sd``; the data term is weighted by n_eff / n against them.
@@ -368,14 +369,18 @@ def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[st
     """95 % intervals in the parameters' own units, correlations, identifiability."""
     p = len(free)
     s2 = float(np.dot(r, r)) / max(n - p, 1) * (n / n_eff)
-    JtJ = J.T @ J
     ci: dict[str, tuple[float, float]] = {}
     ident: dict[str, bool] = {}
     try:
-        cond = np.linalg.cond(JtJ)
-        cov = np.linalg.pinv(JtJ) * s2
+        # the inverse by eigenvalues, each at least 1e-12 of the largest (double precision's
+        # digits): a direction the run does not determine (a parameter at a value where it
+        # does nothing, a column of zeros) gets an interval wider than any bounds, and only
+        # the parameters that share it lose theirs. A pseudo-inverse would give it none.
+        w, V = np.linalg.eigh(J.T @ J)
+        w = np.maximum(w, 1e-12 * max(float(w.max()), np.finfo(float).tiny))
+        cov = (V / w) @ V.T * s2
     except np.linalg.LinAlgError:
-        cond, cov = math.inf, np.full((p, p), np.nan)
+        cov = np.full((p, p), np.nan)
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(sd, sd)
@@ -384,7 +389,7 @@ def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[st
         lo_z, hi_z = z[i] - 1.96 * sd[i], z[i] + 1.96 * sd[i]
         b_lo, b_hi = _bounds_z(pr)
         ci[k] = (_from_z(pr, max(lo_z, b_lo)), _from_z(pr, min(hi_z, b_hi)))
-        ident[k] = bool(np.isfinite(sd[i]) and cond < 1e12 and 3.92 * sd[i] < (b_hi - b_lo))
+        ident[k] = bool(np.isfinite(sd[i]) and 3.92 * sd[i] < (b_hi - b_lo))
     return ci, corr, ident
 
 

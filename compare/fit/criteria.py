@@ -28,10 +28,10 @@ class Criteria:
     # ---------------------------------------------------------------- statistics
     alpha: float = _c(
         0.01, "-", "the level of every test: an effect's likelihood-ratio test, each "
-        "signature test, the competitor's scan (divided by the number of its hypotheses) and "
-        "the plausible range of a base parameter (two-sided). At 1 % per test, the about ten "
-        "candidates of a run give a false one in under 10 % of clean runs before the other "
-        "criteria")
+        "signature test, the competitor's scan (against its Monte Carlo critical value: "
+        "scan_null_tail) and the plausible range of a base parameter (two-sided). At 1 % per "
+        "test, the about ten candidates of a run give a false one in under 10 % of clean runs "
+        "before the other criteria")
     material_peak: float = _c(
         0.5, "tolerances", "an effect (or the competitor) is named only if at its estimate it "
         "moves one of its channels by half a tolerance at its peak: a smaller term cannot take "
