@@ -259,3 +259,51 @@ def test_why_a_true_effect_was_missed_is_read_off_its_first_round_criteria():
     assert missed_by(report(["mount_conduction"], mount), "mount_conduction") is None
     assert missed_by(report([], mount, unexplained=True), "unexplained") is None
     assert missed_by(report([], mount), None) is None
+
+
+def test_each_criterions_margin_counts_the_candidates_only_it_decides(tmp_path):
+    """benchmarks/criteria_margins.margins on hand-written reports: a criterion counts the
+    candidates of its round that pass every other criterion (significant and material
+    first), true or false by the run's truth, with its figure; a candidate failing two
+    criteria counts for neither, and a signature-route candidate for none."""
+    import json
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        from criteria_margins import margins, table
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+
+    def judged(label, rnd=1, signature=None, **failed):
+        crit = {"significant": True, "material": True, "signature": signature,
+                "predicts": True, "beats_something_else": True, "distinct": True,
+                "changes_prediction": True}
+        crit.update({k: False for k in failed})
+        return {"candidate": label, "round": rnd, "gain": 10.0, "p_value": 1e-4,
+                "peak_tolerances": 2.0, "criteria": crit, "penalised_gain": 8.0,
+                "competitor_penalised_gain": 2.0, "rival_penalised_gain": 1.0,
+                "net_change_peak": 0.3, "cv_before": 1.0, "cv_after": 0.4}
+
+    crit = [{"name": "alpha", "value": 0.01}]
+    reports = {"a": [judged("mount_conduction", changes_prediction=True),  # only it fails
+                     judged("bearing_preload", changes_prediction=True, distinct=True),
+                     judged("windage_loss", signature=True)],
+               "b": [judged("bearing_preload", changes_prediction=True),
+                     judged("mount_conduction", rnd=2, changes_prediction=True)]}
+    for run, cands in reports.items():
+        (tmp_path / f"{run}.json").write_text(json.dumps({"candidates": cands,
+                                                          "criteria": crit}), "utf-8")
+    truth = {"a": "mount_conduction", "b": "windage_loss"}.get
+    rows = {r["criterion"]: r for r in table(margins([tmp_path], truth, 1))}
+    cp = rows["changes_prediction"]
+    assert (cp["true"], cp["true_pass"], cp["false"], cp["false_pass"]) == (1, 0, 1, 0)
+    assert cp["true_failing"] == ["a:mount_conduction"]
+    assert cp["true_min"] == pytest.approx(0.3)
+    assert rows["predicts"]["true"] == 0 and rows["distinct"]["false"] == 0
+    # the share of the cross-validated excess removed: 1 - 0.4 / 1.0
+    (tmp_path / "a.json").write_text(json.dumps({"candidates": [judged("mount_conduction")],
+                                                 "criteria": crit}), "utf-8")
+    rows = {r["criterion"]: r for r in table(margins([tmp_path], truth, 1))}
+    assert rows["predicts"]["true_min"] == pytest.approx(0.6)
+    assert table(margins([tmp_path], truth, 2))[-1]["false"] == 1

@@ -22,7 +22,7 @@ from spindle.spec_reader import load_spec
 CHANNELS = ["T1", "T2", "T_stator", "P1"]
 ALL_PASS = {"significant": True, "material": True, "signature": None,
             "predicts": True, "beats_something_else": True,
-            "distinct": True, "changes_prediction": True}
+            "distinct": True, "changes_prediction": True, "restores_plausible_base": None}
 
 
 @pytest.mark.parametrize("changes, route", [
@@ -38,6 +38,10 @@ ALL_PASS = {"significant": True, "material": True, "signature": None,
     ({"changes_prediction": False}, None),  # the base re-adjusts around it
     ({"changes_prediction": False, "signature": True}, "signature"),  # its own evidence
     ({"changes_prediction": None}, "open loop"),  # switched off
+    # the prediction does not move, but the base is implausible without it and not with it
+    ({"changes_prediction": False, "restores_plausible_base": True}, "open loop"),
+    ({"changes_prediction": False, "restores_plausible_base": False}, None),
+    ({"restores_plausible_base": True, "predicts": False}, None),
 ])
 def test_a_candidates_route_follows_its_named_criteria(changes, route):
     j = Judgement("x", 1, None, 10.0, 20.0, 1e-5, 2.0, {**ALL_PASS, **changes})
@@ -312,3 +316,31 @@ def test_a_named_effect_that_leaves_a_held_out_misfit_says_something_else_remain
     quiet = verdict_on(local(cal, sel.final), regressors(cal, sel.base, off), off,
                        unknown_inputs=[(float(inp.grid_s[0]), float(inp.grid_s[-1]) + 1.0)])
     assert not quiet.unexplained and quiet.misses == {}
+
+
+def test_the_linearized_models_prior_distances_are_the_calibrators(setup):
+    """Local.prior_sds (the base parameters' |prior z| that restores_plausible_base reads)
+    agrees with Calibrator.prior_z, which computes it from the parameter values instead of the
+    fitted scale: at the fit (no step) and after a step of the base (to round-off)."""
+    from types import SimpleNamespace
+
+    from compare.fit.calibrate import _from_z
+    from compare.fit.linear import local
+    from compare.fit.params import default_theta
+
+    spec, inp = setup
+    truth = GreyBox(spec, DRIVES["spl2782"], inp)
+    vals = _noisy(truth.simulate({"f0": 0.4, "h_air": 2.0}), len(inp.grid_s), 11)
+    cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
+    centre = default_theta(cal.gb.parameters())
+    _, fit = cal.fit_with_prior(centre)
+    loc = local(cal, fit)
+    params = cal.gb.parameters()
+    rng = np.random.default_rng(0)
+    for delta in (np.zeros(len(fit.free)), rng.normal(scale=0.3, size=len(fit.free))):
+        moved = {k: _from_z(params[k], z + d)
+                 for k, z, d in zip(fit.free, loc.z0, delta, strict=True)}
+        want = cal.prior_z(SimpleNamespace(effects=fit.effects, free=fit.free,
+                                           theta={**fit.theta, **moved}))
+        got = dict(zip(fit.free, loc.prior_sds(delta), strict=True))
+        assert want and all(got[k] == pytest.approx(v, abs=1e-9) for k, v in want.items())

@@ -42,6 +42,13 @@ class Criteria:
         "one of its channels: the open loop's only evidence is that prediction, and an effect "
         "the base re-adjusts around to within half a tolerance changes no compensation built "
         "on the model. The signature route keeps its own evidence")
+    plausible_base_route: bool = _c(
+        False, "-", "an open-loop effect that does not change the prediction by material_peak "
+        "still changes the model where, without it, the calibrated base needs an implausible "
+        "value (some |prior z| above implausible_z) and, with it, none: the priors say the "
+        "spindle is like its spec within the declared widths, so a base that can imitate the "
+        "effect only outside them does not (the adequacy verdict would otherwise blame the spec "
+        "for it: 'needs implausible values to fit the run')")
     cv_blocks: int = _c(
         5, "blocks", "blocked cross-validation: each fifth of the run held out in turn; five "
         "blocks of a 16 h run are about 3 h, longer than the slowest time constant (the "

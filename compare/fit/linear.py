@@ -80,6 +80,12 @@ class Local:
             r = r + extra @ delta[kb:]
         return r
 
+    def prior_sds(self, delta: np.ndarray) -> np.ndarray:
+        """Each base parameter's distance from its prior centre after the step ``delta``, in
+        prior standard deviations (0 where it has no prior)."""
+        kb = self.J.shape[1]
+        return self.prior_rows * (self.z0 + delta[:kb] - self.prior_z) / self.cal.prior_scale
+
     def penalty(self, delta: np.ndarray) -> float:
         kb = self.J.shape[1]
         t = self.prior_rows * (self.z0 + delta[:kb] - self.prior_z)

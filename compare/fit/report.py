@@ -374,7 +374,7 @@ def _criteria_html(doc: dict) -> str:
     """Every judged candidate and each named criterion's outcome."""
     rows = []
     names = ("significant", "material", "signature", "predicts", "beats_something_else",
-             "distinct", "changes_prediction")
+             "distinct", "changes_prediction", "restores_plausible_base")
     for c in doc.get("candidates", []):
         crit = c["criteria"]
         rows.append([c["candidate"], c["round"], f"{c['gain']:.1f}", p_text(c["p_value"]),
@@ -387,7 +387,7 @@ def _criteria_html(doc: dict) -> str:
             "this effect by its signature or by every open-loop criterion "
             "(compare.fit.select).</p>"
             + html_table(["candidate", "round", "gain", "p", "peak [tol]", *names,
-                          "qualifies by"], rows, ["s"] * 13))
+                          "qualifies by"], rows, ["s"] * (len(names) + 6)))
 
 
 def _signatures_html(doc: dict) -> str:

@@ -32,7 +32,9 @@ and then show that it is *this* effect, by one of two routes:
     least the competitor's best, less the same for its three (amplitude, start, end);
   - ``changes_prediction`` (``Criteria.open_loop_material_change``): the fitted model's
     prediction, with the base re-adjusted around the effect, moves by ``material_peak`` on
-    one of its channels;
+    one of its channels; or else ``restores_plausible_base`` (``Criteria.plausible_base_route``):
+    without the effect the base needs a value outside its prior's (1 - alpha) range, with it
+    none;
   - ``distinct``: its penalised gain exceeds that of every other candidate acting on one of
     its channels by half the chi-square quantile of one degree of freedom at ``alpha``
     (3.3 at 1 %): two effects that explain the run alike are a guess, not a finding;
@@ -89,9 +91,11 @@ class Judgement:
         if c["signature"]:
             return "signature"
         open_loop = ("predicts", "beats_something_else", "distinct")
-        optional = ("changes_prediction",)  # None: switched off
-        ok = all(c.get(k) for k in open_loop) and all(c.get(k) is not False for k in optional)
-        return "open loop" if ok else None
+        # the model changes: its prediction, or else its base from implausible to plausible
+        # (each None where switched off)
+        changes = (c.get("changes_prediction") is not False
+                   or bool(c.get("restores_plausible_base")))
+        return "open loop" if all(c.get(k) for k in open_loop) and changes else None
 
     @property
     def qualifies(self) -> bool:
@@ -328,6 +332,10 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
     # re-adjustment around the effect included
     net = float(np.max(np.abs(null.residual[rows] - ef.residual[rows]))) if rows.any() else 0.0
     margin = 0.5 * chi2_threshold(criteria.alpha, 1)
+    # the largest |prior z| of the base parameters without the candidate and with it
+    z_null = float(np.max(np.abs(loc.prior_sds(null.delta)), initial=0.0))
+    z_with = float(np.max(np.abs(loc.prior_sds(ef.delta)), initial=0.0))
+    z_crit = criteria.implausible_z()
     out: dict[str, bool | None] = {
         "significant": pv < criteria.alpha,
         "material": peak >= criteria.material_peak,
@@ -335,6 +343,8 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
         "predicts": None,
         "changes_prediction": (net >= criteria.material_peak
                                if criteria.open_loop_material_change else None),
+        "restores_plausible_base": (z_null > z_crit >= z_with
+                                    if criteria.plausible_base_route else None),
         "beats_something_else": bool(penalised >= competitor),
         "distinct": bool(penalised >= rival + margin),
     }
@@ -342,7 +352,8 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
         "values": ef.values, "penalised_gain": penalised,
         "competitor_penalised_gain": competitor if math.isfinite(competitor) else None,
         "rival_penalised_gain": rival if math.isfinite(rival) else None,
-        "net_change_peak": net, "cv_before": None, "cv_after": None}
+        "net_change_peak": net, "base_prior_z_without": z_null, "base_prior_z_with": z_with,
+        "cv_before": None, "cv_after": None}
     if criteria.cv_blocks and out["significant"] and out["material"] and not out["signature"]:
         before = _cv_excess(cv_now or {}, cal.floor, own)
         after = _cv_excess(effect_held_out(loc, ef, criteria.cv_blocks), cal.floor, own)
