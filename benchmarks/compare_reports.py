@@ -36,6 +36,23 @@ def truth_of(run: str, peers: dict) -> object:
     return None if doc["effect"] == "clean" else doc["effect"]
 
 
+def require_reports(folders) -> None:
+    """End the script with one message and exit status 2 where a folder holds no reports."""
+    for d in folders:
+        if not d.is_dir() or not any(d.glob("*.json")):
+            print(f"error: {d}: no report.json files; give folders written by "
+                  "bench_families.py --reports", file=sys.stderr)
+            raise SystemExit(2)
+
+
+def peer_truths() -> dict:
+    """The peer's runs' truths by run name (tests/data/peer-runs)."""
+    peers = {}
+    for folder in (PEER_RUNS / "bench-runs", PEER_RUNS / "bench-runs-2"):
+        peers.update({k: v.get("truth") for k, v in read_truth(folder).items()})
+    return peers
+
+
 def family_of(run: str) -> str:
     head = run.split("-")[0]
     return head if head in FAMILIES else "peers"
@@ -90,14 +107,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--json", type=Path, help="write the comparison as a figures file")
     ap.add_argument("--label", default="", help="what changed between the two folders")
     args = ap.parse_args(argv)
-    for d in (args.before, args.after):
-        if not d.is_dir() or not any(d.glob("*.json")):
-            print(f"error: {d}: no report.json files; give folders written by "
-                  "bench_families.py --reports", file=sys.stderr)
-            raise SystemExit(2)
-    peers = {}
-    for folder in (PEER_RUNS / "bench-runs", PEER_RUNS / "bench-runs-2"):
-        peers.update({k: v.get("truth") for k, v in read_truth(folder).items()})
+    require_reports((args.before, args.after))
+    peers = peer_truths()
     result = compare(outcomes(args.before, peers), outcomes(args.after, peers))
     for f, row in result["families"].items():
         b, a = row["before"], row["after"]

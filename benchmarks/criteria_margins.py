@@ -16,7 +16,8 @@ asked the open loop's criteria); the signature's veto is counted as a criterion.
 - ``beats_something_else``: its penalised gain less the competitor's, against 0;
 - ``distinct``: its penalised gain less the best rival's and the margin, against 0;
 - ``changes_prediction``: the fitted model's net change on its channels [tolerances],
-  against material_peak.
+  against material_peak (it passes, too, where ``restores_plausible_base`` does:
+  compare.fit.select.model_changes).
 """
 
 from __future__ import annotations
@@ -28,9 +29,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from bench_families import PEER_RUNS
-from compare_reports import truth_of
-from verdicts import read_truth
+from compare_reports import peer_truths, require_reports, truth_of
 
 #: asked of every candidate counted (they gate the cross-validation)
 PREREQUISITES = ("significant", "material")
@@ -62,6 +61,7 @@ def margins(folders: list[Path], truth: Callable[[str], object], rnd: int = 1) -
     other criterion, how many of each it passes, and their figures (``truth``: a run's truth
     by its name, as compare_reports.truth_of)."""
     from compare.fit.effects import parse_label
+    from compare.fit.select import model_changes
 
     out = {k: {"true": [], "false": []} for k in CRITERIA}
     for folder in folders:
@@ -84,8 +84,10 @@ def margins(folders: list[Path], truth: Callable[[str], object], rnd: int = 1) -
                             crit.get(o) is None for o in ("predicts", "beats_something_else",
                                                           "distinct") if o != k):
                         continue
+                    passes = (model_changes(crit) if k == "changes_prediction"
+                              else crit.get(k) is not False)
                     out[k][side].append({"run": p.stem, "candidate": c["candidate"],
-                                         "passes": crit.get(k) is not False,
+                                         "passes": passes,
                                          "figure": figure(c, k, table)})
     return out
 
@@ -121,14 +123,8 @@ def main(argv: list[str] | None = None) -> None:
                     "the model that holds the first effect)")
     ap.add_argument("--json", type=Path, help="write the tables as a figures file")
     args = ap.parse_args(argv)
-    for d in args.reports:
-        if not d.is_dir() or not any(d.glob("*.json")):
-            print(f"error: {d}: no report.json files; give folders written by "
-                  "bench_families.py --reports", file=sys.stderr)
-            raise SystemExit(2)
-    peers = {}
-    for folder in (PEER_RUNS / "bench-runs", PEER_RUNS / "bench-runs-2"):
-        peers.update({k: v.get("truth") for k, v in read_truth(folder).items()})
+    require_reports(args.reports)
+    peers = peer_truths()
     tables = {}
     for rnd in args.rounds:
         rows = tables[str(rnd)] = table(margins(args.reports, lambda r: truth_of(r, peers), rnd))

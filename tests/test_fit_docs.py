@@ -307,3 +307,30 @@ def test_each_criterions_margin_counts_the_candidates_only_it_decides(tmp_path):
     rows = {r["criterion"]: r for r in table(margins([tmp_path], truth, 1))}
     assert rows["predicts"]["true_min"] == pytest.approx(0.6)
     assert table(margins([tmp_path], truth, 2))[-1]["false"] == 1
+
+
+def margins_table(doc: dict) -> str:
+    """docs/fit.md's table of what each open-loop criterion decides, from
+    docs/figures/criteria-margins.json (benchmarks/criteria_margins.py)."""
+    def num(v) -> str:
+        return "—" if v is None else f"{v:.2f}"
+
+    lines = ["| round | criterion | true effects it passes | false candidates it passes | "
+             "true: least, median figure | false: median, largest figure |",
+             "|---|---|---|---|---|---|"]
+    for rnd, rows in doc["rounds"].items():
+        for r in rows:
+            lines.append(f"| {rnd} | `{r['criterion']}` | {r['true_pass']} of {r['true']} | "
+                         f"{r['false_pass']} of {r['false']} | {num(r['true_min'])}, "
+                         f"{num(r['true_median'])} | {num(r['false_median'])}, "
+                         f"{num(r['false_max'])} |")
+    return "\n".join(lines)
+
+
+def test_the_criteria_margins_table_is_its_figures_file():
+    import json
+
+    from tests.docs_blocks import assert_block
+
+    doc = json.loads((ROOT / "docs" / "figures" / "criteria-margins.json").read_text("utf-8"))
+    assert_block("docs/fit.md", "criteria-margins", margins_table(doc))

@@ -65,6 +65,14 @@ from compare.fit.effects import effect_of, parse_label
 from compare.fit.linear import Local, effect_held_out, fit_effect, local
 
 
+def model_changes(criteria: Mapping[str, bool | None]) -> bool:
+    """The open loop's last criterion from a candidate's named criteria: the fitted model
+    changes, in its prediction (``changes_prediction``) or else in its base, from implausible
+    to plausible (``restores_plausible_base``); each None where switched off."""
+    return (criteria.get("changes_prediction") is not False
+            or bool(criteria.get("restores_plausible_base")))
+
+
 @dataclass
 class Judgement:
     """One candidate in one round: its refit and each named criterion's outcome (None where
@@ -91,11 +99,8 @@ class Judgement:
         if c["signature"]:
             return "signature"
         open_loop = ("predicts", "beats_something_else", "distinct")
-        # the model changes: its prediction, or else its base from implausible to plausible
-        # (each None where switched off)
-        changes = (c.get("changes_prediction") is not False
-                   or bool(c.get("restores_plausible_base")))
-        return "open loop" if all(c.get(k) for k in open_loop) and changes else None
+        return ("open loop" if all(c.get(k) for k in open_loop) and model_changes(c)
+                else None)
 
     @property
     def qualifies(self) -> bool:
