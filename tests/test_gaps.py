@@ -111,3 +111,43 @@ def test_the_calibrated_model_places_the_switch_where_the_spec_model_cannot():
 
     assert abs(place(None) - true_switch_s) > 120.0  # the spec's model: off
     assert place(theta) == pytest.approx(true_switch_s, abs=60.0)
+
+
+def test_a_load_change_at_constant_speed_inside_a_gap_counts():
+    """The same speed either side of a gap, the load torque's five-minute levels 19 and 22
+    N m: an operating change (beyond a load cell's zero drift, Criteria.no_load_Nm, 0.5 N m);
+    levels 0.3 N m apart are not, nor is a gap on a bench that logs no torque. The switch
+    then sets the torque (and the power) to the old levels before it and the new after."""
+    from compare.fit.criteria import Criteria
+
+    grid = np.arange(0.0, 8000.0, 60.0)
+    t = np.concatenate([np.arange(0.0, 3000.0, 10.0), np.arange(4200.0, 8000.0, 10.0)])
+    n = np.full(len(t), 4900.0)
+    step = np.where(t < 3600.0, 19.0, 22.0)
+    assert gaps_with_change(t, t, n, grid, torque=(t, step)) == [(2990.0, 4200.0, 4900.0,
+                                                                   4900.0)]
+    small = np.where(t < 3600.0, 19.0, 19.3)
+    assert gaps_with_change(t, t, n, grid, torque=(t, small)) == []
+    assert gaps_with_change(t, t, n, grid) == []
+
+    cycle = load_cycle("spl-16h")
+    inputs = inputs_from_cycle(cycle, grid)
+    inputs = replace(inputs, speed_rpm=np.full(len(grid) - 1, 4900.0),
+                     load_torque_Nm=np.full(len(grid) - 1, 19.0))
+    power = np.where(t < 3600.0, 11.2, 12.7)
+    # a misfit that is least with the switch at 3600 s: the grid edge of the true change
+    placed, switches = place_switches(
+        inputs, t, t, n, t, power,
+        lambda trial, end: float(np.sum((trial.load_torque_Nm - np.where(grid[:-1] < 3600.0,
+                                                                         19.0, 22.0)) ** 2)),
+        Criteria(), torque=(t, step))
+    (g,) = switches
+    assert g.switch_s == 3600.0
+    assert (g.torque_before_Nm, g.torque_after_Nm) == pytest.approx((19.0, 22.0), rel=1e-12)
+    inside = (grid[:-1] >= 2940.0) & (grid[:-1] < 4200.0)
+    # the levels are means of equal samples: equal to round-off
+    np.testing.assert_allclose(placed.load_torque_Nm[inside],
+                               np.where(grid[:-1][inside] < 3600.0, 19.0, 22.0), rtol=1e-12)
+    np.testing.assert_allclose(placed.power_kW[inside],
+                               np.where(grid[:-1][inside] < 3600.0, 11.2, 12.7), rtol=1e-12)
+    assert g.text() == "the load changed from 19.0 to 22.0 N m at 4900 rpm"

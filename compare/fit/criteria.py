@@ -114,7 +114,7 @@ class Criteria:
         "Until that hour is over the inputs are not known (what ran inside the gap is a "
         "guess), so something else is not looked for in the gap nor in that hour")
     gap_level_s: float = _c(
-        300.0, "s", "the speed and power levels either side of a gap are read over five "
+        300.0, "s", "the speed, power and load levels either side of a gap are read over five "
         "minutes of samples")
 
     # ---------------------------------------------------------------- signatures: steps
@@ -126,7 +126,9 @@ class Criteria:
         300.0, "rpm", "below this a spindle stands: its bearing and motor heat is nil")
     no_load_Nm: float = _c(
         0.5, "N m", "a segment turns without load up to this process torque (a load cell's "
-        "zero drift)")
+        "zero drift); two load levels either side of a logging gap that differ by more are an "
+        "operating change inside it (compare.fit.gaps), as a speed change beyond the drive's "
+        "scatter is")
     speed_band_rpm: float = _c(
         SPEED_BAND_RPM, "rpm", "a logged speed within max(20 rpm, 1 %) of the current step "
         "belongs to it: a drive's scatter around its set speed (spindle.bench_inputs)")

@@ -201,7 +201,9 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
     from compare.fit.gaps import gaps_with_change, place_switches
 
     t_n, n = _valid_samples(run, "speed_rpm")
-    if not gaps_with_change(run.time_s, t_n, n, inputs.grid_s, criteria=criteria):
+    torque = _valid_samples(run, "load_torque_Nm") if run.load_torque_measured else None
+    if not gaps_with_change(run.time_s, t_n, n, inputs.grid_s, criteria=criteria,
+                            torque=torque):
         return inputs, []
     say("placing the operating change inside a logging gap")
     cache: dict = {}
@@ -220,7 +222,7 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
         return total
 
     return place_switches(inputs, run.time_s, t_n, n, *_valid_samples(run, "power_kW"),
-                          misfit, criteria)
+                          misfit, criteria, torque)
 
 
 def signature_tests(run: BenchRun, gb: GreyBox, theta: dict[str, float], channels,
@@ -329,8 +331,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                                              cal.prior_z(final), ranges, criteria)
     warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
                                    measured.fit_points())
-    warns += [f"the speed changed from {g.speed_before_rpm:.0f} to {g.speed_after_rpm:.0f} rpm "
-              f"inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} h); the change "
+    warns += [f"{g.text()} inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} h); the change "
               f"is placed at {g.switch_s / 3600:.2f} h, where {prep.switches_placed_by} fits "
               "the hour after the gap best (compare.fit.gaps)" for g in prep.gap_switches]
     cv = {}
