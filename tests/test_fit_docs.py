@@ -98,7 +98,9 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-scan-null": "fit-trade-scan-null.json",
           "trade-misfit-named": "fit-trade-misfit-named.json",
           "trade-misfit-named-held-out": "fit-trade-misfit-named-held-out.json",
-          "trade-scan-tail": "fit-trade-scan-tail.json"}
+          "trade-scan-tail": "fit-trade-scan-tail.json",
+          "trade-plausible-base": "fit-trade-plausible-base.json",
+          "trade-plausible-base-held-out": "fit-trade-plausible-base-held-out.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))

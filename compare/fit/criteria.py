@@ -43,7 +43,7 @@ class Criteria:
         "the base re-adjusts around to within half a tolerance changes no compensation built "
         "on the model. The signature route keeps its own evidence")
     plausible_base_route: bool = _c(
-        False, "-", "an open-loop effect that does not change the prediction by material_peak "
+        True, "-", "an open-loop effect that does not change the prediction by material_peak "
         "still changes the model where, without it, the calibrated base needs an implausible "
         "value (some |prior z| above implausible_z) and, with it, none: the priors say the "
         "spindle is like its spec within the declared widths, so a base that can imitate the "
