@@ -284,7 +284,7 @@ def missed_lines(rows: list[dict], families: list[str]) -> list[str]:
     if not missed or any("missed_by" not in r for r in rows if r["kind"] in ("effect", "effects")):
         return []
     def first(r: dict) -> str:
-        return min(r["missed_by"], key=lambda c: ORDER.index(c) if c in ORDER else -1)
+        return min(r["missed_by"], key=lambda c: ORDER.index(c) if c in ORDER else len(ORDER))
 
     out = [f"  why the true effect was not named first ({len(missed)} runs): the first criterion "
            "it failed in the first round, in select's order (alone: the only one it failed)"]

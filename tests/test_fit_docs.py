@@ -100,7 +100,9 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-misfit-named-held-out": "fit-trade-misfit-named-held-out.json",
           "trade-scan-tail": "fit-trade-scan-tail.json",
           "trade-plausible-base": "fit-trade-plausible-base.json",
-          "trade-plausible-base-held-out": "fit-trade-plausible-base-held-out.json"}
+          "trade-plausible-base-held-out": "fit-trade-plausible-base-held-out.json",
+          "trade-gap-load": "fit-trade-gap-load.json",
+          "trade-gap-load-held-out": "fit-trade-gap-load-held-out.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
@@ -249,6 +251,13 @@ def test_why_a_true_effect_was_missed_is_read_off_its_first_round_criteria():
            judged("sensor_lag(P1)", 1, 9.0, signature=True),
            judged("sensor_lag(P1)", 2, 30.0, distinct=False)]
     assert missed_by(report([], lag), "sensor_lag") == ["signature"]
+    # the plausible base stands in for the prediction's change (select.model_changes)
+    rescued = [judged("coolant_dynamics", 1, 30.0, predicts=False, changes_prediction=False)]
+    rescued[0]["criteria"]["restores_plausible_base"] = True
+    assert missed_by(report([], rescued), "coolant_dynamics") == ["predicts"]
+    rescued[0]["criteria"]["restores_plausible_base"] = False
+    assert missed_by(report([], rescued), "coolant_dynamics") == ["changes_prediction",
+                                                                  "predicts"]
     mount = [judged("mount_conduction", 1, 30.0, changes_prediction=False),
              judged("bearing_preload", 1, 40.0, True)]
     assert missed_by(report([], mount), "mount_conduction") == ["changes_prediction"]

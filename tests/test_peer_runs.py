@@ -38,7 +38,6 @@ KNOWN_NOT_RIGHT: dict[str, str] = {
     "dev-07": "mount_conduction: unexplained",
     "dev-08": "coolant_dynamics named, then a false sensor_lag(T_stator) by the open loop",
     "dev2-01": "windage_loss: nothing named",
-    "dev2-04": "sensor_lag: unexplained",
     "dev2-05": "centrifugal_shortening and windage_loss: only the centrifugal shortening",
     "dev2-08": "mount_conduction: unexplained",
     "dev2-09": "outside the library: nothing named, but not unexplained",
