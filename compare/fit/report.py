@@ -384,7 +384,8 @@ def _criteria_html(doc: dict) -> str:
     return ("<h2>Candidates and criteria</h2><p>Each candidate refitted with the base "
             "parameters, round by round, and the criteria it passed (— not asked). A "
             "candidate qualifies when it is significant and material and shows that it is "
-            "this effect by its signature or by every open-loop criterion "
+            "this effect by its signature or by every open-loop criterion, of which the "
+            "last is changes_prediction or, failing it, restores_plausible_base "
             "(compare.fit.select).</p>"
             + html_table(["candidate", "round", "gain", "p", "peak [tol]", *names,
                           "qualifies by"], rows, ["s"] * (len(names) + 6)))
