@@ -344,3 +344,25 @@ def test_the_linearized_models_prior_distances_are_the_calibrators(setup):
                                            theta={**fit.theta, **moved}))
         got = dict(zip(fit.free, loc.prior_sds(delta), strict=True))
         assert want and all(got[k] == pytest.approx(v, abs=1e-9) for k, v in want.items())
+
+
+def test_the_verdict_says_when_an_effect_was_named_for_the_base_it_spares():
+    """report.verdict_lines on hand-written report documents: an open-loop effect named by
+    the plausible-base route (its prediction's change failed, restores_plausible_base
+    passed) says that without it the base needs a value outside its prior's range; one that
+    moved the prediction does not."""
+    from compare.fit.report import verdict_lines
+
+    def doc(criteria):
+        effect = {"label": "mount_conduction", "parameters": {"G_mount_W_K": 4.0},
+                  "units": {"G_mount_W_K": "W/K"},
+                  "confidence_intervals": {"G_mount_W_K": [3.0, 5.0]}, "evidence": None,
+                  "route": "open loop", "p_value": 1e-6, "criteria": criteria}
+        return {"verdict": {"kind": "named", "unexplained": False}, "effects": [effect],
+                "error_before": {"validation": {}}, "error_after": {"validation": {}}}
+
+    spared = verdict_lines(doc({**ALL_PASS, "changes_prediction": False,
+                                "restores_plausible_base": True}))[0]
+    assert "without it the calibrated base needs a value outside its prior's range" in spared
+    moved = verdict_lines(doc(ALL_PASS))[0]
+    assert "prior's range" not in moved and moved.startswith("Named: mount_conduction")

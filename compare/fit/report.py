@@ -127,7 +127,10 @@ def verdict_lines(doc: dict) -> list[str]:
             how = (f"its signature in the raw samples (z = {ev['z']:.1f}, {p_text(ev['p_value'])})"
                    if e["route"] == "signature" else
                    f"the open-loop fit ({p_text(e['p_value'])}): it predicts held-out blocks and "
-                   "explains the run better than something else and than every other effect")
+                   "explains the run better than something else and than every other effect"
+                   + ("; without it the calibrated base needs a value outside its prior's range"
+                      if e["criteria"].get("changes_prediction") is False
+                      and e["criteria"].get("restores_plausible_base") else ""))
             lines.append(f"Named: {e['label']}, {vals}. Evidence: {how}.")
         if v["unexplained"]:
             lines.append(f"Something else remains: {v['where']}{_where_more(v)}.")
