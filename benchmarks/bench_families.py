@@ -269,16 +269,13 @@ def summary(rows: list[dict]) -> list[str]:
     return out
 
 
-#: the criteria in the order compare.fit.select asks them (Judgement.route)
-ORDER = ("significant", "material", "signature", "predicts", "beats_something_else", "distinct",
-         "changes_prediction")
-
-
 def missed_lines(rows: list[dict], families: list[str]) -> list[str]:
     """Why the true effect was not named first: each set of first-round criteria it failed
     (verdicts.missed_by), with its runs in all and per family. Rows saved before the field
     existed give no lines."""
     from collections import Counter
+
+    from compare.fit.select import CRITERIA_ORDER as ORDER
 
     missed = [r for r in rows if r.get("missed_by")]
     if not missed or any("missed_by" not in r for r in rows if r["kind"] in ("effect", "effects")):

@@ -31,9 +31,19 @@ from pathlib import Path
 
 from compare_reports import peer_truths, require_reports, truth_of
 
+from compare.fit.select import CRITERIA_ORDER, OPEN_LOOP, model_changes
+
 #: asked of every candidate counted (they gate the cross-validation)
 PREREQUISITES = ("significant", "material")
-CRITERIA = ("signature", "predicts", "beats_something_else", "distinct", "changes_prediction")
+#: the criteria counted: the rest, restores_plausible_base within changes_prediction
+CRITERIA = tuple(c for c in CRITERIA_ORDER
+                 if c not in (*PREREQUISITES, "restores_plausible_base"))
+
+
+def passes(crit: dict, name: str) -> bool:
+    """Whether a candidate's named criteria ``crit`` pass criterion ``name`` (None, not
+    asked, passes; changes_prediction as compare.fit.select.model_changes)."""
+    return model_changes(crit) if name == "changes_prediction" else crit.get(name) is not False
 
 
 def figure(c: dict, name: str, criteria: dict) -> float | None:
@@ -61,7 +71,6 @@ def margins(folders: list[Path], truth: Callable[[str], object], rnd: int = 1) -
     other criterion, how many of each it passes, and their figures (``truth``: a run's truth
     by its name, as compare_reports.truth_of)."""
     from compare.fit.effects import parse_label
-    from compare.fit.select import model_changes
 
     out = {k: {"true": [], "false": []} for k in CRITERIA}
     for folder in folders:
@@ -77,17 +86,13 @@ def margins(folders: list[Path], truth: Callable[[str], object], rnd: int = 1) -
                     continue
                 side = "true" if parse_label(c["candidate"])[0] in true else "false"
                 for k in CRITERIA:
-                    others = [crit.get(o) for o in CRITERIA if o != k]
                     # open loop: every other criterion passed or not asked (None), and the
                     # open-loop ones asked
-                    if any(v is False for v in others) or any(
-                            crit.get(o) is None for o in ("predicts", "beats_something_else",
-                                                          "distinct") if o != k):
+                    if not all(passes(crit, o) for o in CRITERIA if o != k) or any(
+                            crit.get(o) is None for o in OPEN_LOOP if o != k):
                         continue
-                    passes = (model_changes(crit) if k == "changes_prediction"
-                              else crit.get(k) is not False)
                     out[k][side].append({"run": p.stem, "candidate": c["candidate"],
-                                         "passes": passes,
+                                         "passes": passes(crit, k),
                                          "figure": figure(c, k, table)})
     return out
 

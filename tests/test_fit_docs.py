@@ -318,6 +318,15 @@ def test_each_criterions_margin_counts_the_candidates_only_it_decides(tmp_path):
     rows = {r["criterion"]: r for r in table(margins([tmp_path], truth, 1))}
     assert rows["predicts"]["true_min"] == pytest.approx(0.6)
     assert table(margins([tmp_path], truth, 2))[-1]["false"] == 1
+    # a candidate whose prediction does not move but whose base it spares passes the open
+    # loop's last criterion (select.model_changes), so it counts for the others
+    spared = judged("mount_conduction", changes_prediction=True, predicts=True)
+    spared["criteria"]["restores_plausible_base"] = True
+    (tmp_path / "a.json").write_text(json.dumps({"candidates": [spared], "criteria": crit}),
+                                     "utf-8")
+    rows = {r["criterion"]: r for r in table(margins([tmp_path], truth, 1))}
+    assert rows["predicts"]["true_failing"] == ["a:mount_conduction"]
+    assert (rows["changes_prediction"]["true"], rows["changes_prediction"]["true_pass"]) == (0, 0)
 
 
 def margins_table(doc: dict) -> str:

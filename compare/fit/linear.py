@@ -80,15 +80,19 @@ class Local:
             r = r + extra @ delta[kb:]
         return r
 
+    def _prior_terms(self, delta: np.ndarray) -> np.ndarray:
+        """The priors' residuals after the step ``delta`` (prior_scale / sd times the distance
+        from the prior centre on the fitted scale; 0 where no prior)."""
+        kb = self.J.shape[1]
+        return self.prior_rows * (self.z0 + delta[:kb] - self.prior_z)
+
     def prior_sds(self, delta: np.ndarray) -> np.ndarray:
         """Each base parameter's distance from its prior centre after the step ``delta``, in
         prior standard deviations (0 where it has no prior)."""
-        kb = self.J.shape[1]
-        return self.prior_rows * (self.z0 + delta[:kb] - self.prior_z) / self.cal.prior_scale
+        return self._prior_terms(delta) / self.cal.prior_scale
 
     def penalty(self, delta: np.ndarray) -> float:
-        kb = self.J.shape[1]
-        t = self.prior_rows * (self.z0 + delta[:kb] - self.prior_z)
+        t = self._prior_terms(delta)
         return 0.5 * float(t @ t)
 
     def loglik(self, r: np.ndarray, rows: np.ndarray) -> float:

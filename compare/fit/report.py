@@ -375,9 +375,9 @@ def _pictures(rep, out: Path) -> list[tuple[str, str]]:
 
 def _criteria_html(doc: dict) -> str:
     """Every judged candidate and each named criterion's outcome."""
+    from compare.fit.select import CRITERIA_ORDER as names
+
     rows = []
-    names = ("significant", "material", "signature", "predicts", "beats_something_else",
-             "distinct", "changes_prediction", "restores_plausible_base")
     for c in doc.get("candidates", []):
         crit = c["criteria"]
         rows.append([c["candidate"], c["round"], f"{c['gain']:.1f}", p_text(c["p_value"]),

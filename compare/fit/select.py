@@ -64,6 +64,12 @@ from compare.fit.criteria import Criteria, chi2_threshold
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.linear import Local, effect_held_out, fit_effect, local
 
+#: the open loop's criteria that must all pass (then :func:`model_changes`)
+OPEN_LOOP = ("predicts", "beats_something_else", "distinct")
+#: every named criterion of a candidate, in the order :attr:`Judgement.route` asks them
+CRITERIA_ORDER = ("significant", "material", "signature", *OPEN_LOOP, "changes_prediction",
+                  "restores_plausible_base")
+
 
 def model_changes(criteria: Mapping[str, bool | None]) -> bool:
     """The open loop's last criterion from a candidate's named criteria: the fitted model
@@ -98,8 +104,7 @@ class Judgement:
             return None
         if c["signature"]:
             return "signature"
-        open_loop = ("predicts", "beats_something_else", "distinct")
-        return ("open loop" if all(c.get(k) for k in open_loop) and model_changes(c)
+        return ("open loop" if all(c.get(k) for k in OPEN_LOOP) and model_changes(c)
                 else None)
 
     @property
