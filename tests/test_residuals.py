@@ -1,4 +1,4 @@
-"""Residual diagnostics (compare/fit/residuals.py): whiteness tests on series whose answer is known
+"""Residual diagnostics (compare/residuals.py): whiteness tests on series whose answer is known
 (white noise, AR(1), a sinusoid in noise), Ljung-Box against a hand computation (and statsmodels
 when it is installed), the sign of the cross-correlation lag, NaN handling, the per-channel
 diagnosis and its JSON export, and the plot helpers."""
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from compare.fit.residuals import (
+from compare.residuals import (
     Diagnostics,
     acf,
     acf_band,

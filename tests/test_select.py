@@ -169,7 +169,7 @@ def test_an_unexplained_verdict_says_which_channel_and_which_input():
 
     from compare.fit.calibrate import TOLERANCE
     from compare.fit.report import place_text, residual_place
-    from compare.fit.residuals import diagnose
+    from compare.residuals import diagnose
 
     g = np.arange(0.0, 4 * 3600.0 + 1.0, 60.0)
     speed = np.where((g >= 3000.0) & (g < 6600.0), 4000.0, 0.0)

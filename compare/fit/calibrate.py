@@ -196,7 +196,6 @@ class Calibrator:
     channels: Sequence[str]
     max_nfev: int = 60
     progress: Callable[[str], None] | None = None
-    evaluations: int = field(default=0)
     #: prior centres (the spec's values, compare.fit.discrepancy); the widths are Param.prior_sd
     prior: dict[str, float] | None = None
     #: sqrt(s^2 n / n_eff) of the data term, so that data and prior weigh as a posterior
@@ -336,7 +335,6 @@ class Calibrator:
         J = sol.jac[:n]  # the data rows: the intervals say what this run alone determines
         penalty = 0.5 * float(np.sum(self._prior_terms(params, free, sol.x) ** 2))
         ci, corr, ident = _intervals(J, r_all, n, n_eff, free, params, sol.x)
-        self.evaluations += nfev
         return Fit(tuple(effects), theta, free, ci, corr, ident, self.loglik(res), n, n_eff,
                    out, self.errors(out), time.perf_counter() - t0, nfev, penalty)
 

@@ -307,7 +307,7 @@ def save_report(rep, out: Path, pictures: bool = True) -> list[Path]:
 
 
 def _pictures(rep, out: Path) -> list[tuple[str, str]]:
-    from compare.fit.residuals import plot_acf, plot_cumulated_periodogram
+    from compare.residuals import plot_acf, plot_cumulated_periodogram
     from spindle.outputs import atomic_write
     from spindle.plots import pyplot
 

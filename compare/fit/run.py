@@ -287,7 +287,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     ``cv_blocks`` set the criteria of those names (compare.fit.criteria); ``candidates``:
     the effects to try (default: the library)."""
     from compare.fit.adequacy import base_adequacy, extrapolation_warnings
-    from compare.fit.residuals import diagnose
+    from compare.residuals import diagnose
 
     t0 = time.perf_counter()
     criteria = (criteria or Criteria()).with_options(alpha=alpha, cv_gain=min_gain,
