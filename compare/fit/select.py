@@ -59,14 +59,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from compare.fit.calibrate import Calibrator, Fit, _from_z, _to_z
-from compare.fit.competitor import (
-    Hypothesis,
-    joint_gain,
-    off_base,
-    regressors,
-    scan,
-    scan_threshold,
-)
+from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan, scan_threshold
 from compare.fit.criteria import Criteria, chi2_threshold
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.linear import Local, effect_held_out, fit_effect, local
@@ -381,16 +374,13 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
 
 def verdict_on(loc: Local, reg, criteria: Criteria,
                unknown_inputs: Sequence[tuple[float, float]] = ()) -> Verdict:
-    """The competitor on the final model (linearized as ``loc``) stepped to the whole run,
-    each window fitted jointly with that step (compare.fit.competitor.off_base):
+    """The competitor on the final model (linearized as ``loc``) stepped to the whole run:
     unexplained where it is significant (its scan's largest statistic against the same scan on
-    white noise: compare.fit.competitor.scan_threshold) and material (its net change, the
-    base's give-back included); and, whatever was
+    white noise: compare.fit.competitor.scan_threshold) and material; and, whatever was
     named, where the final model misses a tolerance on held-out data (:func:`held_out_misses`,
     Criteria.held_out_misfit_unexplained)."""
     rows = np.ones(len(loc.r0), dtype=bool)
     r = loc.residual(loc.step(rows))
-    reg = off_base(reg, loc)
     rows = known_inputs(loc, unknown_inputs)
     shrink = loc.fit.n_eff / max(loc.fit.n, 1)
     found, _ = scan(reg, r, loc.channel, rows, shrink, top=1)
