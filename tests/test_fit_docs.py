@@ -102,7 +102,9 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-plausible-base": "fit-trade-plausible-base.json",
           "trade-plausible-base-held-out": "fit-trade-plausible-base-held-out.json",
           "trade-gap-load": "fit-trade-gap-load.json",
-          "trade-gap-load-held-out": "fit-trade-gap-load-held-out.json"}
+          "trade-gap-load-held-out": "fit-trade-gap-load-held-out.json",
+          "trade-joint-verdict": "fit-trade-joint-verdict.json",
+          "trade-joint-verdict-held-out": "fit-trade-joint-verdict-held-out.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
@@ -354,3 +356,36 @@ def test_the_criteria_margins_table_is_its_figures_file():
 
     doc = json.loads((ROOT / "docs" / "figures" / "criteria-margins.json").read_text("utf-8"))
     assert_block("docs/fit.md", "criteria-margins", margins_table(doc))
+
+
+def _sub_rate(summary: str, label: str, family: str) -> tuple[int, int]:
+    """The count and runs of ``family``'s line under the summary line ``label``."""
+    block = summary[summary.index(f"  {label}"):]
+    m = re.search(rf"^    \.\.\. {family}\s+(\d+) of\s+(\d+)", block, re.M)
+    assert m, f"no line '... {family}' under '{label}'"
+    return int(m.group(1)), int(m.group(2))
+
+
+def test_the_joint_verdicts_false_alarms_in_prose_are_its_summaries():
+    """docs/fit.md's paragraph on the joint verdict (measured, not adopted) quotes the false
+    alarms of its summaries against the adopted verdict's, main set and held out."""
+    fig = ROOT / "docs" / "figures"
+    before, after = ((fig / f).read_text(encoding="utf-8") for f in
+                     ("fit-families.txt", "fit-families-joint-verdict.txt"))
+    held_before, held_after = ((fig / f).read_text(encoding="utf-8") for f in
+                               ("fit-families-held-out.txt",
+                                "fit-families-joint-verdict-held-out.txt"))
+    text = " ".join((ROOT / "docs" / "fit.md").read_text(encoding="utf-8").split())
+    alarm = "'unexplained' on clean runs (a false alarm)"
+    beside = "'something else remains' beside a right verdict (a false alarm)"
+    c0, c1 = _sub_rate(before, alarm, "clean"), _sub_rate(after, alarm, "clean")
+    h0, h1 = _sub_rate(held_before, alarm, "clean"), _sub_rate(held_after, alarm, "clean")
+    p0, p1 = _sub_rate(before, alarm, "peers"), _sub_rate(after, alarm, "peers")
+    b0, b1 = _rate(before, beside)[:2], _rate(after, beside)[:2]
+    q0, q1 = _sub_rate(before, beside, "peers"), _sub_rate(after, beside, "peers")
+    expected = (f"\"unexplained\" on clean runs went from {c0[0]} to {c1[0]} of {c1[1]}, from "
+                f"{h0[0]} to {h1[0]} of {h1[1]} held out and from {p0[0]} to {p1[0]} of the "
+                f"peer's {p1[1]} controls, and \"something else remains\" beside a right name "
+                f"from {b0[0]} to {b1[0]} of {b1[1]} (the peer's runs: {q0[0]} to {q1[0]} of "
+                f"{q1[1]};")
+    assert expected in text, expected
