@@ -287,6 +287,26 @@ def test_the_verdicts_scan_has_its_stated_level_on_noise_and_is_sharper_than_bon
     assert scan_threshold(reg, channel, rows, alpha, tail=10) == crit  # seeded: reproducible
 
 
+def test_a_hypothesis_column_is_the_window_the_scan_fitted():
+    """compare.fit.competitor.Regressors.column, which the competitor's joint fits read: the
+    column of a scanned hypothesis is its table's blocks from t0 to t1 summed, so that
+    refitting it by least squares gives the scan's amplitude. (It started a block late:
+    a window [t0, t1) lost its first block, and a one-block window was empty.)"""
+    from compare.fit.competitor import scan
+
+    rng = np.random.default_rng(11)
+    reg, channel = _smooth_block_regressors(rng, 900, 12, 2)
+    r = 2.0 * reg.heat["a"][:, 4:7].sum(axis=1) + rng.standard_normal(900) * 0.3
+    rows = np.ones(900, dtype=bool)
+    found, _ = scan(reg, r, channel, rows, 1.0, top=10 ** 6)
+    for h in found:
+        a, b = int(h.t0_s), int(h.t1_s)  # the blocks are one unit long from 0
+        table = reg.heat[h.where] if h.kind == "heat" else reg.offset[h.where]
+        np.testing.assert_array_equal(reg.column(h), table[:, a:b].sum(axis=1))
+    one = next(h for h in found if h.t1_s - h.t0_s == 1.0 and h.t0_s > 0)
+    assert np.any(reg.column(one) != 0.0)
+
+
 def test_a_named_effect_that_leaves_a_held_out_misfit_says_something_else_remains(setup):
     """Criteria.held_out_misfit_unexplained holds beside a named effect too: fixture_expansion
     data (as above) whose T1 reads 2 K high on the validation window only (a sensor re-seated

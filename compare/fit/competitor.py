@@ -150,7 +150,9 @@ class Regressors:
     offset: dict[str, np.ndarray]
 
     def column(self, h: Hypothesis) -> np.ndarray:
-        a = int(np.searchsorted(self.edges, h.t0_s + 1e-6)) if h.t0_s > self.edges[0] else 0
+        """The hypothesis's column: its table's blocks from the one starting at t0 to the one
+        ending at t1 (the window the scan fitted), summed."""
+        a = int(np.searchsorted(self.edges, h.t0_s - 1e-6))
         b = int(np.searchsorted(self.edges, h.t1_s - 1e-6))
         table = self.heat[h.where] if h.kind == "heat" else self.offset[h.where]
         return table[:, a:b].sum(axis=1)
