@@ -302,37 +302,6 @@ def scan_null_draws(alpha: float, tail: int) -> int:
 BOUNDS = {"heat": (-Q_MAX_W, Q_MAX_W), "offset": (-D_MAX_TOL, D_MAX_TOL)}
 
 
-def off_base(reg: Regressors, loc) -> Regressors:
-    """The hypotheses' columns less what the base parameters' step can take of them:
-    X - J (J^T J + L)^-1 J^T X over every row, J the Jacobian of the linearized model ``loc``
-    (compare.fit.linear.Local) and L its priors' rows squared. A window fitted by least
-    squares to the residual of the base step (bounds aside) is then fitted jointly with the
-    base parameters: a base that took part of an event up when it was stepped gives that
-    part back, as the effects' joint fits (compare.fit.linear.fit_effect) do, and a window
-    the base can imitate whole is worth nothing. The tables are those the scan and its
-    threshold (:func:`scan_threshold`) both read, so the null knows the projection too."""
-    J = loc.J
-    normal = J.T @ J + np.diag(loc.prior_rows ** 2)
-
-    def rest(X: np.ndarray) -> np.ndarray:
-        return X - J @ np.linalg.solve(normal, J.T @ X)
-
-    return Regressors(reg.edges, {k: rest(X) for k, X in reg.heat.items()},
-                      {k: rest(X) for k, X in reg.offset.items()})
-
-
-def left_by(reg: Regressors, h: Hypothesis, r: np.ndarray, channel: np.ndarray,
-            rows: np.ndarray) -> Hypothesis:
-    """``h`` refitted alone, its column as ``reg`` has it, to the residual ``r`` over ``rows``
-    (weighted per channel as :func:`scan` weighs): its amplitude and its peak over those rows
-    [tolerances], the part of it the model that left ``r`` misses."""
-    col = reg.column(h)[:, None]
-    zero = np.zeros(1, dtype=int)
-    _, beta = _window_fits(col, r[:, None], channel, rows, np.unique(channel[rows]), zero, zero)
-    b = float(beta[0, 0])
-    return replace(h, amplitude=b, peak=float(np.max(np.abs(b * col[rows]), initial=0.0)))
-
-
 def joint_gain(loc, reg: Regressors, hypotheses: list[Hypothesis]) -> float:
     """The best log-posterior gain of ``hypotheses``, each fitted jointly with the base
     parameters by one step of the linearized model ``loc`` (compare.fit.linear.Local) over

@@ -54,20 +54,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from compare.fit.calibrate import Calibrator, Fit, _from_z, _to_z
-from compare.fit.competitor import (
-    Hypothesis,
-    joint_gain,
-    left_by,
-    off_base,
-    regressors,
-    scan,
-    scan_threshold,
-)
+from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan, scan_threshold
 from compare.fit.criteria import Criteria, chi2_threshold
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.linear import Local, effect_held_out, fit_effect, local
@@ -145,9 +137,8 @@ class Step:
 @dataclass
 class Verdict:
     """What the run says beyond the named effects: the competitor on the final model (its
-    best hypothesis: the amplitude fitted jointly with the base's step, the peak what the
-    final model misses of it; the likelihood-ratio statistic, the threshold it had to pass)
-    and whether that makes the run ``unexplained``."""
+    best hypothesis, the likelihood-ratio statistic, the threshold it had to pass) and
+    whether that makes the run ``unexplained``."""
 
     hypothesis: Hypothesis | None
     lr: float
@@ -384,25 +375,19 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
 def verdict_on(loc: Local, reg, criteria: Criteria,
                unknown_inputs: Sequence[tuple[float, float]] = ()) -> Verdict:
     """The competitor on the final model (linearized as ``loc``) stepped to the whole run:
-    unexplained where its best window, fitted jointly with that step
-    (compare.fit.competitor.off_base), is significant (its scan's largest statistic against
-    the same scan on white noise: compare.fit.competitor.scan_threshold) and material on the
-    final model's own residual (compare.fit.competitor.left_by: what the calibrated model
-    misses of it, which a compensation built on the model would miss); and, whatever was
+    unexplained where it is significant (its scan's largest statistic against the same scan on
+    white noise: compare.fit.competitor.scan_threshold) and material; and, whatever was
     named, where the final model misses a tolerance on held-out data (:func:`held_out_misses`,
     Criteria.held_out_misfit_unexplained)."""
     rows = np.ones(len(loc.r0), dtype=bool)
     r = loc.residual(loc.step(rows))
-    joint = off_base(reg, loc)
     rows = known_inputs(loc, unknown_inputs)
     shrink = loc.fit.n_eff / max(loc.fit.n, 1)
-    found, _ = scan(joint, r, loc.channel, rows, shrink, top=1)
+    found, _ = scan(reg, r, loc.channel, rows, shrink, top=1)
     h = found[0] if found else None
     lr = 2.0 * h.gain if h is not None else 0.0
-    threshold = (scan_threshold(joint, loc.channel, rows, criteria.alpha,
-                                criteria.scan_null_tail) if h is not None else math.inf)
-    if h is not None:
-        h = replace(h, peak=left_by(reg, h, r, loc.channel, rows).peak)
+    threshold = (scan_threshold(reg, loc.channel, rows, criteria.alpha, criteria.scan_null_tail)
+                 if h is not None else math.inf)
     if h is not None and lr > threshold and h.peak >= criteria.material_peak:
         return Verdict(h, lr, threshold, True)
     misses = held_out_misses(loc.fit.errors) if criteria.held_out_misfit_unexplained else {}
