@@ -151,3 +151,16 @@ def test_a_load_change_at_constant_speed_inside_a_gap_counts():
     np.testing.assert_allclose(placed.power_kW[inside],
                                np.where(grid[:-1][inside] < 3600.0, 11.2, 12.7), rtol=1e-12)
     assert g.text() == "the load changed from 19.0 to 22.0 N m at 4900 rpm"
+
+
+def test_a_load_change_is_worded_as_one_when_the_speed_scatters_within_the_drives_band():
+    """GapSwitch.text judges the speed as gaps_with_change does: 5000 -> 5001 rpm is the
+    drive's scatter (within max(20 rpm, 1 %)), so a gap found by its load says the load
+    changed (the peer's dev2-04 said "the speed changed from 5000 to 5001 rpm"); a speed
+    beyond the band is a speed change, whatever the load did."""
+    from compare.fit.gaps import GapSwitch
+
+    scatter = GapSwitch(0.0, 600.0, 5000.0, 5001.0, 300.0, 20.0, 30.0)
+    assert scatter.text() == "the load changed from 20.0 to 30.0 N m at 5001 rpm"
+    moved = GapSwitch(0.0, 600.0, 5000.0, 3000.0, 300.0, 20.0, 30.0)
+    assert moved.text() == "the speed changed from 5000 to 3000 rpm"

@@ -45,13 +45,22 @@ class GapSwitch:
     torque_after_Nm: float = float("nan")
 
     def text(self) -> str:
-        """The change in words: the speed's, or else the load's."""
-        if abs(self.speed_after_rpm - self.speed_before_rpm) > 0 or not np.isfinite(
+        """The change in words: the speed's (beyond the drive's scatter band, as
+        :func:`gaps_with_change` judges it), or else the load's."""
+        if speed_changed(self.speed_before_rpm, self.speed_after_rpm) or not np.isfinite(
                 self.torque_before_Nm + self.torque_after_Nm):
             return (f"the speed changed from {self.speed_before_rpm:.0f} to "
                     f"{self.speed_after_rpm:.0f} rpm")
         return (f"the load changed from {self.torque_before_Nm:.1f} to "
                 f"{self.torque_after_Nm:.1f} N m at {self.speed_after_rpm:.0f} rpm")
+
+
+def speed_changed(before_rpm: float, after_rpm: float, band_rpm: float = SPEED_BAND_RPM,
+                  band_rel: float = SPEED_BAND_REL) -> bool:
+    """Whether two logged speeds [rpm] differ beyond the drive's scatter band,
+    max(``band_rpm``, ``band_rel`` x speed)."""
+    return abs(after_rpm - before_rpm) > max(band_rpm,
+                                             band_rel * max(abs(before_rpm), abs(after_rpm)))
 
 
 def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.ndarray,
@@ -78,21 +87,21 @@ def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.
         if k < 0 or j >= len(t_speed_s):
             continue
         a, b = float(speed_rpm[k]), float(speed_rpm[j])
-        moved = abs(b - a) > max(band_rpm, band_rel * max(abs(a), abs(b)))
+        moved = speed_changed(a, b, band_rpm, band_rel)
         if not moved and torque is not None:
-            m0, m1 = torque_levels(torque, start, end, criteria)
+            m0, m1 = levels_around(torque, start, end, criteria)
             moved = bool(abs(m1 - m0) > criteria.no_load_Nm)  # False where either is nan
         if moved:
             out.append((start, end, a, b))
     return out
 
 
-def torque_levels(torque: tuple[np.ndarray, np.ndarray], start_s: float, end_s: float,
+def levels_around(samples: tuple[np.ndarray, np.ndarray], start_s: float, end_s: float,
                   criteria: Criteria = _DEFAULT) -> tuple[float, float]:
-    """The load torque's mean [N m] over ``criteria.gap_level_s`` before a gap and after it
-    (nan where no sample lies there)."""
-    return (_level(*torque, start_s - criteria.gap_level_s, start_s),
-            _level(*torque, end_s, end_s + criteria.gap_level_s))
+    """A logged signal's mean (``samples``: its valid samples' times [s] and values) over
+    ``criteria.gap_level_s`` before a gap and after it (nan where no sample lies there)."""
+    return (_level(*samples, start_s - criteria.gap_level_s, start_s),
+            _level(*samples, end_s, end_s + criteria.gap_level_s))
 
 
 def _level(t_s: np.ndarray, y: np.ndarray, t0: float, t1: float) -> float:
@@ -118,9 +127,8 @@ def place_switches(inputs: Inputs, t_rows_s: np.ndarray, t_speed_s: np.ndarray,
         inside = np.where((grid[1:] > start) & (grid[:-1] < end))[0]
         if len(inside) == 0:
             continue
-        p_before = _level(t_power_s, power_kW, start - criteria.gap_level_s, start)
-        p_after = _level(t_power_s, power_kW, end, end + criteria.gap_level_s)
-        m_before, m_after = (torque_levels(torque, start, end, criteria) if torque is not None
+        p_before, p_after = levels_around((t_power_s, power_kW), start, end, criteria)
+        m_before, m_after = (levels_around(torque, start, end, criteria) if torque is not None
                              else (float("nan"), float("nan")))
         best = None
         for s in range(int(inside[0]), int(inside[-1]) + 2):
