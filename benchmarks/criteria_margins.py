@@ -36,8 +36,9 @@ from compare.fit.select import CRITERIA_ORDER, OPEN_LOOP, model_changes
 #: asked of every candidate counted (they gate the cross-validation)
 PREREQUISITES = ("significant", "material")
 #: the criteria counted: the rest, restores_plausible_base within changes_prediction
+#: (final_model_adequate is asked after the selection, of the names only)
 CRITERIA = tuple(c for c in CRITERIA_ORDER
-                 if c not in (*PREREQUISITES, "restores_plausible_base"))
+                 if c not in (*PREREQUISITES, "restores_plausible_base", "final_model_adequate"))
 
 
 def passes(crit: dict, name: str) -> bool:

@@ -6,7 +6,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from compare.fit.gaps import gaps_with_change, place_switches
+from compare.fit.criteria import Criteria
+from compare.fit.gaps import gaps_with_change, place_switches, unknown_input_spans
 from compare.fit.greybox import GreyBox, inputs_from_cycle
 from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES
@@ -22,6 +23,19 @@ def test_only_gaps_with_a_change_beyond_the_drive_scatter_count():
     # a change between rows closer than two grid steps is a logged change, not a gap
     assert gaps_with_change(np.array([0.0, 100.0]), np.array([0.0, 100.0]),
                             np.array([1000.0, 3000.0]), grid) == []
+
+
+def test_every_logging_gap_leaves_its_inputs_unknown_until_the_hour_after_it():
+    """Something else is not looked for in a gap and for Criteria.gap_judge_s after it,
+    whether or not the operating point changed across it (the room and the coolant inside it
+    are interpolated too); rows closer than two grid steps are no gap."""
+    grid = np.arange(0.0, 9000.0, 60.0)
+    rows = np.concatenate([np.arange(0.0, 1000.0, 10.0), np.arange(2200.0, 9000.0, 10.0)])
+    n = np.full(len(rows), 2000.0)  # the same speed either side: no operating change
+    assert gaps_with_change(rows, rows, n, grid) == []
+    judge = Criteria().gap_judge_s
+    assert unknown_input_spans(rows, grid) == [(990.0, 2200.0 + judge)]
+    assert unknown_input_spans(np.arange(0.0, 9000.0, 100.0), grid) == []
 
 
 def test_a_speed_logged_on_change_has_no_gap():

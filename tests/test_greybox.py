@@ -9,9 +9,11 @@ import pytest
 
 from compare.cli import main
 from compare.fit.calibrate import Calibrator, Measured, resample
+from compare.fit.criteria import Criteria
 from compare.fit.effects import LIBRARY, label
 from compare.fit.greybox import GreyBox, inputs_from_cycle
 from lumped import build
+from spindle.bench import read_bench
 from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES, cycle_load_case
 from spindle.spec_reader import load_spec
@@ -198,6 +200,11 @@ def test_synth_then_fit_end_to_end(tmp_path, capsys):
     assert set(rep) >= {"effects", "unexplained", "error_before", "error_after", "parameters",
                         "base_adequacy", "warnings"}
     assert isinstance(rep["warnings"], list)
+    # synth's 20 min logging gap, nothing changed across it: something else is not looked
+    # for from its start to Criteria.gap_judge_s after its end (the inputs are interpolated)
+    t = read_bench(run).time_s
+    i = int(np.argmax(np.diff(t)))
+    assert rep["windows"]["inputs_unknown"] == [[t[i], t[i + 1] + Criteria().gap_judge_s]]
     ad = rep["base_adequacy"]
     assert isinstance(ad["adequate"], bool) and set(ad["channels"]) == set(rep["channels"])
     # the spec's own spindle has no cooled bearing seats: the default extra stays near 0

@@ -69,6 +69,15 @@ class Criteria:
         "inadequate' said the same and pointed at the spec alone; the report still gives the "
         "adequacy verdict on the spec. False: such runs end 'nothing named, base inadequate' "
         "or name their effects alone")
+    open_loop_adequate_model: bool = _c(
+        True, "-", "an effect named by the open loop is withdrawn where the final model, with "
+        "it, still misses the tolerance of one of the effect's own channels on the held-out "
+        "validation window (as for held_out_misfit_unexplained): the open loop's evidence is "
+        "the model's likelihood, and the likelihood-ratio test holds only under a model that "
+        "explains the data; where it does not, any candidate that moves the channel gains "
+        "from what is missing, so the cause is a guess. A misfit on a channel the effect does "
+        "not act on leaves its test as it was. A step judged on a model holding a withdrawn "
+        "one goes with it; a signature's evidence is the raw samples' and stays")
     competitor_step_s: float = _c(
         1800.0, "s", "the time grid of the competitor's windows: half an hour resolves an "
         "event of a few hours, and a 16 h run gives 32 blocks, 528 windows")
@@ -112,7 +121,10 @@ class Criteria:
         3600.0, "s", "an operating change inside a logging gap is placed where the model fits "
         "the hour after the gap best: long against the rings' settling, short against the run. "
         "Until that hour is over the inputs are not known (what ran inside the gap is a "
-        "guess), so something else is not looked for in the gap nor in that hour")
+        "guess), so something else is not looked for in the gap nor in that hour. That holds "
+        "for every gap, not only one with an operating change: the room's and the coolant's "
+        "temperatures inside it are interpolated, and a chiller's on-off cycle (tenths of a "
+        "kelvin to a kelvin, in minutes to tens of minutes) is shorter than a gap")
     gap_level_s: float = _c(
         300.0, "s", "the speed, power and load levels either side of a gap are read over five "
         "minutes of samples")

@@ -14,6 +14,10 @@ the measured channels best over the hour after the gap (sum of squares in tolera
 is taken. The fast channels (the stator, the rings) pin it to about a grid step. This runs
 before the FEM anchor is solved, so the anchor and the fit see the same inputs. Units: s, rpm,
 kW.
+
+Every gap, with a change inside or not, leaves its inputs unknown until the response to them
+has settled (:func:`unknown_input_spans`): the room and the coolant inside it are
+interpolated, and a chiller cycles within a gap's length.
 """
 
 from __future__ import annotations
@@ -78,10 +82,8 @@ def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.
     speed samples); the torque's levels are its means over ``criteria.gap_level_s`` either
     side. A speed logged only on change (empty cells between changes, rows going on) has no
     gap: its change is at the sample that logs it."""
-    step = float(np.median(np.diff(grid_s)))
     out = []
-    for i in np.where(np.diff(t_rows_s) > criteria.gap_min_steps * step)[0]:
-        start, end = float(t_rows_s[i]), float(t_rows_s[i + 1])
+    for start, end in logging_gaps(t_rows_s, grid_s, criteria):
         k = int(np.searchsorted(t_speed_s, start, side="right")) - 1
         j = int(np.searchsorted(t_speed_s, end, side="left"))
         if k < 0 or j >= len(t_speed_s):
@@ -94,6 +96,25 @@ def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.
         if moved:
             out.append((start, end, a, b))
     return out
+
+
+def logging_gaps(t_rows_s: np.ndarray, grid_s: np.ndarray, criteria: Criteria = _DEFAULT
+                 ) -> list[tuple[float, float]]:
+    """(start, end) [s] of each stretch without any row (``t_rows_s``, every row's time)
+    longer than ``criteria.gap_min_steps`` steps of the grid ``grid_s`` [s]."""
+    step = float(np.median(np.diff(grid_s)))
+    t = np.asarray(t_rows_s, dtype=float)
+    return [(float(t[i]), float(t[i + 1]))
+            for i in np.where(np.diff(t) > criteria.gap_min_steps * step)[0]]
+
+
+def unknown_input_spans(t_rows_s: np.ndarray, grid_s: np.ndarray,
+                        criteria: Criteria = _DEFAULT) -> list[tuple[float, float]]:
+    """The spans [start, end) [s] whose inputs are not known: every logging gap
+    (:func:`logging_gaps`) and the ``criteria.gap_judge_s`` after it. Inside a gap the drive,
+    the room and the coolant are interpolated; the response to what they really did there is
+    a guess until it has settled, with an operating change inside or not."""
+    return [(a, b + criteria.gap_judge_s) for a, b in logging_gaps(t_rows_s, grid_s, criteria)]
 
 
 def levels_around(samples: tuple[np.ndarray, np.ndarray], start_s: float, end_s: float,

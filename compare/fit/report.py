@@ -149,6 +149,13 @@ def verdict_lines(doc: dict) -> list[str]:
         lines.append("Nothing named, base inadequate: the calibrated base model misses the "
                      "tolerances, and neither an effect of the library nor something at one "
                      "time of the run explains the misfit; look at the spec (below).")
+    gone = [c["candidate"] for c in doc.get("candidates", [])
+            if c["criteria"].get("final_model_adequate") is False]
+    if gone:
+        lines.append(f"Fitted and withdrawn: {', '.join(gone)}. The model with "
+                     f"{'it' if len(gone) == 1 else 'them'} still misses the tolerances on "
+                     "held-out data, so the open loop's likelihood ratio does not tell the "
+                     "cause.")
     lines.append(f"Validation error before -> after: {_change_text(doc)}.")
     return lines
 
@@ -220,7 +227,8 @@ def report_dict(rep) -> dict:
         "windows": {"blocks": rep.measured.blocks,
                     "fit": [[a, b] for a, b, w in rep.measured.spans() if w == "fit"],
                     "validation": [[a, b] for a, b, w in rep.measured.spans()
-                                   if w == "validation"]},
+                                   if w == "validation"],
+                    "inputs_unknown": [[a, b] for a, b in rep.unknown_inputs]},
         "cross_validation": rep.cross_validation,
         "tolerances": {"temperature_K": TOLERANCE["T1"],
                        "growth_um": TOLERANCE["P1"] * edge_scale("P1")},
@@ -331,6 +339,8 @@ def _pictures(rep, out: Path) -> list[tuple[str, str]]:
             for a, b, w in rep.measured.spans():
                 if w == "validation":
                     ax.axvspan(a / 3600, b / 3600, color="tab:orange", alpha=0.08, lw=0)
+            for a, b in rep.unknown_inputs:
+                ax.axvspan(a / 3600, b / 3600, color="0.4", alpha=0.12, lw=0)
             ax.set_ylabel(f"{c} [{unit}]")
             ax.set_title(f"{c} {label}" + (f" (with {', '.join(fit.effects)})" if fit.effects
                                             else " (base model)"), fontsize=9)
@@ -338,7 +348,8 @@ def _pictures(rep, out: Path) -> list[tuple[str, str]]:
             if i == 0:
                 ax.legend(fontsize=7)
     for ax in axes[-1]:
-        ax.set_xlabel("time [h] (shaded: validation window)")
+        ax.set_xlabel("time [h] (orange: validation window; grey: a logging gap and the "
+                      "hour after it, inputs unknown)")
     atomic_write(out / "fit_channels.png", lambda tmp: fig.savefig(tmp, dpi=110))
     plt.close(fig)
     made.append(("fit_channels.png", "measured against the model, before and after, with the "

@@ -26,6 +26,7 @@ from compare.fit.calibrate import TOLERANCE, Calibrator, Fit, Measured, resample
 from compare.fit.criteria import Criteria
 from compare.fit.effects import LIBRARY
 from compare.fit.effects import candidates as candidate_labels
+from compare.fit.gaps import unknown_input_spans
 from compare.fit.greybox import GreyBox, Inputs
 from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, default_theta
 from compare.fit.select import Selection, select
@@ -259,6 +260,9 @@ class FitReport:
     cross_validation: dict = field(default_factory=dict)
     #: compare.fit.gaps.GapSwitch per logging gap with an operating change inside
     gap_switches: list = field(default_factory=list)
+    #: spans (start, end) [s] whose inputs are not known, where something else is not looked
+    #: for (compare.fit.gaps.unknown_input_spans)
+    unknown_inputs: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         from compare.fit.report import report_dict
@@ -303,9 +307,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     cal, base = prep.cal, prep.base
     say("reading the effects' signatures in the raw samples")
     sig = signature_tests(run, cal.gb, base.theta, channels, criteria)
-    # a logging gap with an operating change: its inputs are not known until the response
-    # to them has settled (Criteria.gap_judge_s, the hour the switch is placed on)
-    unknown = [(g.start_s, g.end_s + criteria.gap_judge_s) for g in prep.gap_switches]
+    unknown = unknown_input_spans(run.time_s, inputs.grid_s, criteria)
     sel = select(cal, base, candidate_labels(channels, candidates), criteria, sig, say,
                  unknown_inputs=unknown)
     final = sel.final
@@ -343,7 +345,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
               "final": local(cal, final).cross_validation_report(criteria.cv_blocks)}
     return FitReport(run, spec, channels, measured, inputs, sel, sig, diag_b, diag_a,
                      time.perf_counter() - t0, criteria, prep.anchor, cal.floor,
-                     cal.prior_z(final) or None, adequacy, warns, cv, prep.gap_switches)
+                     cal.prior_z(final) or None, adequacy, warns, cv, prep.gap_switches,
+                     unknown)
 
 
 def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fraction: float,

@@ -47,7 +47,10 @@ window misses the validation window by its extrapolation, which a window there w
 and the competitor scanned on it: where it is significant (its largest likelihood-ratio
 statistic above the level-``alpha`` critical value of the same scan on white noise, a Monte
 Carlo test) and material, the verdict says
-``unexplained`` and where.
+``unexplained`` and where. Before that, an effect named by the open loop is withdrawn where
+the final model still misses one of its channels' tolerances on held-out data
+(:func:`withdraw_unsupported`, ``Criteria.open_loop_adequate_model``): a likelihood-ratio
+test holds only under a model that explains the data.
 """
 
 from __future__ import annotations
@@ -68,7 +71,7 @@ from compare.fit.linear import Local, effect_held_out, fit_effect, local
 OPEN_LOOP = ("predicts", "beats_something_else", "distinct")
 #: every named criterion of a candidate, in the order :attr:`Judgement.route` asks them
 CRITERIA_ORDER = ("significant", "material", "signature", *OPEN_LOOP, "changes_prediction",
-                  "restores_plausible_base")
+                  "restores_plausible_base", "final_model_adequate")
 
 
 def model_changes(criteria: Mapping[str, bool | None]) -> bool:
@@ -98,6 +101,8 @@ class Judgement:
     @property
     def route(self) -> str | None:
         c = self.criteria
+        if c.get("final_model_adequate") is False:  # withdrawn after the selection
+            return None
         if not c["material"] or c["signature"] is False:
             return None
         if not c["significant"]:
@@ -224,7 +229,7 @@ def signature_outcome(signature, alpha: float) -> bool | None:
 
 def known_inputs(loc: Local, unknown_s: Sequence[tuple[float, float]]) -> np.ndarray:
     """The residual rows of ``loc`` outside the spans [t0, t1) [s] whose inputs are not known
-    (a logging gap with an operating change inside, and the settling after it)."""
+    (a logging gap and the settling after it: compare.fit.gaps.unknown_input_spans)."""
     t = loc.cal.measured.grid_s[loc.point]
     out = np.ones(len(t), dtype=bool)
     for a, b in unknown_s:
@@ -238,9 +243,9 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
            unknown_inputs: Sequence[tuple[float, float]] = ()) -> Selection:
     """Forward selection of ``candidates`` (labels) from the calibrated ``base`` (module
     docstring); ``signatures``: the run's signature tests by label. ``unknown_inputs``: spans
-    [t0, t1) [s] where the run's inputs are not known (a logging gap with an operating change
-    inside and the settling after it): something else is not looked for there, since the
-    model's misfit there says nothing but that the inputs are not known."""
+    [t0, t1) [s] where the run's inputs are not known (a logging gap and the settling after
+    it): something else is not looked for there, since the model's misfit there says nothing
+    but that the inputs are not known."""
     say = progress or (lambda _m: None)
     sig = dict(signatures or {})
     current = base
@@ -300,9 +305,30 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         steps.append(Step(best, current))
         current = best.fit
         loc = local(cal, current)
+    kept = withdraw_unsupported(steps, current, criteria)
+    if kept is not current:
+        current, loc = kept, local(cal, kept)
     say("fitting something else on the final model")
     return Selection(base, steps, judged, verdict_on(loc, reg, criteria,
                                                      unknown_inputs=unknown_inputs))
+
+
+def withdraw_unsupported(steps: list[Step], final: Fit, criteria: Criteria) -> Fit:
+    """Criteria.open_loop_adequate_model: where the ``final`` model misses the tolerance of
+    one of an open-loop step's own channels on held-out data, the first such step and every
+    step after it are withdrawn (``steps`` is cut; their judgements' ``final_model_adequate``
+    set False). A misfit on a channel the effect does not act on leaves its likelihood ratio
+    as it was. Returns the model that remains."""
+    misses = held_out_misses(final.errors) if criteria.open_loop_adequate_model else {}
+    first = next((i for i, s in enumerate(steps) if s.judgement.route == "open loop"
+                  and set(_own(s.label)) & set(misses)), None)
+    if first is None:
+        return final
+    kept = steps[first].before
+    for s in steps[first:]:
+        s.judgement.criteria["final_model_adequate"] = False
+    del steps[first:]
+    return kept
 
 
 @dataclass(frozen=True)
@@ -357,6 +383,7 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
                                     if criteria.plausible_base_route else None),
         "beats_something_else": bool(penalised >= competitor),
         "distinct": bool(penalised >= rival + margin),
+        "final_model_adequate": None,  # asked of the open loop's names after the selection
     }
     figures: dict[str, float | None] = {
         "values": ef.values, "penalised_gain": penalised,
