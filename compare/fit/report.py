@@ -348,8 +348,9 @@ def _pictures(rep, out: Path) -> list[tuple[str, str]]:
             if i == 0:
                 ax.legend(fontsize=7)
     for ax in axes[-1]:
-        ax.set_xlabel("time [h] (orange: validation window; grey: a logging gap and the "
-                      "hour after it, inputs unknown)")
+        ax.set_xlabel("time [h]")
+    fig.supxlabel("orange: validation window; grey: a logging gap and the hour after it "
+                  "(inputs unknown, something else not looked for)", fontsize=9)
     atomic_write(out / "fit_channels.png", lambda tmp: fig.savefig(tmp, dpi=110))
     plt.close(fig)
     made.append(("fit_channels.png", "measured against the model, before and after, with the "
