@@ -109,7 +109,10 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-every-gap-held-out": "fit-trade-every-gap-held-out.json",
           "trade-every-gap-fresh": "fit-trade-every-gap-fresh.json",
           "trade-withdraw": "fit-trade-withdraw.json",
-          "trade-withdraw-held-out": "fit-trade-withdraw-held-out.json"}
+          "trade-withdraw-held-out": "fit-trade-withdraw-held-out.json",
+          "trade-complements": "fit-trade-complements.json",
+          "trade-complements-held-out": "fit-trade-complements-held-out.json",
+          "trade-complements-fresh": "fit-trade-complements-fresh.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))

@@ -477,3 +477,30 @@ def test_the_verdict_says_which_fitted_effect_was_withdrawn_and_why():
     assert lines[1].startswith("Fitted and withdrawn: bearing_preload. The model with it "
                                "still misses the tolerances on held-out data")
     assert not any("withdrawn" in line for line in verdict_lines(doc(None)))
+
+
+def test_two_effects_that_each_add_to_the_other_are_complements_not_rivals(setup):
+    """The distinct criterion weighs a candidate against alternatives only
+    (Criteria.distinct_among_alternatives). Grey-box data with a mount (3 W/K) and a fixture
+    (1.5 µm/K) both present: each, fitted alone on the base, adds a significant gain to the
+    other's, so they are complements. Data with the fixture alone: the mount, fitted on the
+    same base, adds nothing significant once the fixture is in, so it stays the fixture's
+    rival. The level is the criteria's alpha (1 %), as in the rule."""
+    from compare.fit.linear import fit_effect, local
+    from compare.fit.select import complements
+
+    spec, inp = setup
+    n = len(inp.grid_s)
+    both = GreyBox(spec, DRIVES["spl2782"], inp, effects=("mount_conduction", "fixture_expansion"))
+    alone = GreyBox(spec, DRIVES["spl2782"], inp, effects=("fixture_expansion",))
+    runs = {"both": _noisy(both.simulate({"G_mount_W_K": 3.0, "k_fix_um_K": 1.5, "f0": 0.4}),
+                           n, 11),
+            "fixture alone": _noisy(alone.simulate({"k_fix_um_K": 1.5, "f0": 0.4}), n, 11)}
+    found = {}
+    for name, vals in runs.items():
+        cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals),
+                         CHANNELS)
+        loc = local(cal, cal.fit())
+        mount, fixture = fit_effect(loc, "mount_conduction"), fit_effect(loc, "fixture_expansion")
+        found[name] = complements(loc, mount, fixture, Criteria().alpha)
+    assert found == {"both": True, "fixture alone": False}

@@ -14,6 +14,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from compare.fit.calibrate import over_tolerance
+
 #: conductances the spec does not have (base extras whose spec value is 0): the run is said
 #: to need one above Criteria.missing_path_W_K
 MISSING_PATHS = ("G_seat_W_K",)
@@ -86,8 +88,7 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
             if not e.get("n"):
                 continue
             channels.setdefault(c, {})[window] = float(e["rmse_w"])
-            if e["rmse_w"] > 1.0:
-                bad.append((c, window, float(e["rmse_w"])))
+        bad += [(c, window, r) for c, r in over_tolerance(errors.get(window, {})).items()]
     z = dict(prior_z or {})
     moved = [{"name": k, "spec": float(spec_values[k]), "calibrated": float(theta[k]),
               "z": float(z[k]) if k in z else None}

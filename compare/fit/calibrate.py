@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -337,6 +337,15 @@ class Calibrator:
         ci, corr, ident = _intervals(J, r_all, n, n_eff, free, params, sol.x)
         return Fit(tuple(effects), theta, free, ci, corr, ident, self.loglik(res), n, n_eff,
                    out, self.errors(out), time.perf_counter() - t0, nfev, penalty)
+
+
+def over_tolerance(window_errors: Mapping[str, Mapping[str, float]]) -> dict[str, float]:
+    """The channels of one window of :meth:`Calibrator.errors` whose RMS exceeds one
+    tolerance, with that RMS in tolerances (channels without samples are left out). The one
+    test of 'misses its tolerance' that the adequacy verdict, the held-out rules of the
+    selection and the report's verdict read."""
+    return {c: float(e["rmse_w"]) for c, e in window_errors.items()
+            if e.get("n") and e["rmse_w"] > 1.0}
 
 
 def effective_samples(res: dict[str, np.ndarray]) -> float:

@@ -69,6 +69,14 @@ class Criteria:
         "inadequate' said the same and pointed at the spec alone; the report still gives the "
         "adequacy verdict on the spec. False: such runs end 'nothing named, base inadequate' "
         "or name their effects alone")
+    distinct_among_alternatives: bool = _c(
+        True, "-", "the distinct criterion weighs a candidate against the other candidates "
+        "on its channels that are alternatives to it, not against complements: two candidates "
+        "each of which, as the amplitude of its fitted shift, adds a significant gain (at "
+        "alpha, one degree of freedom) to the other's (jointly with the base's step) explain "
+        "different parts of the run, so naming the larger is no guess between them; forward "
+        "selection then judges the other against the model that holds it. False: every other "
+        "candidate on a shared channel is a rival")
     open_loop_adequate_model: bool = _c(
         True, "-", "an effect named by the open loop is withdrawn where the final model, with "
         "it, still misses the tolerance of one of the effect's own channels on the held-out "

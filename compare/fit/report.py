@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.fit.calibrate import TOLERANCE, Fit, at_bound, parameters_table
+from compare.fit.calibrate import TOLERANCE, Fit, at_bound, over_tolerance, parameters_table
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.params import BASE_PARAMS, base_params, default_theta
 from compare.report import html_figure, html_page, html_table
@@ -90,9 +90,8 @@ def verdict_kind(rep) -> str:
         return "named"
     if sel.verdict is not None and sel.verdict.unexplained:
         return "unexplained"
-    val = sel.final.errors["validation"]
-    ok = all(e["rmse_w"] <= 1.0 for e in val.values() if e.get("n"))
-    return "base adequate" if ok else "base inadequate"
+    return ("base inadequate" if over_tolerance(sel.final.errors["validation"])
+            else "base adequate")
 
 
 def _change_text(doc: dict) -> str:

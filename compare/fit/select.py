@@ -37,7 +37,10 @@ and then show that it is *this* effect, by one of two routes:
     none;
   - ``distinct``: its penalised gain exceeds that of every other candidate acting on one of
     its channels by half the chi-square quantile of one degree of freedom at ``alpha``
-    (3.3 at 1 %): two effects that explain the run alike are a guess, not a finding;
+    (3.3 at 1 %): two effects that explain the run alike are a guess, not a finding. A
+    candidate that adds a significant gain to this one, and this one to it, is a complement,
+    not an alternative, and is no rival (:func:`complements`,
+    ``Criteria.distinct_among_alternatives``);
 
 A qualifying candidate joins the model if it adds the most likelihood among those that
 qualify, and the next round judges the rest against the model that holds it (a second effect
@@ -61,7 +64,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from compare.fit.calibrate import Calibrator, Fit, _from_z, _to_z
+from compare.fit.calibrate import Calibrator, Fit, _from_z, _to_z, over_tolerance
 from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan, scan_threshold
 from compare.fit.criteria import Criteria, chi2_threshold
 from compare.fit.effects import effect_of, parse_label
@@ -96,7 +99,7 @@ class Judgement:
     p_value: float
     peak: float
     criteria: dict[str, bool | None]
-    figures: dict[str, float | None] = field(default_factory=dict)
+    figures: dict[str, object] = field(default_factory=dict)
 
     @property
     def route(self) -> str | None:
@@ -283,13 +286,19 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
                      for lab, f in fits.items()}
         cv_now = loc.cross_validate(criteria.cv_blocks) if criteria.cv_blocks else None
         round_judged = []
+        margin = 0.5 * chi2_threshold(criteria.alpha, 1)
         for lab, ef in fits.items():
-            rivals = [v for other, v in penalised.items() if other != lab
-                      and parse_label(other)[0] != parse_label(lab)[0]
-                      and set(_own(other)) & set(_own(lab))]
+            near = {other: v for other, v in penalised.items() if other != lab
+                    and parse_label(other)[0] != parse_label(lab)[0]
+                    and set(_own(other)) & set(_own(lab))}
+            # only a rival that could make it fail is asked whether it is a complement
+            comp = [other for other, v in near.items() if criteria.distinct_among_alternatives
+                    and v + margin > penalised[lab]
+                    and complements(loc, ef, fits[other], criteria.alpha)]
+            rival = max((v for other, v in near.items() if other not in comp),
+                        default=-math.inf)
             round_judged.append(judge(loc, ef, sig.get(lab), criteria, penalised[lab],
-                                      g_gain - 3 * pen, max(rivals, default=-math.inf),
-                                      cv_now, rnd, null))
+                                      g_gain - 3 * pen, rival, cv_now, rnd, null, comp))
         judged += round_judged
         qualified = [j for j in round_judged if j.qualifies]
         if not qualified:
@@ -331,6 +340,25 @@ def withdraw_unsupported(steps: list[Step], final: Fit, criteria: Criteria) -> F
     return kept
 
 
+#: the amplitude of a candidate's fitted shift in :func:`complements`: from none to twice its
+#: own fit (the shift is the effect's at its estimate; the base's step takes the rest)
+SHIFT_BOUNDS = (0.0, 2.0)
+
+
+def complements(loc: Local, a, b, alpha: float) -> bool:
+    """Whether candidates ``a`` and ``b`` (compare.fit.linear.EffectFit) each add a
+    significant gain over the other (at ``alpha``, one degree of freedom): each enters as the
+    amplitude of its fitted shift, jointly with the base's step on the linearized model
+    ``loc``. Such candidates explain different parts of the run, so neither is an
+    alternative to the other (Criteria.distinct_among_alternatives)."""
+    ca, cb = a.shift[:, None], b.shift[:, None]
+    g_a = loc.gain(ca, [SHIFT_BOUNDS])[0]
+    g_b = loc.gain(cb, [SHIFT_BOUNDS])[0]
+    g_ab = loc.gain(np.hstack([ca, cb]), [SHIFT_BOUNDS, SHIFT_BOUNDS])[0]
+    crit = 0.5 * chi2_threshold(alpha, 1)
+    return bool(g_ab - g_a > crit and g_ab - g_b > crit)
+
+
 @dataclass(frozen=True)
 class NullStep:
     """The current model refitted by one step of the linearized model without a candidate:
@@ -348,12 +376,13 @@ class NullStep:
 
 def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
           competitor: float, rival: float, cv_now: dict | None, rnd: int,
-          null: NullStep) -> Judgement:
+          null: NullStep, complements_: Sequence[str] = ()) -> Judgement:
     """The named criteria of one candidate fitted on the linearized model (module
     docstring). ``penalised``: its gain over the ``null`` (the current model refitted by the
     same step, :class:`NullStep`) less half ln(n_eff) per
     parameter; ``competitor`` and ``rival``: the same of the competitor's best hypothesis and
-    of the best other candidate on its channels."""
+    of the best other candidate on its channels that is an alternative to it, the others
+    (``complements_``) being its complements (:func:`complements`)."""
     from scipy.stats import chi2
 
     cal = loc.cal
@@ -385,10 +414,11 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
         "distinct": bool(penalised >= rival + margin),
         "final_model_adequate": None,  # asked of the open loop's names after the selection
     }
-    figures: dict[str, float | None] = {
+    figures: dict[str, object] = {
         "values": ef.values, "penalised_gain": penalised,
         "competitor_penalised_gain": competitor if math.isfinite(competitor) else None,
         "rival_penalised_gain": rival if math.isfinite(rival) else None,
+        "complements": list(complements_),
         "net_change_peak": net, "base_prior_z_without": z_null, "base_prior_z_with": z_with,
         "cv_before": None, "cv_after": None}
     if criteria.cv_blocks and out["significant"] and out["material"] and not out["signature"]:
@@ -424,5 +454,4 @@ def verdict_on(loc: Local, reg, criteria: Criteria,
 def held_out_misses(errors: dict) -> dict[str, float]:
     """Channels whose open-loop RMS on the validation window exceeds one tolerance, with that
     RMS in tolerances (``errors``: compare.fit.calibrate.Fit.errors)."""
-    return {c: float(e["rmse_w"]) for c, e in errors.get("validation", {}).items()
-            if e.get("n") and e["rmse_w"] > 1.0}
+    return over_tolerance(errors.get("validation", {}))
