@@ -504,3 +504,29 @@ def test_two_effects_that_each_add_to_the_other_are_complements_not_rivals(setup
         mount, fixture = fit_effect(loc, "mount_conduction"), fit_effect(loc, "fixture_expansion")
         found[name] = complements(loc, mount, fixture, Criteria().alpha)
     assert found == {"both": True, "fixture alone": False}
+
+
+def test_the_candidates_table_says_which_candidates_were_complements_not_rivals():
+    """report.html's candidates table has a column of each candidate's complements (read from
+    report.json's candidates), so that a reader sees why `distinct` passed beside a larger
+    gain; a hand-written report, one candidate with two complements and one with none."""
+    import re
+
+    from compare.fit.report import _criteria_html
+
+    crit = dict(ALL_PASS)
+    doc = {"candidates": [
+        {"candidate": "windage_loss", "round": 1, "gain": 43.1, "p_value": 1e-6,
+         "peak_tolerances": 1.2, "criteria": crit, "route": "open loop",
+         "complements": ["sensor_lag(T_stator)", "bearing_preload"]},
+        {"candidate": "mount_conduction", "round": 1, "gain": 3.3, "p_value": 0.2,
+         "peak_tolerances": 0.1, "criteria": {**crit, "significant": False}, "route": None,
+         "complements": []}]}
+    html = _criteria_html(doc)
+    head = re.findall(r"<th>(.*?)</th>", html)
+    at = head.index("complements")
+    cells = {r[0]: r for r in (re.findall(r"<td>(.*?)</td>", row)
+                               for row in re.findall(r"<tbody>(.*?)</tbody>", html, re.S)[0]
+                               .split("</tr>") if "<td>" in row)}
+    assert cells["windage_loss"][at] == "sensor_lag(T_stator), bearing_preload"
+    assert cells["mount_conduction"][at] == ""

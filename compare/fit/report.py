@@ -394,15 +394,17 @@ def _criteria_html(doc: dict) -> str:
         rows.append([c["candidate"], c["round"], f"{c['gain']:.1f}", p_text(c["p_value"]),
                      f"{c['peak_tolerances']:.2f}",
                      *["—" if crit.get(k) is None else ("pass" if crit[k] else "FAIL")
-                       for k in names], c.get("route") or "no"])
+                       for k in names], ", ".join(c.get("complements") or []),
+                     c.get("route") or "no"])
     return ("<h2>Candidates and criteria</h2><p>Each candidate refitted with the base "
             "parameters, round by round, and the criteria it passed (— not asked). A "
             "candidate qualifies when it is significant and material and shows that it is "
             "this effect by its signature or by every open-loop criterion, of which the "
             "last is changes_prediction or, failing it, restores_plausible_base "
-            "(compare.fit.select).</p>"
+            "(compare.fit.select). Its complements each add to it as it adds to them, so "
+            "distinct does not count them as rivals.</p>"
             + html_table(["candidate", "round", "gain", "p", "peak [tol]", *names,
-                          "qualifies by"], rows, ["s"] * (len(names) + 6)))
+                          "complements", "qualifies by"], rows, ["s"] * (len(names) + 7)))
 
 
 def _signatures_html(doc: dict) -> str:
