@@ -485,7 +485,8 @@ def test_two_effects_that_each_add_to_the_other_are_complements_not_rivals(setup
     (1.5 µm/K) both present: each, fitted alone on the base, adds a significant gain to the
     other's, so they are complements. Data with the fixture alone: the mount, fitted on the
     same base, adds nothing significant once the fixture is in, so it stays the fixture's
-    rival. The level is the criteria's alpha (1 %), as in the rule."""
+    rival. The margin is the criteria's (Criteria.distinct_margin, alpha 1 %), as in the
+    rule."""
     from compare.fit.linear import fit_effect, local
     from compare.fit.select import complements
 
@@ -502,7 +503,7 @@ def test_two_effects_that_each_add_to_the_other_are_complements_not_rivals(setup
                          CHANNELS)
         loc = local(cal, cal.fit())
         mount, fixture = fit_effect(loc, "mount_conduction"), fit_effect(loc, "fixture_expansion")
-        found[name] = complements(loc, mount, fixture, Criteria().alpha)
+        found[name] = complements(loc, mount, fixture, Criteria().distinct_margin())
     assert found == {"both": True, "fixture alone": False}
 
 

@@ -236,6 +236,11 @@ class Criteria:
 
         return float(norm.isf(self.alpha / 2))
 
+    def distinct_margin(self) -> float:
+        """The log-likelihood margin of ``distinct`` and of :func:`compare.fit.select.complements`:
+        half the chi-square quantile of one degree of freedom at alpha (3.3 at 1 %)."""
+        return 0.5 * chi2_threshold(self.alpha, 1)
+
     def with_options(self, **values) -> Criteria:
         """These criteria with some entries set (None leaves an entry as it is)."""
         return replace(self, **{k: v for k, v in values.items() if v is not None})

@@ -66,7 +66,7 @@ import numpy as np
 
 from compare.fit.calibrate import Calibrator, Fit, _from_z, _to_z, over_tolerance
 from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan, scan_threshold
-from compare.fit.criteria import Criteria, chi2_threshold
+from compare.fit.criteria import Criteria
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.linear import Local, effect_held_out, fit_effect, local
 
@@ -286,7 +286,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
                      for lab, f in fits.items()}
         cv_now = loc.cross_validate(criteria.cv_blocks) if criteria.cv_blocks else None
         round_judged = []
-        margin = 0.5 * chi2_threshold(criteria.alpha, 1)
+        margin = criteria.distinct_margin()
         for lab, ef in fits.items():
             near = {other: v for other, v in penalised.items() if other != lab
                     and parse_label(other)[0] != parse_label(lab)[0]
@@ -294,7 +294,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
             # only a rival that could make it fail is asked whether it is a complement
             comp = [other for other, v in near.items() if criteria.distinct_among_alternatives
                     and v + margin > penalised[lab]
-                    and complements(loc, ef, fits[other], criteria.alpha)]
+                    and complements(loc, ef, fits[other], margin)]
             rival = max((v for other, v in near.items() if other not in comp),
                         default=-math.inf)
             round_judged.append(judge(loc, ef, sig.get(lab), criteria, penalised[lab],
@@ -345,9 +345,10 @@ def withdraw_unsupported(steps: list[Step], final: Fit, criteria: Criteria) -> F
 SHIFT_BOUNDS = (0.0, 2.0)
 
 
-def complements(loc: Local, a, b, alpha: float) -> bool:
+def complements(loc: Local, a, b, margin: float) -> bool:
     """Whether candidates ``a`` and ``b`` (compare.fit.linear.EffectFit) each add a
-    significant gain over the other (at ``alpha``, one degree of freedom): each enters as the
+    significant gain over the other (a log-likelihood gain above ``margin``:
+    Criteria.distinct_margin, one degree of freedom at alpha): each enters as the
     amplitude of its fitted shift, jointly with the base's step on the linearized model
     ``loc``. Such candidates explain different parts of the run, so neither is an
     alternative to the other (Criteria.distinct_among_alternatives)."""
@@ -355,8 +356,7 @@ def complements(loc: Local, a, b, alpha: float) -> bool:
     g_a = loc.gain(ca, [SHIFT_BOUNDS])[0]
     g_b = loc.gain(cb, [SHIFT_BOUNDS])[0]
     g_ab = loc.gain(np.hstack([ca, cb]), [SHIFT_BOUNDS, SHIFT_BOUNDS])[0]
-    crit = 0.5 * chi2_threshold(alpha, 1)
-    return bool(g_ab - g_a > crit and g_ab - g_b > crit)
+    return bool(g_ab - g_a > margin and g_ab - g_b > margin)
 
 
 @dataclass(frozen=True)
@@ -396,7 +396,7 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
     # what the fitted model's prediction moves by against the null, the base's
     # re-adjustment around the effect included
     net = float(np.max(np.abs(null.residual[rows] - ef.residual[rows]))) if rows.any() else 0.0
-    margin = 0.5 * chi2_threshold(criteria.alpha, 1)
+    margin = criteria.distinct_margin()
     # the largest |prior z| of the base parameters without the candidate and with it
     z_null = float(np.max(np.abs(loc.prior_sds(null.delta)), initial=0.0))
     z_with = float(np.max(np.abs(loc.prior_sds(ef.delta)), initial=0.0))
