@@ -8,10 +8,11 @@ import pytest
 
 from compare.fit.criteria import Criteria
 from compare.fit.gaps import gaps_with_change, place_switches, unknown_input_spans
-from compare.fit.greybox import GreyBox, inputs_from_cycle
+from compare.fit.greybox import GreyBox
 from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES
 from spindle.spec_reader import load_spec
+from tests.cycle_inputs import inputs_from_cycle
 
 
 def test_only_gaps_with_a_change_beyond_the_drive_scatter_count():

@@ -11,12 +11,13 @@ from compare.cli import main
 from compare.fit.calibrate import Calibrator, Measured, resample
 from compare.fit.criteria import Criteria
 from compare.fit.effects import LIBRARY, label
-from compare.fit.greybox import GreyBox, inputs_from_cycle
+from compare.fit.greybox import GreyBox
 from lumped import build
 from spindle.bench import read_bench
 from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES, cycle_load_case
 from spindle.spec_reader import load_spec
+from tests.cycle_inputs import inputs_from_cycle
 
 CHANNELS = ["T1", "T2", "T_stator", "P1"]
 
@@ -326,10 +327,13 @@ def test_prior_penalty_and_plausibility(setup):
     z = np.log(fit.theta["h_coolant"]) / 0.25  # BASE_PARAMS prior_sd of h_coolant
     assert fit.penalty == pytest.approx(0.5 * z * z, rel=1e-12)
     assert cal.prior_z(fit) == {"h_coolant": pytest.approx(z, rel=1e-12)}
+    # the plausible range at alpha = 1 % is the normal distribution's two-sided 1 % point
+    z_crit = Criteria(alpha=0.01).implausible_z()
+    assert z_crit == pytest.approx(2.5758, abs=1e-4)
     fit.theta["h_coolant"] = float(np.exp(-2.6 * 0.25))
-    assert cal.implausible(fit, 0.01) == ["h_coolant"]
+    assert abs(cal.prior_z(fit)["h_coolant"]) > z_crit
     fit.theta["h_coolant"] = float(np.exp(-2.5 * 0.25))
-    assert cal.implausible(fit, 0.01) == []
+    assert abs(cal.prior_z(fit)["h_coolant"]) < z_crit
 
 
 def test_anderson_solves_a_slow_linear_fixed_point():

@@ -12,12 +12,13 @@ from compare.fit.calibrate import Calibrator, Measured
 from compare.fit.competitor import WindowHeat
 from compare.fit.criteria import Criteria
 from compare.fit.effects import candidates, hypothesis
-from compare.fit.greybox import GreyBox, inputs_from_cycle
+from compare.fit.greybox import GreyBox
 from compare.fit.select import Judgement, select, signature_outcome
 from compare.fit.signatures import EventTest
 from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES
 from spindle.spec_reader import load_spec
+from tests.cycle_inputs import inputs_from_cycle
 
 CHANNELS = ["T1", "T2", "T_stator", "P1"]
 ALL_PASS = {"significant": True, "material": True, "signature": None,

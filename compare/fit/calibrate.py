@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,13 +41,6 @@ from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
 
 #: the paper's tolerance per bench channel [K; m for P1] (spindle.tolerances)
 TOLERANCE = {c: channel_tolerance(c) for c in ("T1", "T2", "T_stator", "P1")}
-
-
-def implausible_z(alpha: float) -> float:
-    """The prior |z| beyond which a base parameter is implausible: two-sided at ``alpha``."""
-    from scipy.stats import norm
-
-    return float(norm.isf(alpha / 2))
 
 
 def block_index(edges: np.ndarray, t_s: np.ndarray) -> np.ndarray:
@@ -157,6 +150,19 @@ def _bounds_z(p: Param) -> tuple[float, float]:
     return (_to_z(p, p.lo), _to_z(p, p.hi))
 
 
+def z_bounds(params: Sequence[Param]) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) bounds of ``params`` on their fitted scale."""
+    b = np.array([_bounds_z(p) for p in params], dtype=float).reshape(-1, 2)
+    return b[:, 0], b[:, 1]
+
+
+def concentrated_loglik(residuals: Iterable[np.ndarray]) -> float:
+    """-1/2 sum_c n_c ln(RSS_c / n_c) over the channels' residuals (an unknown variance per
+    channel, Gaussian: module docstring)."""
+    return sum(-0.5 * len(r) * math.log(max(float(np.mean(r * r)), 1e-300))
+               for r in residuals if len(r))
+
+
 @dataclass
 class Fit:
     """One calibration: parameters, their intervals and correlations, errors, likelihood."""
@@ -240,12 +246,6 @@ class Calibrator:
                 / params[k].prior_sd for k in fit.free
                 if params[k].prior_sd and k in self.prior}
 
-    def implausible(self, fit: Fit, alpha: float) -> list[str]:
-        """The base parameters outside their two-sided (1 - alpha) prior range."""
-        z_crit = implausible_z(alpha)
-        return [k for k, z in self.prior_z(fit).items() if abs(z) > z_crit]
-
-
     def set_prior(self, centre: dict[str, float], fit: Fit) -> None:
         """Priors around ``centre``, weighed against the data by ``fit``'s residual variance
         and effective sample size (held fixed from then on, so likelihoods stay comparable)."""
@@ -269,13 +269,6 @@ class Calibrator:
             res[c] = (self.measured.values[c][m] - out[c][m]) / TOLERANCE[c]
         return res
 
-    def loglik(self, res: dict[str, np.ndarray]) -> float:
-        total = 0.0
-        for r in res.values():
-            if len(r):
-                total += -0.5 * len(r) * math.log(max(float(np.mean(r * r)), 1e-300))
-        return total
-
     def errors(self, out: dict[str, np.ndarray]) -> dict[str, dict[str, dict[str, float]]]:
         errs: dict[str, dict[str, dict[str, float]]] = {}
         for window in ("fit", "validation"):
@@ -286,7 +279,7 @@ class Calibrator:
                 if len(d) == 0:
                     errs[window][c] = {"n": 0}
                     continue
-                row = _error_row(c, d)
+                row = error_row(c, d)
                 unit = row["unit"]
                 errs[window][c] = {
                     "n": row["n"], f"rmse_{unit}": row["rmse"], f"max_{unit}": row["max"],
@@ -310,8 +303,7 @@ class Calibrator:
             p = params[k]
             theta[k] = min(max(theta[k], p.lo + 1e-9 * (p.hi - p.lo)), p.hi)
         z0 = np.array([_to_z(params[k], theta[k]) for k in free])
-        lo = np.array([_bounds_z(params[k])[0] for k in free])
-        hi = np.array([_bounds_z(params[k])[1] for k in free])
+        lo, hi = z_bounds([params[k] for k in free])
         z0 = np.clip(z0, lo, hi)
         nfev = 0
 
@@ -335,7 +327,7 @@ class Calibrator:
         J = sol.jac[:n]  # the data rows: the intervals say what this run alone determines
         penalty = 0.5 * float(np.sum(self._prior_terms(params, free, sol.x) ** 2))
         ci, corr, ident = _intervals(J, r_all, n, n_eff, free, params, sol.x)
-        return Fit(tuple(effects), theta, free, ci, corr, ident, self.loglik(res), n, n_eff,
+        return Fit(tuple(effects), theta, free, ci, corr, ident, concentrated_loglik(res.values()), n, n_eff,
                    out, self.errors(out), time.perf_counter() - t0, nfev, penalty)
 
 
@@ -426,7 +418,7 @@ def parameters_table(fit: Fit) -> list[dict]:
 
 
 
-def _error_row(channel: str, d: np.ndarray) -> dict:
+def error_row(channel: str, d: np.ndarray) -> dict:
     """rmse, max, bias (channel unit at the edges: K or um) and within_tolerance of
     differences ``d`` [SI]; the errors of Calibrator.errors and of cross_validate."""
     scale, unit = edge_scale(channel), edge_unit(channel, ascii=True)

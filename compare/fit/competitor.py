@@ -31,6 +31,7 @@ import numpy as np
 
 from compare.fit.calibrate import block_index
 from compare.fit.effects import Effect, hypothesis
+from compare.fit.effects.base import spread_heat
 from compare.fit.params import Param
 
 #: the name every competitor hypothesis's label starts with (a report reads it)
@@ -64,15 +65,8 @@ class WindowHeat(Effect):
         self.series = series  # per interval [W per W of q]; None: the window
 
     def extend_network(self, net, spec, power_measured):
-        from lumped.blocks import PrescribedHeatFlow
-
-        parts = [p for p in net.parts.values() if p.part.role == self.role]
-        masses = parts[0].masses
-        total = sum(m.block.C_J_K for m in masses)
-        for m in masses:
-            q = net.network.add(PrescribedHeatFlow(f"source:{NAME}:{m.name}", source=NAME,
-                                                   share=m.block.C_J_K / total))
-            net.network.connect(m.block.port, q.port)
+        part = next(p for p in net.parts.values() if p.part.role == self.role)
+        spread_heat(net, part.masses, NAME, f"source:{NAME}")
 
     def heat(self, sources_W, theta, inputs):
         shape = self.series if self.series is not None else _window(inputs, self.t0_s, self.t1_s)

@@ -45,21 +45,6 @@ class Inputs:
     T_start_K: float | None = None  # uniform initial temperature [K] (default: T_env_K[0])
 
 
-def inputs_from_cycle(cycle, grid_s: np.ndarray) -> Inputs:
-    """Inputs of a shipped or user cycle (spindle.cycles.Cycle) on ``grid_s``: each
-    interval takes the step, ambient and coolant at its middle; power unknown (nan)."""
-    mid = 0.5 * (grid_s[1:] + grid_s[:-1])
-    idx = np.clip(np.searchsorted(np.asarray(cycle.boundaries_s), mid, side="right") - 1, 0,
-                  len(cycle.steps) - 1)
-    steps = [cycle.steps[i] for i in idx]
-    power = np.array([np.nan if s.power_kW is None else s.power_kW for s in steps])
-    return Inputs(grid_s, np.array([s.speed_rpm for s in steps]), power,
-                  np.array([s.load_torque_Nm for s in steps]),
-                  np.asarray(cycle.T_ambient_K(mid), dtype=float),
-                  np.asarray(cycle.T_coolant_K(mid), dtype=float),
-                  float(cycle.T_ambient_K(grid_s[0])))
-
-
 def _geometric(x: np.ndarray, floor: float, rel: float) -> np.ndarray:
     """``x`` (at least ``floor`` taken) rounded to the nearest point of the geometric grid of
     relative step ``rel``."""

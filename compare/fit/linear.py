@@ -12,13 +12,22 @@ same step. One Jacobian costs one simulation per free parameter.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from compare.fit.calibrate import TOLERANCE, Calibrator, Fit, _bounds_z, _from_z, _to_z, block_index
+from compare.fit.calibrate import (
+    TOLERANCE,
+    Calibrator,
+    Fit,
+    _from_z,
+    _to_z,
+    block_index,
+    concentrated_loglik,
+    error_row,
+    z_bounds,
+)
 from compare.fit.effects import effect_of
 
 #: the step of the finite differences on the fitted scale (as the nonlinear fit's)
@@ -96,14 +105,10 @@ class Local:
         return 0.5 * float(t @ t)
 
     def loglik(self, r: np.ndarray, rows: np.ndarray) -> float:
-        """The concentrated log-likelihood of residual ``r`` over ``rows`` (as
-        compare.fit.calibrate.Calibrator.loglik)."""
-        total = 0.0
-        for c in range(len(self.cal.channels)):
-            m = rows & (self.channel == c)
-            if m.any():
-                total += -0.5 * m.sum() * math.log(max(float(np.mean(r[m] ** 2)), 1e-300))
-        return total
+        """The concentrated log-likelihood of residual ``r`` over ``rows``
+        (compare.fit.calibrate.concentrated_loglik)."""
+        return concentrated_loglik(r[rows & (self.channel == c)]
+                                   for c in range(len(self.cal.channels)))
 
     def gain_of(self, r1: np.ndarray, delta: np.ndarray) -> float:
         """The log-posterior gain over the fit window of the residual ``r1`` after the step
@@ -149,20 +154,9 @@ class Local:
     def cross_validation_report(self, blocks: int) -> dict:
         """:meth:`held_out` pooled per channel as the report shows it: RMS, max, bias (the
         channel's unit at the edges), the share within the tolerance."""
-        from spindle.tolerances import edge_scale, edge_unit
-
         held = self.held_out(blocks)
-        pooled = {}
-        for j, c in enumerate(self.cal.channels):
-            d = held[self.channel == j]
-            if len(d):
-                scale = TOLERANCE[c] * edge_scale(c)
-                pooled[c] = {"rmse": float(np.sqrt(np.mean(d * d))) * scale,
-                             "max": float(np.max(np.abs(d))) * scale,
-                             "bias": float(np.mean(d)) * scale,
-                             "unit": edge_unit(c, ascii=True),
-                             "within_tolerance": float(np.mean(np.abs(d) <= 1.0)),
-                             "n": int(len(d))}
+        pooled = {c: error_row(c, held[self.channel == j] * TOLERANCE[c])
+                  for j, c in enumerate(self.cal.channels) if (self.channel == j).any()}
         return {"blocks": blocks, "method": "one Gauss-Newton step per fold", "pooled": pooled}
 
 
@@ -189,8 +183,7 @@ def local(cal: Calibrator, fit: Fit) -> Local:
     free = list(fit.free)
     r0, ch, pt, in_fit = residual_rows(cal, fit.model)
     z0 = np.array([_to_z(params[k], fit.theta[k]) for k in free])
-    lo = np.array([_bounds_z(params[k])[0] for k in free])
-    hi = np.array([_bounds_z(params[k])[1] for k in free])
+    lo, hi = z_bounds([params[k] for k in free])
     J = np.empty((len(r0), len(free)))
     for i, k in enumerate(free):
         # step inside the bounds (a parameter on its upper bound steps down)
@@ -238,8 +231,7 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
     cal, fit = loc.cal, loc.fit
     gb = cal.gb.variant(fit.effects + (label,))
     params = effect_of(label).params
-    lo = np.array([_bounds_z(p)[0] for p in params])
-    hi = np.array([_bounds_z(p)[1] for p in params])
+    lo, hi = z_bounds(params)
     z_n = np.array([_to_z(p, p.default) for p in params])
     z = np.array([_to_z(p, (start or {}).get(p.name, p.lo + 0.1 * (p.hi - p.lo)
                                                  if p.lo >= 0 else 0.1 * p.hi))
@@ -296,7 +288,6 @@ def effect_held_out(loc: Local, ef: EffectFit, blocks: int) -> dict[str, float]:
     estimate): per channel, the RMS of the held-out residual [tolerances]."""
     around = replace(loc, r0=ef.residual, z0=loc.z0 + ef.delta)
     params = effect_of(ef.label).params
-    lo = np.array([_bounds_z(p)[0] for p in params]) - ef.z
-    hi = np.array([_bounds_z(p)[1] for p in params]) - ef.z
-    held = around.held_out(blocks, ef.columns, list(zip(lo, hi, strict=True)))
+    lo, hi = z_bounds(params)
+    held = around.held_out(blocks, ef.columns, list(zip(lo - ef.z, hi - ef.z, strict=True)))
     return around.rms_by_channel(held)

@@ -140,6 +140,18 @@ class Effect:
         raise NotImplementedError(f"{self.name} acts on the physics, not on the measurement")
 
 
+def spread_heat(net, masses, source: str, prefix: str) -> None:
+    """Heat flows of ``source`` into ``masses`` of the lumped network ``net``, shared by
+    their heat capacities (block names ``prefix:mass``)."""
+    from lumped.blocks import PrescribedHeatFlow
+
+    total = sum(m.block.C_J_K for m in masses)
+    for m in masses:
+        q = net.network.add(PrescribedHeatFlow(f"{prefix}:{m.name}", source=source,
+                                               share=m.block.C_J_K / total))
+        net.network.connect(m.block.port, q.port)
+
+
 def label(effect: str, channel: str | None = None) -> str:
     """A candidate's label: the effect's name, with the channel of a per-channel effect."""
     return f"{effect}({channel})" if channel else effect

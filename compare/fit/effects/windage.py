@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from compare.fit.effects.base import Effect
+from compare.fit.effects.base import Effect, spread_heat
 from compare.fit.params import Param
 from compare.fit.signatures import EventTest
 from spindle.drive_file import MOTOR_SOURCES
@@ -32,16 +32,9 @@ class WindageLoss(Effect):
             "labyrinth): a loss the motor model lacks")
 
     def extend_network(self, net, spec, power_measured):
-        from lumped.blocks import PrescribedHeatFlow
-
         rotor = [p for p in net.parts.values() if p.part.role == "rotor"]
         masses = rotor[0].masses if rotor else net.parts[spec.parts[0].name].masses
-        total = sum(m.block.C_J_K for m in masses)
-        for m in masses:
-            q = net.network.add(PrescribedHeatFlow(f"source:windage:{m.name}", source="windage",
-                                                   share=m.block.C_J_K / total))
-            net.network.connect(m.block.port, q.port)
-        return None
+        spread_heat(net, masses, "windage", "source:windage")
 
     def heat(self, sources_W, theta, inputs):
         return from_motor(sources_W, theta["c_w_W_krpm3"], inputs.speed_rpm, inputs.power_kW)
