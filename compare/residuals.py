@@ -274,6 +274,14 @@ def cross_correlation(r: Any, x: Any, max_lag: int, alpha: float = 0.05,
     return lags[keep], c[keep] / denom, acf_band(n, alpha)
 
 
+def _constant_where_both(r: Any, x: Any) -> bool:
+    """Whether the signal ``x`` is constant over the samples where it and ``r`` are valid (its
+    cross-correlation with ``r`` is then undefined)."""
+    a, b = _as_series(r), _as_series(x)
+    v = b[np.isfinite(a) & np.isfinite(b)] if a.shape == b.shape else b[np.isfinite(b)]
+    return bool(v.size and np.ptp(v) == 0.0)
+
+
 def peak_lag(lags: np.ndarray, ccf: np.ndarray) -> tuple[int, float]:
     """(lag [samples], ccf value) of the largest |ccf| (the first one on a tie)."""
     i = int(np.argmax(np.abs(ccf)))
@@ -464,6 +472,8 @@ def diagnose(residuals: Mapping[str, Any], dt_s: float,
             max_lag = a.size // 4 if max_lag_s is None else int(round(max_lag_s / dt_s))
             cross = []
             for sname, kind, x in signals:
+                if _constant_where_both(a, x):
+                    continue  # a constant input (a run at standstill) follows no residual
                 ls, cc, band = cross_correlation(a, x, max_lag, alpha, detrend)
                 lag, val = peak_lag(ls, cc)
                 cross.append(CrossPeak(sname, kind, lag, lag * dt_s, val, band))

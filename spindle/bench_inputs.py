@@ -23,15 +23,17 @@ from spindle.units import ZERO_C_K
 
 
 def bench_grid(run: BenchRun, grid_s: float | None = None) -> np.ndarray:
-    """Times of the model's inputs [s]: every ``grid_s`` (default 60 s) from 0 to the end of
-    the run, plus the run's first and last sample times; strictly increasing (points closer
-    than 1e-6 grid_s to the run's start or end are dropped in their favour)."""
+    """Times of the model's inputs [s]: the multiples of ``grid_s`` (default 60 s) from the
+    last one at or before the run's first sample to its end, plus the run's first and last
+    sample times; strictly increasing (points closer than 1e-6 grid_s to the run's start or
+    end are dropped in their favour). A run whose clock does not start near 0 (a bench that
+    logs the time of day) gets the same grid as the run shifted to start there."""
     step = DEFAULT_GRID_S if grid_s is None else float(grid_s)
     if not math.isfinite(step) or step <= 0:
         raise InputError(str(run.path), "grid_s", f"{grid_s!r} is not a time step > 0 s",
                          "give the grid spacing in seconds, e.g. 60")
     t0, t1 = float(run.time_s[0]), float(run.time_s[-1])
-    pts = np.arange(0.0, t1, step)
+    pts = np.arange(math.floor(t0 / step) * step, t1, step)
     tol = 1e-6 * step
     pts = pts[(np.abs(pts - t0) > tol) & (np.abs(pts - t1) > tol)]
     return np.unique(np.concatenate([pts, [t0, t1]]))
@@ -148,7 +150,7 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
            grid_s: float | None = None) -> tuple[LoadCase, np.ndarray]:
     """The model inputs of a bench run on a time grid: ``(LoadCase, grid [s])``.
 
-    Grid: :func:`bench_grid` (every ``grid_s``, default 60 s, from 0 to the end, plus the run's
+    Grid: :func:`bench_grid` (every ``grid_s``, default 60 s, over the run, plus the run's
     first and last sample). Speed [rpm]: the bench logs it on change, so it is held (the last
     valid sample at or before each grid point; before the first, the first value), a
     'previous' series on the grid. Ambient and coolant [K]: the time mean of the logged

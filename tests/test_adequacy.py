@@ -136,3 +136,28 @@ def test_no_bound_advice_where_the_bound_is_the_specs_value():
                        {**SPEC, "G_seat_W_K": 0.0}, {"h_coolant": 0.0, "f0": 0.0},
                        {"G_seat_W_K": (0.0, 200.0)})
     assert ad["at_bound"] == [] and "bearing seats" not in ad["statement"]
+
+
+def test_a_run_at_standstill_throughout_is_fitted_not_a_traceback(tmp_path):
+    """A peer's run with its speed column zeroed (every input but the speed as logged): the
+    constant speed has no cross-correlation with the residuals, and fit still ends with a
+    verdict and its report (exit 0), where it raised a ValueError before. The drive's power
+    then heats a spindle that does not turn, which the model cannot explain: the verdict is
+    not 'base adequate'."""
+    import json
+
+    from compare.cli import main
+
+    lines = (PEER_RUNS / "dev-01.csv").read_text(encoding="utf-8").splitlines()
+    head = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    k = lines[head].split(",").index("speed_rpm")
+    rows = [line.split(",") for line in lines[head + 1:]]
+    for r in rows:
+        r[k] = "0"
+    run = tmp_path / "standstill.csv"
+    run.write_text("\n".join(lines[:head + 1] + [",".join(r) for r in rows]) + "\n",
+                   encoding="utf-8")
+    out = tmp_path / "fit"
+    assert main(["fit", str(run), "--out", str(out), "--quiet", "--no-pictures"]) == 0
+    verdict = json.loads((out / "report.json").read_text(encoding="utf-8"))["verdict"]
+    assert verdict["kind"] != "base adequate"

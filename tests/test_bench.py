@@ -299,6 +299,25 @@ def test_grid_every_60_s_plus_the_runs_start_and_end(tmp_path):
         bench_grid(run, 0.0)
 
 
+def test_a_run_whose_clock_starts_late_gets_the_grid_of_the_shifted_run(tmp_path):
+    """A bench that logs the time of day (the run starts at 25,200 s, 7 am) gets the grid and
+    the inputs of the same run logged from 0, shifted: the grid started at 0 before, so the
+    fit window (the grid's first 60 %) held no sample and fit refused every channel (found by
+    shifting a peer's run by 1e6 s)."""
+    lines = good_rows()
+    shift = 25_200.0
+    late = [",".join([str(float(x.split(",")[0]) + shift), *x.split(",")[1:]]) for x in lines]
+    early_run = read_bench(write(tmp_path, lines, "early.csv"))
+    late_run = read_bench(write(tmp_path, late, "late.csv"))
+    np.testing.assert_allclose(bench_grid(late_run), bench_grid(early_run) + shift, rtol=0,
+                               atol=1e-9)
+    from compare.fit.run import greybox_inputs
+
+    a, b = greybox_inputs(early_run), greybox_inputs(late_run)
+    for name in ("speed_rpm", "power_kW", "load_torque_Nm", "T_env_K", "T_coolant_K"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+
+
 def test_speed_is_held_and_leading_gaps_take_the_first_value(tmp_path, spec):
     lines = good_rows()
     lines[0] = row(0, speed="")

@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -194,3 +195,25 @@ def test_sensors_command(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "Recommended: N = 3, the smallest node count" in text  # 22.6 K on the warm-up < 30 K
     assert (out / "nodes.csv").exists()
+
+
+def test_an_internal_error_is_one_line_with_the_traceback_in_a_file(tmp_path, monkeypatch, capsys):
+    """A bug (an exception that is not a SpindleVerifyError) ends in one line on stderr that
+    says it is not the user's input and where its traceback was written, exit status 1 (2 is
+    bad input), and no output folder."""
+    import compare.fit.run
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(compare.fit.run, "run_fit", broken)
+    monkeypatch.setattr("tempfile.tempdir", str(tmp_path))
+    run_csv = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs" / "dev-01.csv"
+    out = tmp_path / "o"
+    assert main(["fit", str(run_csv), "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert "internal error: RuntimeError: boom" in err and "not your input" in err
+    crash = next(tmp_path.glob("spindle-verify-crash-*.txt"))
+    assert crash.name in err and "RuntimeError: boom" in crash.read_text(encoding="utf-8")
+    assert not out.exists()

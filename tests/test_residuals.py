@@ -274,6 +274,24 @@ def test_diagnose_two_channels_with_an_input():
         diagnose({"T2": np.zeros(100)}, dt_s)  # a constant residual has no autocorrelation
 
 
+def test_a_constant_input_is_left_out_of_the_cross_correlations():
+    """A run at standstill throughout logs a constant speed: its cross-correlation with a
+    residual is 0 / 0, so diagnose leaves that input out (it follows no residual) and still
+    reads the others; it raised before (found by feeding ``fit`` a run with its speed zeroed)."""
+    n = 600
+    rng = np.random.default_rng(3)
+    power = np.repeat(rng.uniform(0.0, 5.0, n // 60), 60)
+    r = {"T1": 0.1 * (power - power.mean()) + 0.01 * rng.standard_normal(n)}
+    d = diagnose(r, 60.0, inputs={"speed": np.zeros(n), "power": power}, alpha=0.01)
+    assert [c.name for c in d.channels["T1"].cross] == ["power"]
+    assert d.channels["T1"].best("input").ccf > 0.9
+    # constant only where the residual is valid: still constant for the correlation
+    gappy = np.where(np.arange(n) < n // 2, 1500.0, np.nan)
+    r_half = {"T1": np.where(np.arange(n) < n // 2, r["T1"], np.nan)}
+    d = diagnose(r_half, 60.0, inputs={"speed": gappy, "power": power}, alpha=0.01)
+    assert [c.name for c in d.channels["T1"].cross] == ["power"]
+
+
 # ---------------------------------------------------------------------------------------- plots
 def test_plot_helpers_draw_and_return_the_axes():
     from spindle.plots import pyplot

@@ -113,6 +113,27 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`, which closed early
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except Exception as exc:  # a bug, not the user's input: one line, the traceback in a file
+        print(f"spindle-verify: internal error: {type(exc).__name__}: {exc}; this is a bug, "
+              f"not your input: please report it with the command and {_crash_file(exc)}",
+              file=sys.stderr)
+        return 1
+
+
+def _crash_file(exc: BaseException) -> str:
+    """The traceback of ``exc`` written to a new file in the temporary folder; its path (or
+    where it could not be written)."""
+    import tempfile
+    import traceback
+
+    try:
+        fd, path = tempfile.mkstemp(prefix="spindle-verify-crash-", suffix=".txt")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(f"spindle-verify {' '.join(sys.argv[1:])}\n")
+            f.write("".join(traceback.format_exception(exc)))
+        return f"the traceback in {path}"
+    except OSError:
+        return "the input"
 
 
 
