@@ -557,10 +557,19 @@ def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error:
         y = columns[col]
         v = y[~np.isnan(y)]
         med, top = float(np.median(v)), float(v.max())
-        if med > T_KELVIN_MEDIAN_C or top > T_KELVIN_MAX_C:
+        # above the range in °C: kelvin where it is a plausible temperature in kelvin (the
+        # median, or a reading that is one less 273.15), a broken reading where it is not
+        as_celsius = top - 273.15
+        kelvin = med > T_KELVIN_MEDIAN_C or T_MIN_C <= as_celsius <= T_KELVIN_MEDIAN_C
+        if kelvin and (med > T_KELVIN_MEDIAN_C or top > T_KELVIN_MAX_C):
             over = y > (T_KELVIN_MAX_C if top > T_KELVIN_MAX_C else T_KELVIN_MEDIAN_C)
             raise error(f"{col} (line {first(over)})", f"{top:g} (median {med:g}) looks like kelvin",
                         "export °C (°C = K - 273.15)")
+        if top > T_KELVIN_MAX_C:
+            raise error(f"{col} (line {first(y > T_KELVIN_MAX_C)})", f"{top:g} °C is above "
+                        f"{T_KELVIN_MAX_C:g} °C while the column's median is {med:g} °C: a "
+                        "broken reading", "check the sensor; leave the cell empty where it did "
+                        "not measure")
         if v.min() < T_MIN_C:
             raise error(f"{col} (line {first(y < T_MIN_C)})", f"{v.min():g} °C is below "
                         f"{T_MIN_C:g} °C", "check the sensor and export temperatures in °C")

@@ -190,6 +190,9 @@ ERRORS = [
      "T1_C (line 2)", "looks like kelvin"),
     ("kelvin one", HEADER, lambda ls: ls[:30] + [row(1800, ts="300")] + ls[31:], "T_stator_C (line 32)",
      "300 (median 30) looks like kelvin"),
+    # 5000 K is no bench temperature either: a broken reading, not a unit
+    ("spike", HEADER, lambda ls: ls[:30] + [row(1800, t1="5000")] + ls[31:], "T1_C (line 32)",
+     "5000 °C is above 250 °C while the column's median is 22 °C: a broken reading"),
     ("too cold", HEADER, lambda ls: ls[:7] + [row(420, cool="-80")] + ls[8:], "T_coolant_C (line 9)",
      "-80 °C is below -60 °C"),
     ("speed high", HEADER, lambda ls: ls[:7] + [row(420, speed="258000")] + ls[8:], "speed_rpm (line 9)",
