@@ -557,8 +557,8 @@ def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error:
         y = columns[col]
         v = y[~np.isnan(y)]
         med, top = float(np.median(v)), float(v.max())
-        # above the range in °C: kelvin where it is a plausible temperature in kelvin (the
-        # median, or a reading that is one less 273.15), a broken reading where it is not
+        # above the range in °C: kelvin where the median is, or where the reading less 273.15
+        # is a plausible temperature in °C; a broken reading where it is not
         as_celsius = top - 273.15
         kelvin = med > T_KELVIN_MEDIAN_C or T_MIN_C <= as_celsius <= T_KELVIN_MEDIAN_C
         if kelvin and (med > T_KELVIN_MEDIAN_C or top > T_KELVIN_MAX_C):

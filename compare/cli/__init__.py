@@ -115,21 +115,21 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     except Exception as exc:  # a bug, not the user's input: one line, the traceback in a file
         print(f"spindle-verify: internal error: {type(exc).__name__}: {exc}; this is a bug, "
-              f"not your input: please report it with the command and {_crash_file(exc)}",
+              f"not your input: please report it with the command and {_crash_file(exc, argv)}",
               file=sys.stderr)
         return 1
 
 
-def _crash_file(exc: BaseException) -> str:
-    """The traceback of ``exc`` written to a new file in the temporary folder; its path (or
-    where it could not be written)."""
+def _crash_file(exc: BaseException, argv: list[str] | None) -> str:
+    """The command ``argv`` and the traceback of ``exc`` written to a new file in the
+    temporary folder: where to find them."""
     import tempfile
     import traceback
 
     try:
         fd, path = tempfile.mkstemp(prefix="spindle-verify-crash-", suffix=".txt")
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(f"spindle-verify {' '.join(sys.argv[1:])}\n")
+            f.write(f"spindle-verify {' '.join(sys.argv[1:] if argv is None else argv)}\n")
             f.write("".join(traceback.format_exception(exc)))
         return f"the traceback in {path}"
     except OSError:

@@ -327,8 +327,9 @@ class Calibrator:
         J = sol.jac[:n]  # the data rows: the intervals say what this run alone determines
         penalty = 0.5 * float(np.sum(self._prior_terms(params, free, sol.x) ** 2))
         ci, corr, ident = _intervals(J, r_all, n, n_eff, free, params, sol.x)
-        return Fit(tuple(effects), theta, free, ci, corr, ident, concentrated_loglik(res.values()), n, n_eff,
-                   out, self.errors(out), time.perf_counter() - t0, nfev, penalty)
+        return Fit(tuple(effects), theta, free, ci, corr, ident,
+                   concentrated_loglik(res.values()), n, n_eff, out, self.errors(out),
+                   time.perf_counter() - t0, nfev, penalty)
 
 
 def over_tolerance(window_errors: Mapping[str, Mapping[str, float]]) -> dict[str, float]:
