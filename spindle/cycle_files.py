@@ -179,7 +179,7 @@ def _generated_temperature(f: _File, d: dict[str, Any], key: str, model: str,
 
 def _read_text(path: Path, f: _File) -> str:
     try:
-        return path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8-sig")  # a BOM (some editors write one) is no text
     except (OSError, UnicodeDecodeError) as exc:
         raise f.error("file", f"cannot be read ({exc})",
                       "check the path and that the file is UTF-8 text") from None

@@ -47,15 +47,23 @@ def drive_for(spec: Spec) -> Drive | None:
                      "relative to the spec's folder (format: docs/power.md)")
 
 
-def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None) -> LoadCase:
+def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None,
+                    where: str | None = None) -> LoadCase:
     """The LoadCase of ``cycle`` on ``spec``: speeds, ambient and coolant from the cycle;
     heat sources from the drive's power balance per step (or, without a drive, the spec's
-    own constant sources)."""
+    own constant sources). ``where``: the cycle's file or name, for messages."""
     drive = drive if drive is not None else drive_for(spec)
     if drive is None:
         return cycle.to_load_case(spec)
     starts = tuple(float(t) for t in cycle.boundaries_s[:-1])
-    heats = [drive.heat_W(s.speed_rpm, s.load_torque_Nm, s.power_kW) for s in cycle.steps]
+    heats = []
+    for i, s in enumerate(cycle.steps):
+        try:
+            heats.append(drive.heat_W(s.speed_rpm, s.load_torque_Nm, s.power_kW))
+        except ValueError as exc:  # a step the power balance cannot close (P_el < M omega)
+            raise InputError(where or f"cycle {cycle.name}", f"steps[{i}]", str(exc),
+                             "give the step a power_kW above its mechanical power M omega, or "
+                             "leave power_kW out (the motor model then gives the losses)") from None
     names = {h.name for h in spec.heat_sources}
     missing = set(heats[0]) - names
     if missing:
@@ -84,9 +92,9 @@ def load_case(spec: Spec, name_or_path: str | Path, base: LoadCase | None = None
     what the file leaves out taken from ``base``, by default the spec's own load case)."""
     path = Path(name_or_path)
     if path.suffix.lower() == ".csv" and path.is_file():
-        header = next((ln for ln in path.read_text(encoding="utf-8", errors="replace").splitlines()
+        header = next((ln for ln in path.read_text(encoding="utf-8-sig", errors="replace").splitlines()
                        if ln.strip() and not ln.lstrip().startswith("#")), "")
         if "time_s" in [h.strip() for h in header.split(",")]:
             return read_cycle_csv(path, [h.name for h in spec.heat_sources],
                                   base if base is not None else spec.default_load_case())
-    return cycle_load_case(spec, load_cycle(name_or_path))
+    return cycle_load_case(spec, load_cycle(name_or_path), where=str(name_or_path))

@@ -108,32 +108,37 @@ class Field:
     required: bool = True
 
 
+# Upper (and some lower) bounds are not plausibility: they are a hundred to a thousand times
+# beyond any motor spindle's value (the shipped spl2782's in brackets), so that a unit slip
+# or a stray exponent is refused by name instead of overflowing the power balance.
 DRIVE_FIELDS = (Field("T_winding_K", "K", lo=200.0, hi=700.0),)
-NOMINAL_FIELDS = (Field("speed_rpm", "rpm", lo=0.0, lo_open=True),
-                  Field("P_mech_W", "W", lo=0.0),
-                  Field("losses_W", "W", lo=0.0, required=False))
-MOTOR_FIELDS = (Field("R20_ohm", "ohm", lo=0.0, lo_open=True),
-                Field("kT_Nm_A", "N m/A", lo=0.0, lo_open=True),
-                Field("pole_pairs", "-", lo=1.0, whole=True),
-                Field("k_h_W_HzT2", "W/(Hz T2)", lo=0.0),
-                Field("k_e_W_Hz2T2", "W/(Hz2 T2)", lo=0.0),
-                Field("B_T", "T", lo=0.0),
-                Field("phases", "-", lo=1.0, whole=True, required=False),
+NOMINAL_FIELDS = (Field("speed_rpm", "rpm", lo=0.0, lo_open=True, hi=1e5),  # as a bench's
+                  Field("P_mech_W", "W", lo=0.0, hi=1e7),  # 10 MW (38 kW)
+                  Field("losses_W", "W", lo=0.0, hi=1e7, required=False))
+MOTOR_FIELDS = (Field("R20_ohm", "ohm", lo=0.0, lo_open=True, hi=100.0),  # (0.195)
+                Field("kT_Nm_A", "N m/A", lo=0.01, hi=100.0),  # (1.2)
+                Field("pole_pairs", "-", lo=1.0, hi=64.0, whole=True),  # (4)
+                Field("k_h_W_HzT2", "W/(Hz T2)", lo=0.0, hi=1e3),  # (0.6)
+                Field("k_e_W_Hz2T2", "W/(Hz2 T2)", lo=0.0, hi=10.0),  # (0.003)
+                Field("B_T", "T", lo=0.0, hi=5.0),  # electrical steel saturates near 2 T (1.5)
+                Field("phases", "-", lo=1.0, hi=12.0, whole=True, required=False),
                 Field("rotor_loss_share", "-", lo=0.0, hi=1.0, required=False),
-                Field("alpha_cu_1_K", "1/K", lo=0.0, required=False))
-BEARING_FIELDS = (Field("f0", "-", lo=0.0, lo_open=True),
+                Field("alpha_cu_1_K", "1/K", lo=0.0, hi=0.1, required=False))  # (0.00393)
+BEARING_FIELDS = (Field("f0", "-", lo=0.0, lo_open=True, hi=100.0),  # Palmgren's 1-10 (0.26)
                   # 2 m catches a pitch diameter given in mm
                   Field("dm_m", "m", lo=0.0, lo_open=True, hi=2.0),
-                  Field("nu_mm2_s", "mm2/s", lo=0.0, lo_open=True),
-                  Field("preload_N", "N", lo=0.0),
-                  Field("C0_N", "N", lo=0.0, lo_open=True),
-                  Field("count", "-", lo=1.0, whole=True, required=False),
+                  Field("nu_mm2_s", "mm2/s", lo=0.0, lo_open=True, hi=1e5),  # (12)
+                  Field("preload_N", "N", lo=0.0, hi=1e6),  # (300-400)
+                  # 100 N catches a rating given in kN (40-52 kN)
+                  Field("C0_N", "N", lo=100.0, hi=1e8),
+                  Field("count", "-", lo=1.0, hi=64.0, whole=True, required=False),
                   Field("inner_ring_share", "-", lo=0.0, hi=1.0, required=False))
 TEXT_KEYS = ("name", "source")
 DRIVE_KEYS = ("name", "description", "T_winding_K")
 TABLES = ("drive", "nominal", "motor", "bearings")
 #: A unit slip that a range check most likely caught, named in the fix.
-UNIT_SLIPS = {"T_winding_K": " (in K: 120 degC is 393.15 K)", "dm_m": " (in m: 115 mm is 0.115 m)"}
+UNIT_SLIPS = {"T_winding_K": " (in K: 120 degC is 393.15 K)", "dm_m": " (in m: 115 mm is 0.115 m)",
+              "C0_N": " (in N: 40 kN is 40000 N)"}
 #: Heat-source names the motor feeds; a bearing set cannot take them.
 MOTOR_SOURCES = ("stator", "rotor")
 

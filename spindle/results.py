@@ -15,15 +15,24 @@ from spindle.units import ZERO_C_K
 MAX_RELATIVE_IMBALANCE = 1e-3
 
 
+#: iron melts at 1811 K: a solid model's temperature above it is no result, it is a unit or
+#: an exponent off in the spec (a conductivity in kW/(m K), a source of 1e300 W)
+T_MELT_K = 1811.0
+
+
 def check_plausible(T_K: np.ndarray, relative_imbalance: float, file: str) -> None:
     """Refuse a result that cannot be physical before anything is written: temperatures that
-    are not finite or not above 0 K, or an energy balance that does not close."""
+    are not finite, not above 0 K or above iron's melting point, or an energy balance that
+    does not close."""
     T = np.asarray(T_K, dtype=float)
-    if not np.isfinite(T).all() or T.min() <= 0.0:
-        bad = "not finite" if not np.isfinite(T).all() else f"down to {T.min():.4g} K"
+    if not np.isfinite(T).all() or T.min() <= 0.0 or T.max() > T_MELT_K:
+        bad = ("not finite" if not np.isfinite(T).all() else f"down to {T.min():.4g} K"
+               if T.min() <= 0.0 else f"up to {T.max():.4g} K, above the melting point of iron "
+               f"({T_MELT_K:g} K)")
         raise SolverError(f"{file}: result: the temperatures are {bad}, which is not physical; "
-                          "fix: check the spec's conductances, films and sources for values "
-                          "many orders of magnitude off (docs/spec.md lists plausible ranges)")
+                          "fix: check the spec's conductances, films and sources, and the cycle's "
+                          "loads and heat, for values many orders of magnitude off (docs/spec.md "
+                          "lists plausible ranges)")
     if not relative_imbalance <= MAX_RELATIVE_IMBALANCE:
         raise SolverError(f"{file}: result: the energy balance is off by "
                           f"{relative_imbalance:.2g} of the heat flows (limit "

@@ -250,8 +250,10 @@ class FieldReader:
                 table = power.air_gap_film_table(*args)
             else:
                 table = SpeedTable.constant(power.h_coolant_channel_W_m2K(*args))
-        except ValueError as exc:
-            self.add(path, f"the correlation cannot be evaluated ({exc})",
+        except (ValueError, ArithmeticError) as exc:
+            why = ("a parameter is so large that the correlation overflows" if
+                   isinstance(exc, ArithmeticError) else str(exc))  # e.g. d_m = 1e300
+            self.add(path, f"the correlation cannot be evaluated ({why})",
                      "check the parameters against the correlation's range in docs/power.md")
             return None
         return SpeedTable(table.speed_rpm, tuple(factor * h for h in table.values))

@@ -1,5 +1,6 @@
 """The command line: outputs, messages and exit status 2 for bad input."""
 
+import argparse
 import json
 import subprocess
 import sys
@@ -217,3 +218,51 @@ def test_an_internal_error_is_one_line_with_the_traceback_in_a_file(tmp_path, mo
     crash = next(tmp_path.glob("spindle-verify-crash-*.txt"))
     assert crash.name in err and "RuntimeError: boom" in crash.read_text(encoding="utf-8")
     assert not out.exists()
+
+
+def test_synth_on_a_spec_without_a_drive_or_p1_names_what_it_needs(tmp_path):
+    """synth writes a bench run: its power column needs the spec's drive (fin-shaft has none);
+    it was an internal error (a KeyError or an AttributeError) before."""
+    r = run("synth", "--spec", "fin-shaft", "--level", "0", "--cycle", "nominal", "--out",
+            str(tmp_path / "run.csv"))
+    assert r.returncode == 2 and "power_balance.preset" in r.stderr and "fix:" in r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "run.csv").exists()
+
+
+def test_an_output_path_the_system_refuses_is_named_exit_2(tmp_path):
+    """A folder name longer than the file system allows (255 bytes) is the user's path, not a
+    bug: one line naming it, exit 2."""
+    out = tmp_path / ("y" * 300)
+    r = run("solve", "fin-shaft", "--model", "lumped", "--no-pictures", "--out", str(out))
+    assert r.returncode == 2 and "File name too long" in r.stderr and "fix:" in r.stderr
+    assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+
+
+def test_a_result_above_the_melting_point_of_iron_is_refused(tmp_path):
+    """The fin-shaft with its radius in a thousandth of its millimetres (1e-6 m): its 60 W
+    have nowhere to go, and the lumped model ends above 1e6 K. Such a result is a slip in the
+    spec, not a temperature: refused by name, exit 2, nothing written (it was written with
+    exit 0 before)."""
+    text = (Path(__file__).resolve().parents[1] / "spindle" / "data" / "specs"
+            / "fin-shaft.toml").read_text(encoding="utf-8")
+    assert "r_outer = 0.025" in text
+    spec = tmp_path / "thin.toml"
+    spec.write_text(text.replace("r_outer = 0.025", "r_outer = 1e-6"), encoding="utf-8")
+    out = tmp_path / "o"
+    r = run("solve", str(spec), "--model", "lumped", "--no-pictures", "--out", str(out))
+    assert r.returncode == 2 and "melting point of iron" in r.stderr and "fix:" in r.stderr
+    assert not out.exists()
+
+
+def test_a_node_count_beyond_the_bound_is_refused_before_any_work(tmp_path):
+    """--nodes 100000 (a typo) ran for hours; the bound is lumped.build.MAX_NODES, which the
+    parser's NODE_COUNT repeats (it does not import numpy)."""
+    from compare.cli.common import NODE_COUNT
+    from lumped.build import MAX_NODES
+
+    assert NODE_COUNT(str(MAX_NODES)) == MAX_NODES
+    with pytest.raises(argparse.ArgumentTypeError):
+        NODE_COUNT(str(MAX_NODES + 1))
+    r = run("solve", "fin-shaft", "--model", "lumped", "--nodes", "100000", "--out",
+            str(tmp_path / "o"))
+    assert r.returncode == 2 and "--nodes" in r.stderr and "2..1000" in r.stderr

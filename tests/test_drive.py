@@ -237,3 +237,50 @@ def test_friction_exponent_scales_the_bearing_friction_with_speed():
     for k in ("front_bearing", "rear_bearing"):
         assert got[k] == pytest.approx(ref[k], rel=1e-12)
     assert drive.with_friction_exponent(0.0).heat_W(6000.0) == drive.heat_W(6000.0)
+
+
+@pytest.mark.parametrize("old, new, field, words", [
+    # a stray exponent overflowed the power balance (found by fuzzing the drive file)
+    ("f0 = ", "f0 = 1e200 # ", "bearings.front_bearing.f0", "out of range"),
+    ("B_T = 1.2", "B_T = 1e200", "motor.B_T", "out of range"),
+    ("kT_Nm_A = 0.8", "kT_Nm_A = 1e-300", "motor.kT_Nm_A", "out of range"),
+    # a static load rating given in kN: the preload over C0 made a torque of 1e98 N m
+    ("C0_N = ", "C0_N = 40.0 # ", "bearings.front_bearing.C0_N", "out of range"),
+])
+def test_drive_values_beyond_any_spindle_are_refused_by_name(tmp_path, old, new, field, words):
+    """The bounds sit a hundred to a thousand times beyond any motor spindle's value
+    (spindle/drive_file.py), so an absurd value is named instead of overflowing."""
+    assert old in SMALL_DRIVE
+    path = tmp_path / "d.toml"
+    path.write_text(SMALL_DRIVE.replace(old, new, 1))
+    with pytest.raises(SpecError) as err:
+        read_drive_toml(path)
+    by_field = {p.field: p for p in err.value.problems}
+    assert field in by_field and words in by_field[field].message
+    if field.endswith("C0_N"):
+        assert "40000 N" in by_field[field].fix
+
+
+def test_a_cycle_step_whose_power_is_below_its_mechanical_power_names_the_step(tmp_path):
+    """P_el < M omega cannot close the power balance: the cycle file and its step are named
+    (it was an internal error before)."""
+    path = tmp_path / "c.toml"
+    path.write_text('[cycle]\nname = "c"\nsteps = [\n  { speed_rpm = 1000.0, duration_h = 1.0 },\n'
+                    '  { speed_rpm = 4000.0, duration_h = 1.0, load_torque_Nm = 100, '
+                    'power_kW = 1.0 },\n]\n', encoding="utf-8")
+    from spindle.drive import load_case
+
+    with pytest.raises(InputError) as err:
+        load_case(load_spec("spl2782"), path)
+    p = err.value.problem
+    assert p.file == str(path) and p.field == "steps[1]" and "mechanical power" in p.message
+    assert "power_kW" in p.fix
+
+
+def test_a_cycle_file_with_a_byte_order_mark_is_read(tmp_path):
+    """Some editors save UTF-8 with a byte-order mark; the cycle is read as without it."""
+    text = '[cycle]\nname = "c"\nsteps = [ { speed_rpm = 1000.0, duration_h = 1.0 } ]\n'
+    plain, marked = tmp_path / "a.toml", tmp_path / "b.toml"
+    plain.write_text(text, encoding="utf-8")
+    marked.write_text(text, encoding="utf-8-sig")
+    assert load_cycle(marked).steps == load_cycle(plain).steps

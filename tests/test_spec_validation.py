@@ -158,6 +158,12 @@ def test_film_from_a_correlation(tmp_path):
     assert any(p.field == "surfaces[0].h_W_m2K.correlation" for p in problems(tmp_path, bad))
     bad = GOOD.replace("h_W_m2K = 10.0", 'h_W_m2K = { correlation = "air_gap", d_m = 0.08 }')
     assert any("not a parameter" in p.message for p in problems(tmp_path, bad))
+    # a diameter of 1e300 m overflowed the correlation's Rayleigh number (d^3): a problem of
+    # the field, not an internal error
+    bad = GOOD.replace("h_W_m2K = 10.0",
+                       'h_W_m2K = { correlation = "rotating_shaft", d_m = 1e300 }')
+    assert any(p.field == "surfaces[0].h_W_m2K" and "overflows" in p.message
+               for p in problems(tmp_path, bad))
 
 
 def test_python_api_takes_a_spec_name_or_path():

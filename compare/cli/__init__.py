@@ -113,6 +113,11 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`, which closed early
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as exc:  # a path the system refuses (too long, no permission, disk full)
+        what = exc.filename if exc.filename is not None else "a file"
+        print(f"spindle-verify: error: {what}: {exc.strerror or exc}; fix: check the path (its "
+              "length, its folder's permissions) and the free disk space", file=sys.stderr)
+        return 2
     except Exception as exc:  # a bug, not the user's input: one line, the traceback in a file
         print(f"spindle-verify: internal error: {type(exc).__name__}: {exc}; this is a bug, "
               f"not your input: please report it with the command and {_crash_file(exc, argv)}",

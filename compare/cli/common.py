@@ -50,7 +50,7 @@ SPEED_RPM = number(0.0, 100_000.0, unit="rpm")  # spindle.units.SPEED_MAX_RPM
 MESH_LEVEL = number(0, 6, integer=True)  # level 6 of spl2782: 5.6 million elements
 POSITIVE = number(0.0, lo_open=True)
 WORKERS = number(1, 256, integer=True)
-NODE_COUNT = number(2, 1000, integer=True)
+NODE_COUNT = number(2, 1000, integer=True)  # lumped.build.MAX_NODES (not imported: numpy)
 
 
 def add_spec(parser: argparse.ArgumentParser) -> None:

@@ -239,8 +239,18 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
     from spindle.cycle_files import load_cycle
     from spindle.cycles import RANDOM_CYCLES, drawn_cycle
     from spindle.drive import cycle_load_case, drive_for
+    from spindle.errors import InputError
     from spindle.outputs import atomic_write
 
+    if drive_for(spec) is None:  # before any work: the bench logs the drive's power
+        raise InputError(spec.path, "power_balance.preset", "synth writes a bench run, whose "
+                         "power_kW column comes from the spec's drive, and this spec names none",
+                         "add [power_balance] preset = <drive> to the spec, or use spl2782")
+    if "P1" not in spec.growth_points():
+        raise InputError(spec.path, "sensors", "synth writes a bench run with P1, and this spec "
+                         "has no axial-displacement sensor named P1",
+                         "add a [[sensors]] entry with name = \"P1\" and kind = "
+                         "\"axial_displacement\" (docs/spec.md)")
     names = [effect] if isinstance(effect, str) else list(effect)
     names = [n for n in names if n != "clean"]
     for n in names:
