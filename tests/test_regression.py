@@ -93,3 +93,31 @@ def test_shipped_baselines_still_hold(name, capsys):
     path = f"tests/baselines/{name}.json"
     status = main(["check", path, "--quiet"])
     assert status == 0, capsys.readouterr().out
+
+
+@pytest.mark.parametrize("path, value, field", [
+    # a NaN tolerance passed every moved figure ("all within their tolerances", exit 0)
+    (("tolerances", "temperature_K"), float("nan"), "tolerances.temperature_K"),
+    (("figures", "steady/lumped 11/err_shaft_max_K"), "a", "figures.steady/lumped 11"),
+    (("settings", "levels"), [0, 1], "settings.levels"),  # a GCI needs three
+    (("settings", "levels"), "0 1 2", "settings.levels"),
+    (("settings", "nodes"), [10 ** 8], "settings.nodes"),  # ran for hours
+    (("settings", "transient"), "no", "settings.transient"),  # text is true in Python
+    (("spec",), 5, "spec"),
+])
+def test_a_baseline_field_of_the_wrong_type_or_range_is_named(baseline, tmp_path, path, value,
+                                                              field):
+    """Each of these was an internal error (TypeError, IndexError, ValueError) or a false
+    pass before; found by fuzzing the baseline file."""
+    doc = json.loads(baseline.read_text())
+    *outer, key = path
+    target = doc
+    for k in outer:
+        target = target[k]
+    target[key] = value
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(doc))
+    with pytest.raises(InputError) as err:
+        read_baseline(bad)
+    assert err.value.problem.field.startswith(field)
+    assert main(["check", str(bad), "--quiet"]) == 2

@@ -119,8 +119,9 @@ def read_baseline(path: str | Path) -> dict:
     path = Path(path)
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise InputError(str(path), "file", f"cannot be read ({exc.strerror})",
+    except (OSError, UnicodeDecodeError) as exc:
+        why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
+        raise InputError(str(path), "file", f"cannot be read ({why})",
                          "give the file written by 'spindle-verify baseline'") from None
     except json.JSONDecodeError as exc:
         raise InputError(str(path), f"line {exc.lineno}", f"is not valid JSON ({exc.msg})",
@@ -132,12 +133,55 @@ def read_baseline(path: str | Path) -> dict:
     for key in ("spec", "settings", "tolerances", "figures"):
         if key not in doc:
             raise InputError(str(path), key, "is missing", "write a new baseline")
-    tol = doc["tolerances"]
-    for key in ("temperature_K", "growth_um", "gci_pct"):
-        if not isinstance(tol.get(key), int | float) or tol[key] < 0:
-            raise InputError(str(path), f"tolerances.{key}", "must be a number >= 0",
-                             f"set it, e.g. {DEFAULT_TOLERANCES[key]}")
+    _check_contents(doc, lambda fld, message, fix="write a new baseline with 'spindle-verify "
+                    "baseline SPEC --out FILE'": InputError(str(path), fld, message, fix))
     return doc
+
+
+def _check_contents(doc: dict, refuse: Callable[..., InputError]) -> None:
+    """Every field ``check`` reads has its type and range (``refuse(field, message[, fix])``
+    makes the error): a NaN tolerance passed every figure, a figure of text was a TypeError."""
+    tol = doc["tolerances"]
+    if not isinstance(tol, dict):
+        raise refuse("tolerances", "must be a table of numbers")
+    for key in ("temperature_K", "growth_um", "gci_pct"):
+        if not _number(tol.get(key)) or tol[key] < 0:
+            raise refuse(f"tolerances.{key}", "must be a finite number >= 0",
+                         f"set it, e.g. {DEFAULT_TOLERANCES[key]}")
+    if not isinstance(doc["spec"], str):
+        raise refuse("spec", "must be the spec's name or path (text)")
+    figs = doc["figures"]
+    if not isinstance(figs, dict) or not figs:
+        raise refuse("figures", "must be a non-empty table of figures")
+    bad = next((k for k, v in figs.items() if v is not None and not _number(v)), None)
+    if bad is not None:
+        raise refuse(f"figures.{bad}", f"{figs[bad]!r} is not a finite number")
+    settings = doc["settings"]
+    if not isinstance(settings, dict):
+        raise refuse("settings", "must be a table")
+    settings = {**DEFAULT_SETTINGS, **settings}
+    # the study's own ranges: mesh levels 0..6 (three or more for a GCI), lumped nodes 2..1000
+    levels, nodes = settings["levels"], settings["nodes"]
+    if not _integers(levels, 0, 6) or len(set(levels)) < 3:
+        raise refuse("settings.levels", f"{levels!r} is not three or more mesh levels 0..6")
+    if not _integers(nodes, 2, 1000) or not nodes:
+        raise refuse("settings.nodes", f"{nodes!r} is not a list of node counts 2..1000")
+    for key in ("dt_s", "threshold_pct"):
+        if not _number(settings[key]) or settings[key] <= 0:
+            raise refuse(f"settings.{key}", f"{settings[key]!r} is not a number > 0")
+    if not isinstance(settings["transient"], bool):
+        raise refuse("settings.transient", f"{settings['transient']!r} is not true or false")
+
+
+def _integers(v: object, lo: int, hi: int) -> bool:
+    """Whether ``v`` is a list of whole numbers in lo..hi."""
+    return isinstance(v, list) and all(isinstance(x, int) and not isinstance(x, bool)
+                                       and lo <= x <= hi for x in v)
+
+
+def _number(v: object) -> bool:
+    """Whether ``v`` is a finite JSON number (not a boolean)."""
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
 
 
 def check(doc: dict, figures: dict | None = None,
