@@ -266,3 +266,17 @@ def test_a_node_count_beyond_the_bound_is_refused_before_any_work(tmp_path):
     r = run("solve", "fin-shaft", "--model", "lumped", "--nodes", "100000", "--out",
             str(tmp_path / "o"))
     assert r.returncode == 2 and "--nodes" in r.stderr and "2..1000" in r.stderr
+
+
+def test_rom_on_a_spec_without_growth_readings_and_a_steady_training_case(tmp_path):
+    """fin-shaft has no P1: its ROM has temperatures only (the held-out rows stacked an empty
+    growth array and raised); a steady case cannot train a ROM (no snapshots in time): named,
+    exit 2 (it was an IndexError)."""
+    out = tmp_path / "rom"
+    r = run("rom", "fin-shaft", "--level", "0", "--no-pictures", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    assert json.loads((out / "rom.json").read_text(encoding="utf-8"))
+    r = run("rom", "fin-shaft", "--level", "0", "--cycle", "nominal", "--no-pictures", "--out",
+            str(tmp_path / "steady"))
+    assert r.returncode == 2 and "--cycle" in r.stderr and "steady case" in r.stderr
+    assert not (tmp_path / "steady").exists()

@@ -150,6 +150,7 @@ def rom_study(spec, level: int, training: str, held_out: Sequence[str], dt_s: fl
               tol_temp_K: float, tol_growth_um: float, safety: float,
               progress: Callable[[str], None] | None = None) -> ROMStudy:
     from reference import ReferenceModel
+    from spindle.errors import InputError
 
     say = progress or (lambda _m: None)
     t0 = time.perf_counter()
@@ -157,6 +158,11 @@ def rom_study(spec, level: int, training: str, held_out: Sequence[str], dt_s: fl
     ref = ReferenceModel(spec, level)
     name, seed = parse_cycle(training)
     train = named_case(ref.spec, name, seed)
+    if train.duration_s == 0:  # a steady case has no snapshots in time to reduce
+        raise InputError("command line", "--cycle", f"'{training}' is a steady case; a ROM is "
+                         "trained on a cycle that runs in time",
+                         "train on a transient cycle, e.g. random-loaded (the default) or "
+                         "spl-16h; a steady case may be held out (--held-out nominal)")
     rom, report = build_rom(ref, train, dt_s, tol_temp_K, tol_growth_um, safety=safety,
                             level=level, progress=say)
     full = full_system(ref)
@@ -178,7 +184,8 @@ def rom_study(spec, level: int, training: str, held_out: Sequence[str], dt_s: fl
         _, Y_ref = fem_transient(full, case, dt_s)
         t2 = time.perf_counter()
         res = rom.transient(case, dt_s)
-        Y = np.hstack([res.sensor_K, np.array([res.growth_m[k] for k in rom.readings]).T])
+        growth = np.array([res.growth_m[k] for k in rom.readings]).T  # none: a spec without P1
+        Y = np.hstack([res.sensor_K, growth.reshape(len(res.sensor_K), len(rom.readings))])
         err = output_errors(full, Y, Y_ref)
         rows.append(HeldOut(case.name, "transient", err, t2 - t1, res.runtime_s,
                             res.error_estimate))
