@@ -17,7 +17,7 @@ import numpy as np
 
 from spindle.commented_csv import CommentedCsv, split_commented_csv
 from spindle.errors import InputError
-from spindle.units import CYCLE_MAX_S, MAX_SERIES_POINTS, SPEED_MAX_RPM, ZERO_C_K
+from spindle.units import CYCLE_MAX_S, MAX_SERIES_POINTS, POWER_MAX_KW, SPEED_MAX_RPM, ZERO_C_K
 
 Interpolation = Literal["linear", "previous"]
 
@@ -222,8 +222,20 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
                                  f"{data[col][out[0]]:g} is outside -60..200 degC",
                                  "give temperatures in degrees Celsius (not kelvin)")
             case = replace(case, **{attr: series(col, ZERO_C_K)})
+    for col in (f"{s}_W" for s in source_names if f"{s}_W" in data):
+        # a loss is heat into the spindle: >= 0, and below the 1000 kW a bench logs at most
+        out = [k for k, v in enumerate(data[col]) if not 0.0 <= v <= SOURCE_MAX_W]
+        if out:
+            raise InputError(name, f"{col} (line {line_no[out[0] + 1]})",
+                             f"{data[col][out[0]]:g} W is outside 0..{SOURCE_MAX_W:g} W",
+                             "give the heat the source puts into the spindle, in W (a loss is "
+                             "never negative)")
     sources = {s: series(f"{s}_W") for s in source_names if f"{s}_W" in data}
     return case.with_sources(sources)
+
+
+#: the largest heat a cycle CSV may give one source [W]: a bench's power limit
+SOURCE_MAX_W = POWER_MAX_KW * 1e3
 
 
 def _check_cycle_header(name: str, header: list[str], source_names: list[str]) -> None:

@@ -82,6 +82,9 @@ def test_solve_cycle(tmp_path, capsys):
     ("speed_rpm\n0\n", "duration_s: required column is missing"),  # read as a step table
     ("time_s,torque_Nm\n0,1\n10,1\n", "torque_Nm: is not a cycle column"),
     ("time_s,T_env_C\n0,293\n10,293\n", "outside -60..200 degC"),
+    # a negative loss ended the stator at -83 degC with exit 0; 1e300 W overflowed
+    ("time_s,Q1_rear_bearing_A_W\n0,-5000\n10,0\n", "-5000 W is outside 0..1e+06 W"),
+    ("time_s,Q1_rear_bearing_A_W\n0,1e300\n10,0\n", "1e+300 W is outside 0..1e+06 W"),
 ])
 def test_bad_cycle_exits_2(tmp_path, content, words):
     cycle = tmp_path / "bad.csv"
