@@ -10,7 +10,8 @@ Each case writes its files into a fresh folder, runs one command with ``--out`` 
 records: the exit status; whether an exception escaped (a traceback); the number of message
 lines on stderr and whether the first names a field and a fix; the seconds it took; whether an
 input changed; whether anything was written on a refusal; and, for a run that succeeded,
-whether its summary holds an impossible result (a temperature at or below 0 K, or NaN).
+whether its summary holds an impossible result (a temperature at or below 0 K, above iron's
+melting point, or NaN).
 Spec mutations that happen to be valid run a level-0 solve and count as accepted. Prints the
 counts; the issue's figures: 100 % of the refused cases clean (exit 2, one line naming field
 and fix), 0 tracebacks, 0 runs past 60 s, 0 impossible results written, 0 inputs modified.
@@ -34,6 +35,8 @@ from pathlib import Path
 
 from figures import write_figures
 from verdicts import run_verdicts
+
+from spindle.results import T_MELT_K
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "spindle" / "data" / "specs"
@@ -186,7 +189,8 @@ def run_case(case: dict) -> dict:
             text = summary.read_text(encoding="utf-8")
             doc = json.loads(text)
             temps = [v for v in (doc.get("sensors_C") or {}).values() if v is not None]
-            impossible = "NaN" in text or any(v <= -273.15 for v in temps)
+            impossible = "NaN" in text or any(not -273.15 < v <= T_MELT_K - 273.15
+                                              for v in temps)
     first = lines[0] if lines else ""
     row = {"kind": case["kind"], "label": case["label"], "exit": code, "traceback": traceback,
            "lines": len(lines), "seconds": round(seconds, 2),
