@@ -510,8 +510,14 @@ class _Builder:
         of every named surface (for the surface heat sources)."""
         faces = exposed_faces(self.spec)
         surface_map: dict[str, list[tuple[Mass, float, float]]] = {}
+        empty = []
         for s in self.spec.surfaces:
             surface_map[s.name] = [p for f in surface_faces(s, faces, self.spec) for p in self.face_pieces(f)]
+            if not surface_map[s.name]:  # its film or its source would vanish unseen
+                empty.append(Problem(self.spec.path, f"surfaces.{s.name}", "selects no exposed "
+                                     f"boundary of {list(s.parts)} (side '{s.side}', z "
+                                     f"{s.z_min:g}..{s.z_max:g} m)", "check side and z limits: "
+                                     "surfaces that touch another part are not exposed"))
             if s.h_W_m2K is None:
                 continue
             grouped: dict[str, list[tuple[float, float]]] = {}
@@ -522,6 +528,8 @@ class _Builder:
                 c = self.net.add(Convection(f"film:{s.name}:{mname}", Gc_W_K=_film(s.h_W_m2K, pcs)))
                 self.net.connect(self.by_name[mname].block.port, c.port_a)
                 self.net.connect(self.fixed(s.T_ref), c.port_b)
+        if empty:  # as the FEM's mesh refuses them (meshes.build)
+            raise SpecError(empty)
         return surface_map
 
     # ------------------------------------------------------------------ sources

@@ -283,3 +283,17 @@ def test_rom_on_a_spec_without_growth_readings_and_a_steady_training_case(tmp_pa
             str(tmp_path / "steady"))
     assert r.returncode == 2 and "--cycle" in r.stderr and "steady case" in r.stderr
     assert not (tmp_path / "steady").exists()
+
+
+def test_the_lumped_model_refuses_a_surface_that_selects_nothing_as_the_fem_does(tmp_path):
+    """fin-shaft's rear face asked on the bore side of a solid shaft: no face. The FEM's mesh
+    refused it; the lumped model dropped the 15 W source on it unseen (heat in 45 W, not 60)."""
+    text = (Path(__file__).resolve().parents[1] / "spindle" / "data" / "specs"
+            / "fin-shaft.toml").read_text(encoding="utf-8")
+    assert 'side = "rear"' in text
+    spec = tmp_path / "s.toml"
+    spec.write_text(text.replace('side = "rear"', 'side = "inner"', 1), encoding="utf-8")
+    for model in (["--model", "lumped"], ["--level", "0"]):
+        r = run("solve", str(spec), *model, "--no-pictures", "--out", str(tmp_path / "o"))
+        assert r.returncode == 2 and "surfaces.end_A: selects no exposed boundary" in r.stderr
+        assert not (tmp_path / "o").exists()
