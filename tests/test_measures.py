@@ -493,3 +493,25 @@ def test_fig15_spreads_lambdas_near_one_and_survives_a_loss(tmp_path, monkeypatc
         t.get_text() for t in left.get_legend().get_texts()]
     labels = [t.get_text() for t in fig_axes[1].get_yticklabels()]
     assert labels[0].startswith("fins\no 0.08 K, ■ 0.64 K")  # eq. 24: 34.8 * 0.0188 / 1.0188
+
+
+@pytest.mark.parametrize("key, value", [("A_M_m2", 1e300), ("alpha_M_W_m2K", 1e300)])
+def test_a_measure_far_beyond_any_spindle_is_named(tmp_path, body, key, value):
+    """An added surface of 1e300 m2 ran, printed numpy's overflow warnings, and wrote its
+    folder with exit 1; the bounds (100 m2, 1e5 W/(m2 K): compare.design.measure_file) name
+    it instead."""
+    values = {"A_M_m2": 0.01, "alpha_M_W_m2K": 10.0, key: value}
+    p = _write(tmp_path, f"""
+spec = "uniform-body"
+
+[[measure]]
+name = "fins"
+kind = "added_surface"
+surfaces = ["lateral"]
+A_M_m2 = {values["A_M_m2"]}
+alpha_M_W_m2K = {values["alpha_M_W_m2K"]}
+""")
+    with pytest.raises(MeasureFileError) as exc:
+        read_measures(p, body)
+    assert [q.field for q in exc.value.problems] == [f"measure[0].{key}"]
+    assert "is outside 0.." in str(exc.value)

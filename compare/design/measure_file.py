@@ -64,6 +64,10 @@ class MeasureFile:
     sweeps: tuple[SweepSpec, ...] | None = None  # None: derive defaults from the spec
 
 
+#: the largest added surface [m2] and film coefficient [W/(m2 K)] a measure may name
+MAX_AREA_M2 = 100.0
+MAX_FILM_W_M2K = 1e5
+
 _MEASURE_KEYS = ("name", "kind", "description", "surfaces", "A_M_m2", "alpha_M_W_m2K",
                  "alpha_M2_W_m2K")
 
@@ -201,9 +205,13 @@ def _read_measure_list(r: _Reader, data: dict, convective: list[str]) -> list[Me
         surfaces = r.surfaces(d, where, convective)
         uses_A = kind in ("added_surface", "both")
         uses_a2 = kind in ("improved_coefficient", "both")
-        A_M = r.number(d, "A_M_m2", where, "m2", required=uses_A)
-        a_M = r.number(d, "alpha_M_W_m2K", where, "W/m2/K", required=uses_A)
-        a_M2 = r.number(d, "alpha_M2_W_m2K", where, "W/m2/K", required=uses_a2)
+        # bounds far beyond any measure, so that a unit slip or an exponent is named: a
+        # hundred times a motor spindle's whole surface (about 1 m2), and a boiling film
+        A_M = r.number(d, "A_M_m2", where, "m2", required=uses_A, lo=0.0, hi=MAX_AREA_M2)
+        a_M = r.number(d, "alpha_M_W_m2K", where, "W/m2/K", required=uses_A, lo=0.0,
+                       hi=MAX_FILM_W_M2K)
+        a_M2 = r.number(d, "alpha_M2_W_m2K", where, "W/m2/K", required=uses_a2, lo=0.0,
+                        hi=MAX_FILM_W_M2K)
         for key, used in (("A_M_m2", uses_A), ("alpha_M_W_m2K", uses_A),
                           ("alpha_M2_W_m2K", uses_a2)):
             if key in d and not used:
