@@ -297,3 +297,11 @@ def test_the_lumped_model_refuses_a_surface_that_selects_nothing_as_the_fem_does
         r = run("solve", str(spec), *model, "--no-pictures", "--out", str(tmp_path / "o"))
         assert r.returncode == 2 and "surfaces.end_A: selects no exposed boundary" in r.stderr
         assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("option", ["--out", "--cycle", "--case"])
+def test_an_empty_option_is_refused_not_taken_for_its_default(tmp_path, option):
+    """`--out "$DIR"` with DIR unset wrote into the default folder; an empty --cycle or --case
+    was ignored: each is named, exit 2."""
+    r = run("solve", "fin-shaft", "--model", "lumped", option, "")
+    assert r.returncode == 2 and f"{option}: is empty" in r.stderr and "fix:" in r.stderr

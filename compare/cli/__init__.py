@@ -61,6 +61,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _check_args(args: argparse.Namespace) -> None:
+    for name in ("out", "case", "cycle"):  # an unset shell variable: not "the default"
+        if getattr(args, name, None) == "":
+            raise InputError("command line", f"--{name}", "is empty",
+                             f"give a value, or leave --{name} out for its default")
     if not 0 <= getattr(args, "level", 0) <= 6:
         raise InputError("command line", "--level", f"{args.level} is out of range",
                          "give a level between 0 and 6")
