@@ -19,6 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from lumped.build import MAX_NODES
 from spindle.errors import InputError, SpindleVerifyError
 from spindle.units import ZERO_C_K
 
@@ -160,12 +161,12 @@ def _check_contents(doc: dict, refuse: Callable[..., InputError]) -> None:
     if not isinstance(settings, dict):
         raise refuse("settings", "must be a table")
     settings = {**DEFAULT_SETTINGS, **settings}
-    # the study's own ranges: mesh levels 0..6 (three or more for a GCI), lumped nodes 2..1000
+    # the study's own ranges: mesh levels 0..6 (three or more for a GCI), lumped nodes
     levels, nodes = settings["levels"], settings["nodes"]
     if not _integers(levels, 0, 6) or len(set(levels)) < 3:
         raise refuse("settings.levels", f"{levels!r} is not three or more mesh levels 0..6")
-    if not _integers(nodes, 2, 1000) or not nodes:
-        raise refuse("settings.nodes", f"{nodes!r} is not a list of node counts 2..1000")
+    if not _integers(nodes, 2, MAX_NODES) or not nodes:
+        raise refuse("settings.nodes", f"{nodes!r} is not a list of node counts 2..{MAX_NODES}")
     for key in ("dt_s", "threshold_pct"):
         if not _number(settings[key]) or settings[key] <= 0:
             raise refuse(f"settings.{key}", f"{settings[key]!r} is not a number > 0")
