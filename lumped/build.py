@@ -47,7 +47,7 @@ from lumped.blocks import (
 )
 from lumped.network import Network, ThermalSystem
 from spindle.errors import Problem, SpecError
-from spindle.faces import Face, exposed_faces, surface_faces
+from spindle.faces import Face, exposed_faces, no_face_problem, surface_faces
 from spindle.geometry import TOL_M
 from spindle.loads import SpeedTable
 from spindle.spec import BEARING_ROLES, AirGapLink, BearingLink, ContactLink, HeatSource, Part, Section, Spec
@@ -514,10 +514,7 @@ class _Builder:
         for s in self.spec.surfaces:
             surface_map[s.name] = [p for f in surface_faces(s, faces, self.spec) for p in self.face_pieces(f)]
             if not surface_map[s.name]:  # its film or its source would vanish unseen
-                empty.append(Problem(self.spec.path, f"surfaces.{s.name}", "selects no exposed "
-                                     f"boundary of {list(s.parts)} (side '{s.side}', z "
-                                     f"{s.z_min:g}..{s.z_max:g} m)", "check side and z limits: "
-                                     "surfaces that touch another part are not exposed"))
+                empty.append(no_face_problem(self.spec, s))
             if s.h_W_m2K is None:
                 continue
             grouped: dict[str, list[tuple[float, float]]] = {}

@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 from skfem import MeshTri
 
 from spindle.errors import Problem, SpecError
-from spindle.faces import closed_radii
+from spindle.faces import closed_radii, no_face_problem
 from spindle.geometry import TOL_M, Trapezoid
 from spindle.spec import AirGapLink, BearingLink, ContactLink, Material, Spec
 from spindle.spec_reader import as_spec
@@ -309,10 +309,7 @@ def _classify_facets(sm: SpindleMesh) -> None:
                 sel[k] = not any(a + TOL_M < r < b - TOL_M for a, b in closed[key])
         facets = bf[sel]
         if len(facets) == 0:
-            problems.append(Problem(spec.path, f"surfaces.{s.name}", "selects no exposed "
-                                    f"boundary of {list(s.parts)} (side '{s.side}', z "
-                                    f"{s.z_min:g}..{s.z_max:g} m)", "check side and z limits: "
-                                    "surfaces that touch another part are not exposed"))
+            problems.append(no_face_problem(spec, s))
             continue
         if s.h_W_m2K is not None:
             clash = [owner[f] for f in facets if f in owner]

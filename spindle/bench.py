@@ -559,9 +559,8 @@ def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error:
         med, top = float(np.median(v)), float(v.max())
         # above the range in °C: kelvin where the median is, or where the reading less 273.15
         # is a plausible temperature in °C; a broken reading where it is not
-        as_celsius = top - 273.15
-        kelvin = med > T_KELVIN_MEDIAN_C or T_MIN_C <= as_celsius <= T_KELVIN_MEDIAN_C
-        if kelvin and (med > T_KELVIN_MEDIAN_C or top > T_KELVIN_MAX_C):
+        if med > T_KELVIN_MEDIAN_C or (top > T_KELVIN_MAX_C
+                                       and T_MIN_C <= top - 273.15 <= T_KELVIN_MEDIAN_C):
             over = y > (T_KELVIN_MAX_C if top > T_KELVIN_MAX_C else T_KELVIN_MEDIAN_C)
             raise error(f"{col} (line {first(over)})", f"{top:g} (median {med:g}) looks like kelvin",
                         "export °C (°C = K - 273.15)")

@@ -18,6 +18,7 @@ from spindle.checks import omega_rad_s
 from spindle.errors import Problem, SpecError
 from spindle.power import BearingParams, MotorParams, PowerBalance, bearing_friction, power_balance
 from spindle.spec_reader import read_toml
+from spindle.units import SPEED_MAX_RPM
 
 
 @dataclass(frozen=True)
@@ -112,7 +113,7 @@ class Field:
 # beyond any motor spindle's value (the shipped spl2782's in brackets), so that a unit slip
 # or a stray exponent is refused by name instead of overflowing the power balance.
 DRIVE_FIELDS = (Field("T_winding_K", "K", lo=200.0, hi=700.0),)
-NOMINAL_FIELDS = (Field("speed_rpm", "rpm", lo=0.0, lo_open=True, hi=1e5),  # as a bench's
+NOMINAL_FIELDS = (Field("speed_rpm", "rpm", lo=0.0, lo_open=True, hi=SPEED_MAX_RPM),
                   Field("P_mech_W", "W", lo=0.0, hi=1e7),  # 10 MW (38 kW)
                   Field("losses_W", "W", lo=0.0, hi=1e7, required=False))
 MOTOR_FIELDS = (Field("R20_ohm", "ohm", lo=0.0, lo_open=True, hi=100.0),  # (0.195)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spindle.errors import Problem
 from spindle.geometry import TOL_M, Trapezoid
 from spindle.spec import AirGapLink, Section, Spec, Surface
 
@@ -143,6 +144,15 @@ def open_to_air(spec: Spec, face: Face) -> list[Face]:
         return [face] if face.side == "outer" else []
     return [Face(face.part, face.section, face.side, p, q, face.z)
             for p, q in _subtract(face.lo, face.hi, closed_radii(spec, face.side, face.z))]
+
+
+def no_face_problem(spec: Spec, surface: Surface) -> Problem:
+    """The problem of a named surface that selects no exposed boundary (the FEM's mesh and
+    the lumped network refuse it alike: a film or a source on it would vanish unseen)."""
+    return Problem(spec.path, f"surfaces.{surface.name}", "selects no exposed boundary of "
+                   f"{list(surface.parts)} (side '{surface.side}', z {surface.z_min:g}.."
+                   f"{surface.z_max:g} m)", "check side and z limits: surfaces that touch "
+                   "another part are not exposed")
 
 
 def surface_faces(surface: Surface, faces: list[Face], spec: Spec) -> list[Face]:

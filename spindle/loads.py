@@ -171,6 +171,10 @@ def time_grid(case: LoadCase, dt_s: float) -> np.ndarray:
 _KNOWN_CYCLE_COLUMNS = {"time_s", "speed_rpm", "T_env_C", "T_coolant_C"}
 
 
+#: the largest heat a cycle CSV may give one source [W]: a bench's power limit
+SOURCE_MAX_W = POWER_MAX_KW * 1e3
+
+
 def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) -> LoadCase:
     """Read a transient load cycle from CSV (comment lines start with ``#``).
 
@@ -232,10 +236,6 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
                              "never negative)")
     sources = {s: series(f"{s}_W") for s in source_names if f"{s}_W" in data}
     return case.with_sources(sources)
-
-
-#: the largest heat a cycle CSV may give one source [W]: a bench's power limit
-SOURCE_MAX_W = POWER_MAX_KW * 1e3
 
 
 def _check_cycle_header(name: str, header: list[str], source_names: list[str]) -> None:

@@ -242,7 +242,8 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
     from spindle.errors import InputError
     from spindle.outputs import atomic_write
 
-    if drive_for(spec) is None:  # before any work: the bench logs the drive's power
+    drive = drive_for(spec)
+    if drive is None:  # before any work: the bench logs the drive's power
         raise InputError(spec.path, "power_balance.preset", "synth writes a bench run, whose "
                          "power_kW column comes from the spec's drive, and this spec names none",
                          "add [power_balance] preset = <drive> to the spec, or use spl2782")
@@ -267,7 +268,6 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
     # and bench sampling stay what they were without them
     cycle = drawn_cycle(cycle_name, seed) if cycle_name in RANDOM_CYCLES else \
         load_cycle(cycle_name)
-    drive = drive_for(spec)
     if mismatch:
         mm = draw_mismatch(np.random.default_rng([seed, 1]))
         spec, drive = mm.apply(spec, drive)
