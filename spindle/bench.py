@@ -91,8 +91,8 @@ class BenchRun:
     all zeros when the file has no such column (a no-load run, ``load_torque_measured`` False).
     ``extra``: unknown columns by name, as float arrays (NaN where empty) or, if a cell is not
     a number, as lists of the cell strings. ``channels``: the measured model channels present,
-    a subset of T1, T2, T_stator, P1 in that order. ``duration_s`` [s]: the last time_s (the
-    run starts at t = 0). ``lines``: the file line of each data row (for messages).
+    a subset of T1, T2, T_stator, P1 in that order. ``duration_s`` [s]: the last time_s less the
+    first (a bench that logs the time of day starts late). ``lines``: the file line of each data row (for messages).
     """
 
     path: Path
@@ -349,7 +349,7 @@ def read_bench(path: str | Path) -> BenchRun:
     if not torque_measured:
         columns["load_torque_Nm"] = np.zeros(len(t))
     return BenchRun(path=path, metadata=metadata, time_s=t, columns=columns, extra=extra,
-                    unknown_columns=unknown, channels=channels, duration_s=float(t[-1]),
+                    unknown_columns=unknown, channels=channels, duration_s=float(t[-1] - t[0]),
                     lines=line_no, P1_reference_um=p1_ref, load_torque_measured=torque_measured)
 
 

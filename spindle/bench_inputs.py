@@ -163,7 +163,10 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
     held over the interval ('previous' series at t_i); the spec's sources the power balance
     does not feed get 0 W. ``drive`` defaults to the spec's ``[power_balance] preset``; without
     one, InputError. A :class:`BenchWarning` reports intervals where the power was below the
-    mechanical power (motor losses set to 0 there). ``duration_s`` = the run's duration.
+    mechanical power (motor losses set to 0 there). The case's time runs from the grid's
+    start (its t = 0 is ``grid[0]``, the run's first sample or the multiple of ``grid_s``
+    before it, so that a run whose clock logs the time of day is simulated from its start) to
+    the run's last sample. Returns the case and ``grid`` (the run's own times [s]).
     """
     drive = drive if drive is not None else drive_for(spec)
     if drive is None:
@@ -203,17 +206,18 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
         raise InputError(spec.path, "heat_sources", f"the power balance feeds sources {missing} "
                          "that the spec does not have",
                          "name the spec's heat sources stator, rotor, front_bearing, rear_bearing")
-    starts = tuple(float(x) for x in grid[:-1])
+    rel = grid - grid[0]
+    starts = tuple(float(x) for x in rel[:-1])
     sources = {k: TimeSeries.constant(0.0) for k in names}
     sources.update({k: TimeSeries(starts, tuple(float(h[k]) for h in heats), "previous")
                     for k in heats[0]})
-    times = tuple(float(x) for x in grid)
+    times = tuple(float(x) for x in rel)
     case = LoadCase(
         name=run.name,
         speed_rpm=TimeSeries(times, tuple(float(x) for x in speed), "previous"),
         T_ambient_K=TimeSeries(times, tuple(float(x) for x in T_env), "linear"),
         T_coolant_K=TimeSeries(times, tuple(float(x) for x in T_cool), "linear"),
         sources=sources,
-        duration_s=run.duration_s,
+        duration_s=float(rel[-1]),
     )
     return case, grid

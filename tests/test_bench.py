@@ -321,6 +321,24 @@ def test_a_run_whose_clock_starts_late_gets_the_grid_of_the_shifted_run(tmp_path
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
 
 
+def test_a_run_whose_clock_starts_late_lasts_as_long_and_loads_alike(tmp_path, spec):
+    """The same time-of-day run: its duration is the last time less the first (it was the
+    last time, so fit's summary said "7.xx h" for a run of one hour), and the load case it
+    gives is the run logged from 0, on the same relative times."""
+    lines = good_rows()
+    shift = 25_200.0
+    late = [",".join([str(float(x.split(",")[0]) + shift), *x.split(",")[1:]]) for x in lines]
+    early_run = read_bench(write(tmp_path, lines, "early.csv"))
+    late_run = read_bench(write(tmp_path, late, "late.csv"))
+    assert late_run.duration_s == early_run.duration_s == early_run.time_s[-1]
+    (a, grid_a), (b, grid_b) = inputs(early_run, spec), inputs(late_run, spec)
+    np.testing.assert_allclose(grid_b, grid_a + shift, rtol=0, atol=1e-9)
+    assert b.duration_s == a.duration_s
+    for t in grid_a:
+        assert b.speed_rpm(t) == a.speed_rpm(t) and b.T_ambient_K(t) == a.T_ambient_K(t)
+        assert all(b.sources[k](t) == a.sources[k](t) for k in a.sources)
+
+
 def test_speed_is_held_and_leading_gaps_take_the_first_value(tmp_path, spec):
     lines = good_rows()
     lines[0] = row(0, speed="")
