@@ -305,3 +305,11 @@ def test_an_empty_option_is_refused_not_taken_for_its_default(tmp_path, option):
     was ignored: each is named, exit 2."""
     r = run("solve", "fin-shaft", "--model", "lumped", option, "")
     assert r.returncode == 2 and f"{option}: is empty" in r.stderr and "fix:" in r.stderr
+
+
+def test_a_speed_beside_a_cycle_is_refused_not_ignored(tmp_path):
+    """`solve --cycle C --speed N` ran the cycle at its own speeds and said nothing of N."""
+    r = run("solve", "fin-shaft", "--model", "lumped", "--cycle", "spl-16h", "--speed", "1000",
+            "--out", str(tmp_path / "o"))
+    assert r.returncode == 2 and "--speed:" in r.stderr and "drop --speed" in r.stderr
+    assert not (tmp_path / "o").exists()

@@ -46,6 +46,10 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
     if args.case and args.cycle:
         raise InputError("command line", "--case", "--case (a steady load point) and --cycle (a "
                          "transient) exclude each other", "give one of them")
+    if args.speed is not None and args.cycle:
+        raise InputError("command line", "--speed", "sets a steady solve's speed, and --cycle "
+                         "gives the transient its own speeds, so it would be ignored",
+                         "drop --speed, or drop --cycle for a steady solve at that speed")
     progress.stage("reading the spec")
     spec = load_spec(args.spec)
     inputs = [spec.path, *(x for x in (args.case, args.cycle) if x and Path(x).is_file())]
