@@ -92,7 +92,8 @@ class BenchRun:
     ``extra``: unknown columns by name, as float arrays (NaN where empty) or, if a cell is not
     a number, as lists of the cell strings. ``channels``: the measured model channels present,
     a subset of T1, T2, T_stator, P1 in that order. ``duration_s`` [s]: the last time_s less the
-    first (a bench that logs the time of day starts late). ``lines``: the file line of each data row (for messages).
+    first (a bench that logs the time of day starts late). ``lines``: the file line of each
+    data row (for messages).
     """
 
     path: Path

@@ -313,3 +313,17 @@ def test_a_speed_beside_a_cycle_is_refused_not_ignored(tmp_path):
             "--out", str(tmp_path / "o"))
     assert r.returncode == 2 and "--speed:" in r.stderr and "drop --speed" in r.stderr
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["solve", "fin-shaft", "--level", "9"], "spindle-verify solve: --level: 9 is too large"),
+    (["solv"], "spindle-verify: COMMAND: invalid choice: 'solv'"),
+    (["fit"], "spindle-verify fit: the following arguments are required: RUN.csv"),
+])
+def test_an_option_the_parser_refuses_is_one_line(argv, words):
+    """argparse printed its usage block (up to 8 lines) before the message; the message is
+    now the only line, and it says where the options are listed."""
+    r = run(*argv)
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.count("\n") == 1 and r.stderr.startswith(words), r.stderr
+    assert f"'{words.split(':')[0]} --help' lists the options" in r.stderr

@@ -281,7 +281,7 @@ def test_rom_command_writes_its_outputs(tmp_path, capsys):
 @pytest.mark.parametrize("args, words", [
     (["--held-out", "no-such-cycle"], "neither a shipped cycle"),
     (["--cycle", "random:x"], "is not a whole number"),
-    (["--tol-temp", "0"], "argument --tol-temp"),
+    (["--tol-temp", "0"], "rom: --tol-temp:"),
 ])
 def test_rom_command_bad_options_exit_2(tmp_path, capsys, args, words):
     from compare.cli import main

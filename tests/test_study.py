@@ -77,8 +77,8 @@ def test_study_command_writes_the_report(tmp_path, capsys):
 
 @pytest.mark.parametrize("args, words", [
     (["--levels", "0", "1"], "fewer than 3 levels"),
-    (["--nodes", "1", "5"], "argument --nodes: 1 is too small"),  # the parser's message
-    (["--levels", "0", "1", "9"], "argument --levels: 9 is too large"),
+    (["--nodes", "1", "5"], "study: --nodes: 1 is too small"),  # the parser's message
+    (["--levels", "0", "1", "9"], "study: --levels: 9 is too large"),
 ])
 def test_study_bad_options_exit_2(tmp_path, capsys, args, words):
     assert main(["study", "fin-shaft", *args, "--out", str(tmp_path / "x")]) == 2

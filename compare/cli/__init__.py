@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from typing import NoReturn
 
 from spindle.errors import InputError, SpindleVerifyError
 
@@ -24,8 +25,18 @@ def package_version() -> str:
         return "unknown (not installed)"
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose error is one line on stderr, exit status 2: what is wrong
+    with which option and where the options are listed (argparse's own prints the usage
+    block first, which buries the message under the options)."""
+
+    def error(self, message: str) -> NoReturn:
+        message = message.removeprefix("argument ")
+        self.exit(2, f"{self.prog}: {message}; '{self.prog} --help' lists the options\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = OneLineParser(
         prog="spindle-verify",
         description="How far can you trust a thermal model of a motor spindle? FEM reference, "
                     "lumped models and the harness that compares them. SPEC is a shipped spec "
