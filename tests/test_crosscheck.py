@@ -17,7 +17,9 @@ Skipped only when ``ccx`` is not installed (CI installs the Debian package calcu
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -193,6 +195,25 @@ def test_missing_ccx_names_the_fix(monkeypatch, tmp_path):
     with pytest.raises(SolverError) as exc:
         crosscheck("fin-shaft", 0)
     assert str(exc.value) == CCX_MISSING
+
+
+def test_a_failing_ccx_leaves_the_log_its_message_names(monkeypatch, tmp_path):
+    """The message said "see its .log" of a temporary folder removed as the error left it; the
+    folder of a failed solve is kept now, and the message names the log's path."""
+    fake = tmp_path / "bin" / "ccx"
+    fake.parent.mkdir()
+    fake.write_text("#!/bin/sh\necho ' *ERROR in e_c3d: nonpositive jacobian'\nexit 201\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{fake.parent}{os.pathsep}{os.environ['PATH']}")
+    with pytest.raises(SolverError) as exc:
+        crosscheck("fin-shaft", 0)
+    msg = str(exc.value)
+    log = Path(msg.rsplit("fix: see ", 1)[1])
+    try:
+        assert "exit status 201" in msg and "nonpositive jacobian" in msg
+        assert log.suffix == ".log" and "nonpositive jacobian" in log.read_text()
+    finally:
+        shutil.rmtree(log.parent, ignore_errors=True)
 
 
 @pytest.mark.parametrize("field", ["uniform", "r_linear", "r_quadratic"])

@@ -7,6 +7,8 @@ import math
 import shutil
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -28,13 +30,30 @@ from spindle.spec_reader import load_spec
 EXPANSION_REL = (math.pi / 180.0) ** 2
 
 
+@contextmanager
+def ccx_folder() -> Iterator[Path]:
+    """A temporary folder for ccx's decks, results and logs: removed when the cross-check
+    gets through, kept when ccx fails (a SolverError), so that the log its message names can
+    still be read."""
+    work = Path(tempfile.mkdtemp(prefix="spindle-ccx-"))
+    try:
+        yield work
+    except SolverError:
+        raise
+    except BaseException:
+        shutil.rmtree(work, ignore_errors=True)
+        raise
+    shutil.rmtree(work, ignore_errors=True)
+
+
 def crosscheck(spec: Spec | str | Path, level: int = 1, case: LoadCase | None = None, *,
                keep_dir: str | Path | None = None, timeout_s: float = 600) -> CrosscheckResult:
     """Solve ``spec`` at mesh ``level`` (P2) with the reference and with CalculiX; compare.
 
     ``case`` is a steady load case (default: the spec's own operating point), evaluated at
-    t = 0. ccx runs in a temporary folder; ``keep_dir`` keeps its decks, result files and
-    logs there. Raises SolverError when ccx is missing or fails.
+    t = 0. ccx runs in a temporary folder, which is kept when ccx fails (its message names the
+    log there); ``keep_dir`` keeps its decks, result files and logs there. Raises SolverError
+    when ccx is missing or fails.
     """
     if shutil.which("ccx") is None:
         raise SolverError(CCX_MISSING)
@@ -52,8 +71,7 @@ def crosscheck(spec: Spec | str | Path, level: int = 1, case: LoadCase | None = 
     th = model.thermal
     names, pts = th.sensor_points()
     P = th.probe_matrix(pts)
-    with tempfile.TemporaryDirectory(prefix="spindle-ccx-") as tmp:
-        work = Path(tmp)
+    with ccx_folder() as work:
         t1 = time.perf_counter()
         name = "".join(c if c.isalnum() or c in "-_" else "_" for c in spec.name)
         info, cm, data, con = write_thermal_deck(model, case, work / f"{name}.inp")
@@ -64,7 +82,7 @@ def crosscheck(spec: Spec | str | Path, level: int = 1, case: LoadCase | None = 
         N = th.basis.N
         if frd["T"] is None or len(frd["T"]) < N or not np.all(np.isfinite(frd["T"][:N])):
             raise SolverError(f"{info['thermal_deck']}: ccx wrote no temperature for some "
-                              "nodes; fix: see its .log")
+                              f"nodes; fix: see {info['thermal_deck'].with_suffix('.log')}")
         rise = frd["T"][:N]
         datum = info["T_datum_K"]
         T_ccx = datum + rise
@@ -80,7 +98,7 @@ def crosscheck(spec: Spec | str | Path, level: int = 1, case: LoadCase | None = 
             times["ccx_elastic_s"] = time.perf_counter() - t1
             if U is None or len(U) < N or not np.all(np.isfinite(U[:N, :2])):
                 raise SolverError(f"{deck}: ccx wrote no displacement for some nodes; fix: "
-                                  "see its .log")
+                                  f"see {deck.with_suffix('.log')}")
             U_ccx = U[:N, 1]
             ulp = half_ulp(U_ccx)
             for k, row in rows.items():
