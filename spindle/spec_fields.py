@@ -44,6 +44,14 @@ def finite_number(v: Any) -> float | None:
     return f if math.isfinite(f) else None
 
 
+def exact(v: float) -> str:
+    """``v`` as short as ``:g`` writes it where that is the same number, else in full, so that
+    a value just beyond a bound does not read as the bound's other side (0.4999999999, not
+    0.5, against a bound of 0.4999)."""
+    short = f"{v:g}"
+    return short if float(short) == v else repr(float(v))
+
+
 def show_value(v: Any) -> str:
     """A short text for a bad value in a message (no 400-digit integers)."""
     text = repr(v)
@@ -160,11 +168,11 @@ class FieldReader:
             return default
         if lo is not None and (v <= lo if lo_open else v < lo):
             rel = ">" if lo_open else ">="
-            self.add(f"{path}.{key}", f"{v:g} {unit} is not physical (must be {rel} {lo:g})",
+            self.add(f"{path}.{key}", f"{exact(v)} {unit} is not physical (must be {rel} {lo:g})",
                      f"give {key} {rel} {lo:g} {unit}")
             return default
         if hi is not None and v > hi:
-            self.add(f"{path}.{key}", f"{v:g} {unit} is out of range (must be <= {hi:g})",
+            self.add(f"{path}.{key}", f"{exact(v)} {unit} is out of range (must be <= {hi:g})",
                      f"give {key} <= {hi:g} {unit}")
             return default
         return v

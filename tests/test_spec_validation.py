@@ -185,3 +185,19 @@ def test_python_api_takes_a_spec_name_or_path():
     assert Fin.from_spec("fin-shaft") == Fin.from_spec(load_spec("fin-shaft"))
     with pytest.raises(TypeError, match="shipped name or a path"):
         lumped.build(3)
+
+
+def test_a_value_just_beyond_its_bound_is_written_in_full(tmp_path):
+    """nu = 0.4999999999 was reported as "0.5 - is out of range (must be <= 0.4999)", a
+    message that contradicts itself; the value is written as given."""
+    found = problems(tmp_path, GOOD + """
+[materials.rubbery]
+k_W_mK = 1.0
+rho_kg_m3 = 1000.0
+c_J_kgK = 1000.0
+E_Pa = 1e9
+nu = 0.4999999999
+alpha_1_K = 1e-5
+""")
+    nu = [p for p in found if p.field == "materials.rubbery.nu"]
+    assert nu and "0.4999999999 - is out of range (must be <= 0.4999)" in nu[0].message, found
