@@ -146,12 +146,24 @@ def _check_parts_joined(r: FieldReader, parts: list[Part], links: list[Link],
 
 def _check_sensors_inside(r: FieldReader, sensors: list[Sensor],
                           secs: list[tuple[Part, int, Section]]) -> None:
+    """Every sensor point lies in a part. An array's sensors outside have one cause, its
+    radius: one problem per array, not one per sensor."""
+    outside_of_array: dict[str, list[Sensor]] = {}
     for s in sensors:
         pts = [(s.z, s.r)] + ([(s.z_ref, s.r_ref)] if s.kind == "axial_displacement" else [])
         for z, rr in pts:
-            if not any(sec.contains(z, rr) for _, _, sec in secs):
+            if any(sec.contains(z, rr) for _, _, sec in secs):
+                continue
+            if s.array is not None:
+                outside_of_array.setdefault(s.array, []).append(s)
+            else:
                 r.add(f"sensors.{s.name}", f"point (z = {z:g} m, r = {rr:g} m) is outside every "
                       "part", "move it into a part's section (z along the axis, r radius)")
+    for name, out in outside_of_array.items():
+        of = sum(s.array == name for s in sensors)
+        r.add(f"sensor_arrays.{name}.radius", f"r = {out[0].r:g} m puts {len(out)} of the array's "
+              f"{of} sensors outside every part (first {out[0].name} at z = {out[0].z:g} m)",
+              'write radius = "mid", "inner", "outer" or a radius in m within the part')
 
 
 def _check_heat_paths(r: FieldReader, parts: list[Part], surfaces: list[Surface],

@@ -80,6 +80,9 @@ class FieldReader:
         #: names of parts, surfaces and materials that are defined but could not be read:
         #: a reference to one is not a second problem
         self.broken: dict[str, set[str]] = {"part": set(), "surface": set(), "material": set()}
+        #: required lists (``parts``, ``surfaces``) that are missing or could not be read:
+        #: every name a reference looks up in one is unknown, and not a problem of its own
+        self.absent: set[str] = set()
 
     def add(self, fld: str, message: str, fix: str) -> None:
         if any(fld == q or fld.startswith(q + ".") or fld.startswith(q + "[")
@@ -89,8 +92,9 @@ class FieldReader:
 
     def unknown(self, kind: str, name: str, fld: str, fix: str) -> None:
         """An unknown ``kind`` (part, surface, material) named ``name`` at ``fld``; nothing
-        when that name is defined but broken (its own problem is the root cause)."""
-        if name not in self.broken[kind]:
+        when that name is defined but broken, or its whole list is (its own problem is the
+        root cause)."""
+        if name not in self.broken[kind] and f"{kind}s" not in self.absent:
             self.add(fld, f"unknown {kind} '{name}'", fix)
 
     def keys(self, data: dict, known: tuple[str, ...], path: str) -> None:
@@ -130,10 +134,15 @@ class FieldReader:
         if v is None:
             if required:
                 self.add(key, "required list is missing", f"add at least one [[{key}]] entry")
+                self.absent.add(key)
             return []
         if not isinstance(v, list) or not all(isinstance(x, dict) for x in v):
+            self.absent.add(key)
             self.add(f"{path}{key}", "must be a list of tables", f"write entries as [[{key}]]")
             return []
+        if required and not v:
+            self.absent.add(key)
+            self.add(f"{path}{key}", "the list is empty", f"add at least one [[{key}]] entry")
         return v
 
     def string(self, data: dict, key: str, path: str, required: bool = True,

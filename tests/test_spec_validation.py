@@ -201,3 +201,47 @@ alpha_1_K = 1e-5
 """)
     nu = [p for p in found if p.field == "materials.rubbery.nu"]
     assert nu and "0.4999999999 - is out of range (must be <= 0.4999)" in nu[0].message, found
+
+
+def _shipped_text() -> str:
+    from spindle.spec_reader import shipped_specs
+
+    return shipped_specs()["spl2782"].read_text(encoding="utf-8")
+
+
+def problems_of_file(tmp_path, text: str) -> list:
+    """The problems of a whole spec file (a shipped spec, changed)."""
+    path = tmp_path / "case.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(SpecError) as exc:
+        load_spec(path)
+    return exc.value.problems
+
+
+def _without_parts(text: str) -> str:
+    import re
+
+    return "".join(b for b in re.split(r"(?m)^(?=\[)", text) if not b.startswith("[[parts]]"))
+
+
+@pytest.mark.parametrize("head, words", [
+    ("", "required list is missing"),
+    ("parts = []\n", "the list is empty"),
+])
+def test_a_spec_without_parts_is_one_problem(tmp_path, head, words):
+    """Without parts, every link, surface, source and sensor array named an unknown part: 27
+    lines for one cause; `parts = []` was not named at all, only its consequences."""
+    found = problems_of_file(tmp_path, _without_parts(_shipped_text()).replace(
+        "[spindle]", head + "[spindle]", 1))
+    assert len(found) == 1 and found[0].field == "parts" and words in found[0].message, found
+
+
+def test_an_array_radius_outside_its_part_is_one_problem(tmp_path):
+    """A radius of 5 m put each of the array's 11 sensors outside every part: 11 lines for one
+    field."""
+    text = _shipped_text()
+    old = 'name = "shaft"\npart = "shaft"\ncount = 11\nradius = "mid"'
+    assert old in text
+    found = problems_of_file(tmp_path, text.replace(old, old.replace('"mid"', "5.0")))
+    assert len(found) == 1 and found[0].field == "sensor_arrays.shaft.radius", found
+    assert "puts 11 of the array's 11 sensors outside every part" in found[0].message
