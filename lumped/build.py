@@ -47,7 +47,14 @@ from lumped.blocks import (
 )
 from lumped.network import Network, ThermalSystem
 from spindle.errors import Problem, SpecError
-from spindle.faces import Face, exposed_faces, no_face_problem, surface_faces
+from spindle.faces import (
+    Face,
+    exposed_faces,
+    faces_overlap,
+    film_clash_problem,
+    no_face_problem,
+    surface_faces,
+)
 from spindle.geometry import TOL_M
 from spindle.loads import SpeedTable
 from spindle.spec import BEARING_ROLES, AirGapLink, BearingLink, ContactLink, HeatSource, Part, Section, Spec
@@ -510,13 +517,19 @@ class _Builder:
         of every named surface (for the surface heat sources)."""
         faces = exposed_faces(self.spec)
         surface_map: dict[str, list[tuple[Mass, float, float]]] = {}
-        empty = []
+        problems = []
+        filmed: list[tuple[str, Face]] = []  # (surface, face piece) of the films so far
         for s in self.spec.surfaces:
-            surface_map[s.name] = [p for f in surface_faces(s, faces, self.spec) for p in self.face_pieces(f)]
+            selected = surface_faces(s, faces, self.spec)
+            surface_map[s.name] = [p for f in selected for p in self.face_pieces(f)]
             if not surface_map[s.name]:  # its film or its source would vanish unseen
-                empty.append(no_face_problem(self.spec, s))
+                problems.append(no_face_problem(self.spec, s))
             if s.h_W_m2K is None:
                 continue
+            clash = next((o for o, g in filmed for f in selected if faces_overlap(f, g)), None)
+            if clash is not None:  # the boundary would lose its heat twice
+                problems.append(film_clash_problem(self.spec, s, clash))
+            filmed.extend((s.name, f) for f in selected)
             grouped: dict[str, list[tuple[float, float]]] = {}
             for m, A, R in surface_map[s.name]:
                 grouped.setdefault(m.name, []).append((A, R))
@@ -525,8 +538,8 @@ class _Builder:
                 c = self.net.add(Convection(f"film:{s.name}:{mname}", Gc_W_K=_film(s.h_W_m2K, pcs)))
                 self.net.connect(self.by_name[mname].block.port, c.port_a)
                 self.net.connect(self.fixed(s.T_ref), c.port_b)
-        if empty:  # as the FEM's mesh refuses them (meshes.build)
-            raise SpecError(empty)
+        if problems:  # as the FEM's mesh refuses them (meshes.build)
+            raise SpecError(problems)
         return surface_map
 
     # ------------------------------------------------------------------ sources

@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 from skfem import MeshTri
 
 from spindle.errors import Problem, SpecError
-from spindle.faces import closed_radii, no_face_problem
+from spindle.faces import closed_radii, film_clash_problem, no_face_problem
 from spindle.geometry import TOL_M, Trapezoid
 from spindle.spec import AirGapLink, BearingLink, ContactLink, Material, Spec
 from spindle.spec_reader import as_spec
@@ -314,9 +314,7 @@ def _classify_facets(sm: SpindleMesh) -> None:
         if s.h_W_m2K is not None:
             clash = [owner[f] for f in facets if f in owner]
             if clash:
-                problems.append(Problem(spec.path, f"surfaces.{s.name}", "has a film "
-                                        f"coefficient on the same boundary as '{clash[0]}'",
-                                        "narrow one of them with side or z_min/z_max"))
+                problems.append(film_clash_problem(spec, s, clash[0]))
             owner.update(dict.fromkeys(facets.tolist(), s.name))
         sm.surfaces[s.name] = facets
     if problems:

@@ -155,6 +155,22 @@ def no_face_problem(spec: Spec, surface: Surface) -> Problem:
                    "another part are not exposed")
 
 
+def film_clash_problem(spec: Spec, surface: Surface, other: str) -> Problem:
+    """The problem of a film surface on a boundary another film surface already covers (the
+    FEM's mesh and the lumped network refuse it alike: the boundary would lose heat twice)."""
+    return Problem(spec.path, f"surfaces.{surface.name}", "has a film coefficient on the same "
+                   f"boundary as '{other}'", "narrow one of them with side or z_min/z_max")
+
+
+def faces_overlap(a: Face, b: Face) -> bool:
+    """Two face pieces share a piece of boundary longer than the geometric tolerance."""
+    if a.part != b.part or a.section != b.section or a.side != b.side:
+        return False
+    if not a.is_line and abs(a.z - b.z) > TOL_M:
+        return False
+    return min(a.hi, b.hi) - max(a.lo, b.lo) > TOL_M
+
+
 def surface_faces(surface: Surface, faces: list[Face], spec: Spec) -> list[Face]:
     """The exposed face pieces (``faces``: :func:`exposed_faces` of ``spec``) a named surface
     selects: its parts, its side, its z range; ``side = "any"`` selects what the open air

@@ -327,3 +327,33 @@ def test_an_option_the_parser_refuses_is_one_line(argv, words):
     assert r.returncode == 2 and r.stdout == ""
     assert r.stderr.count("\n") == 1 and r.stderr.startswith(words), r.stderr
     assert f"'{words.split(':')[0]} --help' lists the options" in r.stderr
+
+
+@pytest.mark.parametrize("extra, clashes", [
+    # the housing's outer film again, on a piece of it: the boundary would lose heat twice
+    ('[[surfaces]]\nname = "draft"\nparts = ["housing"]\nside = "outer"\nz_min = 0.2\n'
+     'z_max = 0.3\nh_W_m2K = 20.0\nT_ref = "ambient"\n', True),
+    # a source-only surface (no film) on the same boundary is legal
+    ('[[surfaces]]\nname = "pad"\nparts = ["housing"]\nside = "outer"\nz_min = 0.2\n'
+     'z_max = 0.3\n', False),
+])
+def test_the_lumped_model_refuses_two_films_on_one_boundary_as_the_fem_does(tmp_path, extra,
+                                                                              clashes):
+    """The FEM's mesh refused a second film on a boundary; the lumped model added both."""
+    from lumped import build
+    from meshes import build_mesh
+    from spindle.errors import SpecError
+    from spindle.spec_reader import load_spec, shipped_specs
+
+    text = shipped_specs()["spl2782"].read_text(encoding="utf-8")
+    path = tmp_path / "s.toml"
+    path.write_text(text + "\n" + extra, encoding="utf-8")
+    spec = load_spec(path)
+    for make in (lambda: build(spec, 11), lambda: build_mesh(spec, 0)):
+        if not clashes:
+            make()
+            continue
+        with pytest.raises(SpecError) as exc:
+            make()
+        (p,) = exc.value.problems
+        assert p.field == "surfaces.draft" and "same boundary as 'housing_outer'" in p.message
