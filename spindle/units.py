@@ -14,6 +14,10 @@ RPM_TO_RAD_S = 2.0 * math.pi / 60.0
 """Angular speed [rad/s] of one revolution per minute."""
 
 
+MESH_LEVEL_MAX = 6
+"""The finest FEM mesh level a command or a baseline accepts: level 6 of spl2782 has 5.6
+million elements (each level halves every edge of level 0)."""
+
 SPEED_MAX_RPM = 100_000.0
 """The highest speed any input may give [rpm]: the fastest machine-tool motor spindles turn at
 60 000-80 000 rpm; above this a value is taken to be in other units or a typo."""

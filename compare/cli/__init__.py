@@ -76,9 +76,6 @@ def _check_args(args: argparse.Namespace) -> None:
         if getattr(args, name, None) == "":
             raise InputError("command line", f"--{name}", "is empty",
                              f"give a value, or leave --{name} out for its default")
-    if not 0 <= getattr(args, "level", 0) <= 6:
-        raise InputError("command line", "--level", f"{args.level} is out of range",
-                         "give a level between 0 and 6")
     if getattr(args, "dt", 1.0) <= 0:
         raise InputError("command line", "--dt", "must be > 0 s", "give a positive time step")
     if not 0.0 <= getattr(args, "theta", 1.0) <= 1.0:

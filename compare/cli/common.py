@@ -13,6 +13,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from spindle.units import MESH_LEVEL_MAX
+
 if TYPE_CHECKING:
     from compare.progress import Progress
     from spindle.loads import LoadCase
@@ -47,7 +49,7 @@ def number(lo: float | None = None, hi: float | None = None, *, lo_open: bool = 
 #: option types shared by the commands (limits: the reason in the help of each option)
 TIME_STEP_S = number(0.0, 86400.0, lo_open=True, unit="s")
 SPEED_RPM = number(0.0, 100_000.0, unit="rpm")  # spindle.units.SPEED_MAX_RPM
-MESH_LEVEL = number(0, 6, integer=True)  # level 6 of spl2782: 5.6 million elements
+MESH_LEVEL = number(0, MESH_LEVEL_MAX, integer=True)
 POSITIVE = number(0.0, lo_open=True)
 WORKERS = number(1, 256, integer=True)
 NODE_COUNT = number(2, 1000, integer=True)  # lumped.build.MAX_NODES (not imported: numpy)

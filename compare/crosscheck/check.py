@@ -23,6 +23,7 @@ from spindle.errors import InputError, SolverError
 from spindle.loads import LoadCase
 from spindle.spec import Spec
 from spindle.spec_reader import load_spec
+from spindle.units import MESH_LEVEL_MAX
 
 #: ccx expands a CAX6 section into a 2-degree C3D15 wedge (+-1 degree): the hoop strain of the
 #: expanded element is exact only to O(theta^2), theta = 1 degree in radians; the growth
@@ -59,9 +60,9 @@ def crosscheck(spec: Spec | str | Path, level: int = 1, case: LoadCase | None = 
         raise SolverError(CCX_MISSING)
     if not isinstance(spec, Spec):
         spec = load_spec(spec)
-    if not 0 <= int(level) <= 6:
+    if not 0 <= int(level) <= MESH_LEVEL_MAX:
         raise InputError("crosscheck", "level", f"{level} is out of range",
-                         "give a level between 0 and 6")
+                         f"give a level between 0 and {MESH_LEVEL_MAX}")
     case = case or spec.default_load_case()
     times: dict[str, float] = {}
     t0 = time.perf_counter()

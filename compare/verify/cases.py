@@ -11,8 +11,9 @@ from pathlib import Path
 from spindle.errors import InputError
 from spindle.loads import LoadCase
 from spindle.spec import Spec
+from spindle.units import MESH_LEVEL_MAX
 
-MAX_LEVEL = 6
+MAX_LEVEL = MESH_LEVEL_MAX
 
 
 # ============================================================================ load cases

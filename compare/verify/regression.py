@@ -21,7 +21,7 @@ from pathlib import Path
 
 from lumped.build import MAX_NODES
 from spindle.errors import InputError, SpindleVerifyError
-from spindle.units import ZERO_C_K
+from spindle.units import MESH_LEVEL_MAX, ZERO_C_K
 
 FORMAT = "spindle-verify-baseline/1"
 DEFAULT_TOLERANCES = {"temperature_K": 0.01, "growth_um": 0.01, "gci_pct": 0.01, "level": 0}
@@ -161,10 +161,11 @@ def _check_contents(doc: dict, refuse: Callable[..., InputError]) -> None:
     if not isinstance(settings, dict):
         raise refuse("settings", "must be a table")
     settings = {**DEFAULT_SETTINGS, **settings}
-    # the study's own ranges: mesh levels 0..6 (three or more for a GCI), lumped nodes
+    # the study's own ranges: mesh levels (three or more for a GCI), lumped nodes
     levels, nodes = settings["levels"], settings["nodes"]
-    if not _integers(levels, 0, 6) or len(set(levels)) < 3:
-        raise refuse("settings.levels", f"{levels!r} is not three or more mesh levels 0..6")
+    if not _integers(levels, 0, MESH_LEVEL_MAX) or len(set(levels)) < 3:
+        raise refuse("settings.levels", f"{levels!r} is not three or more mesh levels "
+                     f"0..{MESH_LEVEL_MAX}")
     if not _integers(nodes, 2, MAX_NODES) or not nodes:
         raise refuse("settings.nodes", f"{nodes!r} is not a list of node counts 2..{MAX_NODES}")
     for key in ("dt_s", "threshold_pct"):
