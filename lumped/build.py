@@ -623,8 +623,9 @@ class _FilmConductance:
         h = self.h(speed_rpm)
         if h <= 0:
             return 0.0
-        A, R = np.asarray(self.A), np.asarray(self.R)
-        return float(np.sum(1.0 / (R + 1.0 / (h * A))))
+        # a few pieces: plain floats, as a fit evaluates this a million times
+        pieces = zip(self.A, self.R, strict=True)
+        return float(sum(1.0 / (R + 1.0 / (h * A)) for A, R in pieces))
 
 
 def _film(h: SpeedTable, pieces: list[tuple[float, float]]):

@@ -30,6 +30,7 @@ from lumped.blocks import (
     PrescribedHeatFlow,
     ThermalConductor,
     conductance_at,
+    varies_with_speed,
 )
 from spindle.errors import SpindleVerifyError
 from spindle.loads import SpeedTable
@@ -203,6 +204,18 @@ def _may_conduct(G: Conductance) -> bool:
     return float(G) > 0
 
 
+@dataclass(frozen=True)
+class _Stamps:
+    """K and B of a system as K0 + Kv g(n) and B0 + Bv g(n), flattened, with g the varying
+    conductances at the speed n [W/K]; the temperature-dependent flows' terms come on top."""
+
+    K0: np.ndarray
+    B0: np.ndarray
+    Kv: np.ndarray  # (free x free, varying)
+    Bv: np.ndarray  # (free x inputs, varying)
+    varying: list
+
+
 @dataclass
 class ThermalSystem:
     """Eq. 8 for a network: matrices at a speed, inputs, and node bookkeeping.
@@ -225,8 +238,10 @@ class ThermalSystem:
     source_names: list[str | float]
     across: dict[int, tuple[int, int]] = field(default_factory=dict)  # flow -> (node a, node b)
     _cache: dict = field(default_factory=dict, repr=False)
+    _stamp: _Stamps | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
+        self._stamp = None  # a system made by replace() has edges of its own
         pos = {n: k for k, n in enumerate(self.free)}
         self._pos = pos
         C = self.capacity[self.free]
@@ -255,16 +270,25 @@ class ThermalSystem:
     def n_inputs(self) -> int:
         return len(self.source_names) + len(self.fixed_nodes)
 
-    def _full(self, speed_rpm: float, q: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-        """K over all free nodes and B (free x inputs) at a speed, for source powers q."""
-        nf = len(self.free)
+    def _stamps(self) -> _Stamps:
+        """The edges and flows as fixed stamps (computed once per system): what does not vary
+        with speed summed, and each conductance that does as a column, so that K and B at a
+        speed are one product (:meth:`_full`, called for every speed of every parameter set a
+        fit tries) and not a loop over the edges."""
+        if self._stamp is not None:
+            return self._stamp
+        nf, ni, m = len(self.free), self.n_inputs, len(self.source_names)
         pos = self._pos
-        K = np.zeros((nf, nf))
-        B = np.zeros((nf, self.n_inputs))
-        m = len(self.source_names)
         fixed_col = {n: m + k for k, n in enumerate(self.fixed_nodes)}
-        for i, j, G, _ in self.edges:
-            g = conductance_at(G, speed_rpm)
+        K0, B0 = np.zeros((nf, nf)), np.zeros((nf, ni))
+        varying = [k for k, (_, _, G, _) in enumerate(self.edges) if varies_with_speed(G)]
+        Kv, Bv = np.zeros((nf, nf, len(varying))), np.zeros((nf, ni, len(varying)))
+        column = {k: c for c, k in enumerate(varying)}
+        for k, (i, j, G, _) in enumerate(self.edges):
+            c = column.get(k)
+            # a constant edge adds its value, a varying one a unit into its column
+            g = conductance_at(G, 0.0) if c is None else 1.0
+            K, B = (K0, B0) if c is None else (Kv[:, :, c], Bv[:, :, c])
             for a, b in ((i, j), (j, i)):
                 if a in pos:
                     K[pos[a], pos[a]] += g
@@ -276,21 +300,38 @@ class ThermalSystem:
         for n, f in self.flows:
             if n not in pos:
                 continue  # heat into a fixed temperature leaves the network at once
-            if id(f) in self.across:
-                # Q = share q (1 + tc (T_a - T_b)): linear in T_a and T_b
-                B[pos[n], col[f.source]] += f.share
-                if f.tc_1_K and q is not None:
-                    g = f.share * f.tc_1_K * q[col[f.source]]
-                    for node_, sign in zip(self.across[id(f)], (1.0, -1.0), strict=True):
-                        if node_ in pos:
-                            K[pos[n], pos[node_]] -= sign * g
-                        else:
-                            raise ValueError("a heat flow across a fixed temperature")
-                continue
+            # Q = share q (1 + tc (T_a - T_b)) across two nodes; else
             # Q = share q (1 + tc (T - T_ref)) = share q (1 - tc T_ref) + share q tc T
-            B[pos[n], col[f.source]] += f.share * (1.0 - f.tc_1_K * f.T_ref_K)
-            if f.tc_1_K and q is not None:
-                K[pos[n], pos[n]] -= f.share * f.tc_1_K * q[col[f.source]]
+            B0[pos[n], col[f.source]] += (f.share if id(f) in self.across
+                                          else f.share * (1.0 - f.tc_1_K * f.T_ref_K))
+        self._stamp = _Stamps(K0, B0, Kv.reshape(nf * nf, -1), Bv.reshape(nf * ni, -1),
+                              [self.edges[k][2] for k in varying])
+        return self._stamp
+
+    def _full(self, speed_rpm: float, q: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """K over all free nodes and B (free x inputs) at a speed, for source powers q."""
+        st = self._stamps()
+        K, B = st.K0.copy(), st.B0.copy()
+        if st.varying:
+            g = np.array([conductance_at(G, speed_rpm) for G in st.varying])
+            K += (st.Kv @ g).reshape(K.shape)
+            B += (st.Bv @ g).reshape(B.shape)
+        if q is None or not self.temperature_dependent:
+            return K, B
+        pos = self._pos
+        col = {s: k for k, s in enumerate(self.source_names)}
+        for n, f in self.flows:  # the temperature-dependent flows' terms in K
+            if n not in pos or not f.tc_1_K:
+                continue
+            g = f.share * f.tc_1_K * q[col[f.source]]
+            if id(f) in self.across:
+                for node_, sign in zip(self.across[id(f)], (1.0, -1.0), strict=True):
+                    if node_ in pos:
+                        K[pos[n], pos[node_]] -= sign * g
+                    else:
+                        raise ValueError("a heat flow across a fixed temperature")
+            else:
+                K[pos[n], pos[n]] -= g
         return K, B
 
     def matrices(self, speed_rpm: float, q: np.ndarray | None = None

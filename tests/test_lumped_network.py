@@ -129,3 +129,62 @@ def test_bad_networks_name_the_block_and_the_fix():
         net.add(HeatCapacitor("m", C_J_K=1.0))
     with pytest.raises(NetworkError, match="was not added"):
         net.connect(HeatCapacitor("x").port, HeatCapacitor("y").port)
+
+
+def _loop_matrices(sys_, speed_rpm, q):
+    """K and B of the free nodes written out entry by entry, as eq. 8 states them: the
+    independent statement :meth:`ThermalSystem._full`'s stamps are held to."""
+    from lumped.blocks import conductance_at
+
+    pos = {n: k for k, n in enumerate(sys_.free)}
+    m = len(sys_.source_names)
+    fixed_col = {n: m + k for k, n in enumerate(sys_.fixed_nodes)}
+    K = np.zeros((len(pos), len(pos)))
+    B = np.zeros((len(pos), sys_.n_inputs))
+    for i, j, G, _ in sys_.edges:
+        g = conductance_at(G, speed_rpm)
+        for a, b in ((i, j), (j, i)):
+            if a in pos:
+                K[pos[a], pos[a]] += g
+                if b in pos:
+                    K[pos[a], pos[b]] -= g
+                else:
+                    B[pos[a], fixed_col[b]] += g
+    col = {s: k for k, s in enumerate(sys_.source_names)}
+    for n, f in sys_.flows:
+        if n not in pos:
+            continue
+        c = col[f.source]
+        if id(f) in sys_.across:
+            B[pos[n], c] += f.share
+            if q is not None:
+                a, b = sys_.across[id(f)]
+                K[pos[n], pos[a]] -= f.share * f.tc_1_K * q[c]
+                K[pos[n], pos[b]] += f.share * f.tc_1_K * q[c]
+        else:
+            B[pos[n], c] += f.share * (1.0 - f.tc_1_K * f.T_ref_K)
+            if q is not None:
+                K[pos[n], pos[n]] -= f.share * f.tc_1_K * q[c]
+    return K, B
+
+
+@pytest.mark.parametrize("nodes, tc", [(5, 0.0), (11, 0.0), (11, 0.05), (21, 0.0)])
+def test_the_stamped_matrices_are_the_entrywise_ones(nodes, tc):
+    """K and B at a speed come from stamps summed once per system (a fit asks for them at
+    every speed of every parameter set); they must be the matrices eq. 8 writes entry by
+    entry, on spl2782's networks with speed-dependent films and bearings, and with the
+    temperature-dependent bearing friction. Tolerance: the two sum the same terms in another
+    order, 1e-13 of the largest entry is a few hundred roundings of 1e-16."""
+    from lumped.build import build_network
+    from spindle.spec_reader import load_spec
+
+    sys_ = build_network(load_spec("spl2782"), nodes, bearing_tc_1_K=tc,
+                         coolant_advection_W_K=50.0 if tc else None).network.assemble()
+    assert len(sys_._stamps().varying) > 0 and sys_.temperature_dependent == (tc != 0)
+    q = np.linspace(10.0, 100.0, len(sys_.source_names))
+    for speed in (0.0, 1234.5, 4300.0, 9000.0):
+        for power in (None, q):
+            K, B = sys_._full(speed, power)
+            K_ref, B_ref = _loop_matrices(sys_, speed, power if tc else None)
+            np.testing.assert_allclose(K, K_ref, rtol=0, atol=1e-13 * np.abs(K_ref).max())
+            np.testing.assert_allclose(B, B_ref, rtol=0, atol=1e-13 * np.abs(B_ref).max())
