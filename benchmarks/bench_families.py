@@ -5,6 +5,7 @@ not verdicts on named runs (issue 32 §7).
                                         [--workers 2] [--cache DIR] [--json OUT.json]
                                         [--peers tests/data/peer-runs/bench-runs ...]
                                         [--reports DIR] [--summary FILE] [--synth-only]
+                                        [--geometry RADIAL AXIAL [--fit-own-spec]]
 
 Families (each run drawn from its seed: the spindle's mismatch to the spec, the cycle, the
 effect and its size, the noise and sampling; ``synth --mismatch``):
@@ -15,6 +16,12 @@ effect and its size, the noise and sampling; ``synth --mismatch``):
 - ``outside``: one cause outside the library (compare.synth.outside), drawn uniformly;
 - ``two``: two different effects of the library together;
 - ``peers``: the peer's runs in the folders of ``--peers`` (a fixed set, each fitted once).
+
+``--geometry RADIAL AXIAL`` draws the runs from another spindle: the spec's radii times
+RADIAL and its lengths times AXIAL (spindle.stretch), before the drawn mismatch, and fits them
+with the shipped spec, which does not describe that spindle (or, with ``--fit-own-spec``,
+with the other spindle's own spec, as its user would). Such runs are kept in a cache folder
+of their own.
 
 Half the drawn runs (a stream of their own) are logged by exception, as the peer's second bench
 logs (compare.synth.bench.log_on_change: dead bands and heartbeats, rows with a few channels).
@@ -87,6 +94,8 @@ class FamilyRun:
     truth_doc: dict | None = None  # a peer's whole truth.json entry (its effect sizes)
     reports: str | None = None  # a folder for each run's report.json (--reports)
     criteria: tuple = ()  # (name, value) pairs set in compare.fit.criteria.Criteria
+    geometry: tuple = ()  # (radial, axial) factors of the spindle the drawn runs come from
+    fit_own_spec: bool = False  # fit with that spindle's own spec, not the shipped one
 
     @property
     def label(self) -> str:
@@ -128,6 +137,12 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
     from spindle.tolerances import channel_tolerance, edge_scale
 
     spec = load_spec(case.spec)
+    data_spec = spec
+    if case.geometry and not case.path:
+        from spindle.stretch import scale_radially, stretch_axially
+
+        radial, axial = case.geometry
+        data_spec = stretch_axially(scale_radially(spec, radial), axial)
     t0 = time.perf_counter()
     if case.path:
         run, truth = Path(case.path), case.truth
@@ -137,7 +152,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
         run = Path(case.cache) / f"{case.family}-{case.seed}.csv"
         sidecar = run.with_suffix(".truth.json")
         if not (run.exists() and sidecar.exists()):
-            synth(spec, cycle, effects if len(effects) > 1 else effects[0], case.seed, run,
+            synth(data_spec, cycle, effects if len(effects) > 1 else effects[0], case.seed, run,
                   mismatch=True)
         if logs_on_change(case.family, case.seed):
             from compare.synth.bench import log_on_change
@@ -159,7 +174,8 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
                 "sizes": sizes}
     from compare.fit.criteria import Criteria
 
-    rep = run_fit(run, spec, criteria=Criteria().with_options(**dict(case.criteria)))
+    fit_spec = data_spec if case.fit_own_spec else spec
+    rep = run_fit(run, fit_spec, criteria=Criteria().with_options(**dict(case.criteria)))
     doc = rep.to_dict()
     if case.reports:
         from spindle.outputs import atomic_write, jsonable
@@ -321,6 +337,11 @@ def main(argv: list[str] | None = None) -> None:
                     help="also keep each run's report.json in this folder (named by run)")
     ap.add_argument("--synth-only", action="store_true",
                     help="only synthesise the drawn runs into the cache (no fits)")
+    ap.add_argument("--geometry", nargs=2, type=float, metavar=("RADIAL", "AXIAL"),
+                    help="draw the runs from another spindle: the spec's radii and lengths "
+                    "times these factors; fitted with the shipped spec")
+    ap.add_argument("--fit-own-spec", action="store_true",
+                    help="with --geometry: fit with the other spindle's own spec")
     args = ap.parse_args(argv)
     if args.rows:
         try:
@@ -331,13 +352,21 @@ def main(argv: list[str] | None = None) -> None:
         return _report(rows, args, argv)
     if args.runs_per_family < 1:
         ap.error("--runs-per-family: at least 1")
+    geometry = tuple(args.geometry or ())
+    if geometry:
+        if not all(0.5 <= g <= 2.0 for g in geometry):
+            ap.error("--geometry: factors between 0.5 and 2")
+        args.cache = args.cache / f"geometry-{geometry[0]:g}-{geometry[1]:g}"
+    elif args.fit_own_spec:
+        ap.error("--fit-own-spec: only with --geometry")
     args.cache.mkdir(parents=True, exist_ok=True)
     criteria = _criteria(ap, args.criterion)
     reports = None
     if args.reports:
         args.reports.mkdir(parents=True, exist_ok=True)
         reports = str(args.reports)
-    cases = [FamilyRun(f, s, str(args.cache), reports=reports, criteria=criteria)
+    cases = [FamilyRun(f, s, str(args.cache), reports=reports, criteria=criteria,
+                       geometry=geometry, fit_own_spec=args.fit_own_spec)
              for f in args.families
              if f in FAMILIES
              for s in range(args.first_seed, args.first_seed + args.runs_per_family)]

@@ -22,3 +22,20 @@ def stretch_axially(spec: Spec, factor: float) -> Spec:
     sensors = tuple(replace(s, z=z(s.z), z_ref=None if s.z_ref is None else z(s.z_ref))
                     for s in spec.sensors)
     return replace(spec, parts=parts, surfaces=surfaces, sensors=sensors)
+
+
+def scale_radially(spec: Spec, factor: float) -> Spec:
+    """The spec scaled in radius by ``factor`` (every r: sections, sensors and their
+    reference points, numeric sensor-array radii): a slimmer or stouter spindle of the same
+    lengths; materials, films, links, powers and the mesh size h0 stay."""
+    def scaled(pair: tuple[float, float]) -> tuple[float, float]:
+        return (pair[0] * factor, pair[1] * factor)
+
+    parts = tuple(replace(p, sections=tuple(replace(s, r_inner=scaled(s.r_inner),
+                                                    r_outer=scaled(s.r_outer))
+                                            for s in p.sections)) for p in spec.parts)
+    sensors = tuple(replace(s, r=s.r * factor, r_ref=None if s.r_ref is None else s.r_ref * factor)
+                    for s in spec.sensors)
+    arrays = tuple(a if isinstance(a.radius, str) else replace(a, radius=a.radius * factor)
+                   for a in spec.sensor_arrays)
+    return replace(spec, parts=parts, sensors=sensors, sensor_arrays=arrays)

@@ -140,3 +140,25 @@ def test_open_air_surfaces_leave_the_cavities_out():
     area = {s.name: sum(f.area_m2 for f in surface_faces(s, faces, spec)) for s in spec.surfaces}
     assert area["shaft_front_free"] == pytest.approx(front, rel=1e-9)
     assert area["shaft_rear_free"] == pytest.approx(rear, rel=1e-9)
+
+
+def test_a_spec_scaled_in_radius_is_the_same_spindle_slimmer():
+    """spindle.stretch.scale_radially (the other spindles of bench_families --geometry): the
+    meshed volume (sum of 2 pi r_centroid x triangle area, exact for the straight-sided
+    triangles) scales by the factor squared, to round-off, and the sensors' radii by the
+    factor, each still inside a section."""
+    from spindle.stretch import scale_radially
+
+    def volume(m) -> float:
+        p, t = m.mesh.p, m.mesh.t  # p[0] = z, p[1] = r
+        a, b, c = p[:, t[0]], p[:, t[1]], p[:, t[2]]
+        area = 0.5 * np.abs((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]))
+        return float(np.sum(2 * math.pi * (a[1] + b[1] + c[1]) / 3 * area))
+
+    spec = load_spec("spl2782")
+    slim = scale_radially(spec, 0.8)
+    assert volume(build_mesh(slim, 0)) == pytest.approx(0.64 * volume(build_mesh(spec, 0)),
+                                                        rel=1e-12)
+    assert [s.r for s in slim.sensors] == pytest.approx([0.8 * s.r for s in spec.sensors])
+    sections = [sec for p in slim.parts for sec in p.sections]
+    assert all(any(sec.contains(s.z, s.r) for sec in sections) for s in slim.sensors)
