@@ -194,7 +194,9 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             "missed_by": missed_by(doc, truth),
             "fit_s": rep.runtime_s, "synth_s": t_synth, "sizes": sizes,
             "on_change": bool(not case.path and logs_on_change(case.family, case.seed)),
-            "at_floor": at_floor(sizes)}
+            "at_floor": at_floor(sizes),
+            **({"geometry": list(case.geometry), "fit_own_spec": case.fit_own_spec}
+               if case.geometry and not case.path else {})}
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float, float]:
@@ -443,6 +445,10 @@ def _fitting_options(rows: list[dict], per: dict[str, int], args) -> str:
         out += f" --first-seed {min(seeds)}"
     if any(n == 0 for n in per.values()):
         out += " --families " + " ".join(f for f, n in per.items() if n)
+    geometry = next((r["geometry"] for r in rows if r.get("geometry")), None)
+    if geometry:
+        out += f" --geometry {geometry[0]:g} {geometry[1]:g}"
+        out += " --fit-own-spec" if any(r.get("fit_own_spec") for r in rows) else ""
     return out + "".join(f" --criterion {c}" for c in args.criterion)
 
 

@@ -208,6 +208,13 @@ def test_a_summary_of_saved_rows_names_the_call_that_made_them(tmp_path):
     assert done.returncode == 0, done.stdout + done.stderr
     head = summary.read_text(encoding="utf-8").splitlines()[0]
     assert "--runs-per-family 2 --first-seed 1001 --families effect --json ROWS" in head, head
+    for r in effect:  # rows of another spindle, fitted with its own spec
+        r.update(geometry=[0.75, 1.25], fit_own_spec=True)
+    saved.write_text(json.dumps(effect), encoding="utf-8")
+    done = subprocess.run([sys.executable, "benchmarks/bench_families.py", "--rows", str(saved),
+                           "--summary", str(summary)], cwd=ROOT, capture_output=True, text=True)
+    head = summary.read_text(encoding="utf-8").splitlines()[0]
+    assert "--families effect --geometry 0.75 1.25 --fit-own-spec --json ROWS" in head, head
 
 
 def scan_null_table(doc: dict) -> str:
@@ -398,3 +405,33 @@ def test_the_joint_verdicts_false_alarms_in_prose_are_its_summaries():
                 f"from {b0[0]} to {b1[0]} of {b1[1]} (the peer's runs: {q0[0]} to {q1[0]} of "
                 f"{q1[1]};")
     assert expected in text, expected
+
+
+#: docs/fit.md's runs from another spindle: (file stem, the spindle, the spec fitted with)
+GEOMETRY_SETS = (
+    ("fit-geometry-0.9-0.85-shipped-spec", "radii × 0.9, lengths × 0.85", "spl2782's"),
+    ("fit-geometry-0.75-1.25-shipped-spec", "radii × 0.75, lengths × 1.25", "spl2782's"),
+    ("fit-geometry-0.75-1.25-own-spec", "radii × 0.75, lengths × 1.25", "its own"),
+)
+GEOMETRY_RATES = ("true effect named first (runs with an effect)",
+                  "nothing named on clean runs", "'unexplained' on clean runs (a false alarm)",
+                  "unexplained, nothing named (runs outside the library)",
+                  "a wrong effect named (any run)")
+
+
+def geometry_table() -> str:
+    """docs/fit.md's table of the runs drawn from another spindle
+    (bench_families --geometry), from their summary files."""
+    lines = ["| spindle | spec | " + " | ".join(GEOMETRY_RATES) + " |",
+             "|---|---|" + "---|" * len(GEOMETRY_RATES)]
+    for stem, spindle, spec in GEOMETRY_SETS:
+        text = (ROOT / "docs" / "figures" / f"{stem}.txt").read_text(encoding="utf-8")
+        cells = [f"{k} of {n}" for k, n, *_ in (_rate(text, label) for label in GEOMETRY_RATES)]
+        lines.append(f"| {spindle} | {spec} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def test_the_other_spindles_table_is_its_files():
+    from tests.docs_blocks import assert_block
+
+    assert_block("docs/fit.md", "geometry", geometry_table())
