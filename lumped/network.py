@@ -211,8 +211,8 @@ class _Stamps:
 
     K0: np.ndarray
     B0: np.ndarray
-    Kv: np.ndarray  # (free x free, varying)
-    Bv: np.ndarray  # (free x inputs, varying)
+    Kv: object  # sparse (free x free, varying): four entries per varying edge at most
+    Bv: object  # sparse (free x inputs, varying)
     varying: list
 
 
@@ -280,22 +280,35 @@ class ThermalSystem:
         nf, ni, m = len(self.free), self.n_inputs, len(self.source_names)
         pos = self._pos
         fixed_col = {n: m + k for k, n in enumerate(self.fixed_nodes)}
+        import scipy.sparse as sp
+
         K0, B0 = np.zeros((nf, nf)), np.zeros((nf, ni))
         varying = [k for k, (_, _, G, _) in enumerate(self.edges) if varies_with_speed(G)]
-        Kv, Bv = np.zeros((nf, nf, len(varying))), np.zeros((nf, ni, len(varying)))
         column = {k: c for c, k in enumerate(varying)}
+        # the varying edges' unit stamps as (flat index, column, value) triplets
+        kv: tuple[list, list, list] = ([], [], [])
+        bv: tuple[list, list, list] = ([], [], [])
+
+        def stamp(flat: tuple[list, list, list], dense: np.ndarray, row: int, col: int,
+                  c: int | None, g: float) -> None:
+            if c is None:
+                dense[row, col] += g
+            else:
+                flat[0].append(row * dense.shape[1] + col)
+                flat[1].append(c)
+                flat[2].append(g)
+
         for k, (i, j, G, _) in enumerate(self.edges):
             c = column.get(k)
             # a constant edge adds its value, a varying one a unit into its column
             g = conductance_at(G, 0.0) if c is None else 1.0
-            K, B = (K0, B0) if c is None else (Kv[:, :, c], Bv[:, :, c])
             for a, b in ((i, j), (j, i)):
                 if a in pos:
-                    K[pos[a], pos[a]] += g
+                    stamp(kv, K0, pos[a], pos[a], c, g)
                     if b in pos:
-                        K[pos[a], pos[b]] -= g
+                        stamp(kv, K0, pos[a], pos[b], c, -g)
                     else:
-                        B[pos[a], fixed_col[b]] += g
+                        stamp(bv, B0, pos[a], fixed_col[b], c, g)
         col = {s: k for k, s in enumerate(self.source_names)}
         for n, f in self.flows:
             if n not in pos:
@@ -304,8 +317,10 @@ class ThermalSystem:
             # Q = share q (1 + tc (T - T_ref)) = share q (1 - tc T_ref) + share q tc T
             B0[pos[n], col[f.source]] += (f.share if id(f) in self.across
                                           else f.share * (1.0 - f.tc_1_K * f.T_ref_K))
-        self._stamp = _Stamps(K0, B0, Kv.reshape(nf * nf, -1), Bv.reshape(nf * ni, -1),
-                              [self.edges[k][2] for k in varying])
+        n_var = len(varying)
+        Kv = sp.csr_matrix((kv[2], (kv[0], kv[1])), shape=(nf * nf, n_var))
+        Bv = sp.csr_matrix((bv[2], (bv[0], bv[1])), shape=(nf * ni, n_var))
+        self._stamp = _Stamps(K0, B0, Kv, Bv, [self.edges[k][2] for k in varying])
         return self._stamp
 
     def _full(self, speed_rpm: float, q: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:

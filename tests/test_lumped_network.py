@@ -188,3 +188,22 @@ def test_the_stamped_matrices_are_the_entrywise_ones(nodes, tc):
             K_ref, B_ref = _loop_matrices(sys_, speed, power if tc else None)
             np.testing.assert_allclose(K, K_ref, rtol=0, atol=1e-13 * np.abs(K_ref).max())
             np.testing.assert_allclose(B, B_ref, rtol=0, atol=1e-13 * np.abs(B_ref).max())
+
+
+def test_the_stamps_of_a_fine_network_hold_four_entries_per_varying_conductance():
+    """A dense column of free x free entries per speed-dependent conductance would take
+    1487^2 x 501 x 8 bytes = 8.9 GB for spl2782 at 400 nodes; the stamps keep a varying
+    edge's at most four entries in K and two in B."""
+    import scipy.sparse as sp
+
+    from lumped import build
+    from spindle.spec_reader import load_spec
+
+    sys_ = build(load_spec("spl2782"), 400).system
+    st = sys_._stamps()
+    n_var = len(st.varying)
+    assert n_var > 400 and sp.issparse(st.Kv) and sp.issparse(st.Bv)
+    assert st.Kv.nnz <= 4 * n_var and st.Bv.nnz <= 2 * n_var
+    K, _ = sys_._full(4300.0, None)
+    np.testing.assert_allclose(K, _loop_matrices(sys_, 4300.0, None)[0], rtol=0,
+                               atol=1e-13 * np.abs(K).max())
