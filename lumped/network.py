@@ -251,8 +251,10 @@ class ThermalSystem:
         self.input_names = [f"{s} W" if not isinstance(s, str) else s for s in self.source_names] \
             + [f"{s} K" if not isinstance(s, str) else s for s in self.fixed_sources]
         self.temperature_dependent = any(f.tc_1_K != 0 for _, f in self.flows)
-        col = {s: k for k, s in enumerate(self.source_names)}
-        self._tc_columns = sorted({col[f.source] for _, f in self.flows if f.tc_1_K != 0})
+        #: each heat source's column in u (and in B)
+        self._source_col = {s: k for k, s in enumerate(self.source_names)}
+        self._tc_columns = sorted({self._source_col[f.source] for _, f in self.flows
+                                   if f.tc_1_K != 0})
 
     # ------------------------------------------------------------------ matrices
     def _q_key(self, q: np.ndarray | None) -> tuple | None:
@@ -309,7 +311,7 @@ class ThermalSystem:
                         stamp(kv, K0, pos[a], pos[b], c, -g)
                     else:
                         stamp(bv, B0, pos[a], fixed_col[b], c, g)
-        col = {s: k for k, s in enumerate(self.source_names)}
+        col = self._source_col
         for n, f in self.flows:
             if n not in pos:
                 continue  # heat into a fixed temperature leaves the network at once
@@ -334,7 +336,7 @@ class ThermalSystem:
         if q is None or not self.temperature_dependent:
             return K, B
         pos = self._pos
-        col = {s: k for k, s in enumerate(self.source_names)}
+        col = self._source_col
         for n, f in self.flows:  # the temperature-dependent flows' terms in K
             if n not in pos or not f.tc_1_K:
                 continue
@@ -405,7 +407,7 @@ class ThermalSystem:
 
     def heat_in(self, T_all: np.ndarray, q: np.ndarray) -> float:
         """Heat [W] from the prescribed heat flows at node temperatures T_all."""
-        col = {s: k for k, s in enumerate(self.source_names)}
+        col = self._source_col
         total = 0.0
         for n, f in self.flows:
             if id(f) in self.across:

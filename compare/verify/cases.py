@@ -13,8 +13,6 @@ from spindle.loads import LoadCase
 from spindle.spec import Spec
 from spindle.units import MESH_LEVEL_MAX
 
-MAX_LEVEL = MESH_LEVEL_MAX
-
 
 # ============================================================================ load cases
 def default_cases(spec: Spec) -> list[LoadCase]:
@@ -70,9 +68,9 @@ def save_result(result, out: Path, stem: str, pictures: bool) -> list[Path]:
 
 
 def check_level(level: int, option: str) -> None:
-    if not 0 <= int(level) <= MAX_LEVEL:
+    if not 0 <= int(level) <= MESH_LEVEL_MAX:
         raise InputError("command line", option, f"{level} is out of range",
-                         f"give a level between 0 and {MAX_LEVEL}")
+                         f"give a level between 0 and {MESH_LEVEL_MAX}")
 
 
 def check_positive(value: float, option: str, unit: str) -> None:
