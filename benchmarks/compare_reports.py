@@ -1,13 +1,15 @@
 """A rule's trade, measured: two folders of fit reports (``bench_families.py --reports``) of
-the same runs, before and after a change, compared run by run.
+the same runs, before and after a change, compared run by run; or two files of rows
+(``bench_families.py --json``).
 
-    python benchmarks/compare_reports.py BEFORE_DIR AFTER_DIR [--json OUT.json]
+    python benchmarks/compare_reports.py BEFORE AFTER [--json OUT.json]
                                          [--label "what changed"]
 
 Prints, per family and in all, the runs with the right verdict, the true effect named first,
 a wrong name and 'unexplained', before and after; every run whose verdict changed; and the
 median validation RMS of the calibrated base model [tolerances] (the base's misfit, before any
-effect is named). ``--json`` writes the same as a figures file (benchmarks/figures.py) that
+effect is named; rows do not hold it). From rows, it also counts the runs whose validation RMS
+after moved and gives the fit times. ``--json`` writes the same as a figures file (benchmarks/figures.py) that
 docs/fit.md quotes. The truths are read where bench_families keeps them: the synthetic runs'
 sidecars in benchmarks/.families-cache, the peer's truth.json in tests/data/peer-runs.
 """
@@ -36,13 +38,19 @@ def truth_of(run: str, peers: dict) -> object:
     return None if doc["effect"] == "clean" else doc["effect"]
 
 
-def require_reports(folders) -> None:
-    """End the script with one message and exit status 2 where a folder holds no reports."""
-    for d in folders:
-        if not d.is_dir() or not any(d.glob("*.json")):
+def require_reports(paths) -> None:
+    """End the script with one message and exit status 2 where a path is neither a folder of
+    reports nor a file of rows, or where one is a folder and the other a file."""
+    for d in paths:
+        if not (d.is_file() or (d.is_dir() and any(d.glob("*.json")))):
             print(f"error: {d}: no report.json files; give folders written by "
-                  "bench_families.py --reports", file=sys.stderr)
+                  "bench_families.py --reports or files written by its --json",
+                  file=sys.stderr)
             raise SystemExit(2)
+    if len({d.is_file() for d in paths}) > 1:
+        print(f"error: {paths[0]}, {paths[1]}: one is a folder of reports and the other a file "
+              "of rows; compare two of a kind", file=sys.stderr)
+        raise SystemExit(2)
 
 
 def peer_truths() -> dict:
@@ -58,11 +66,29 @@ def family_of(run: str) -> str:
     return head if head in FAMILIES else "peers"
 
 
+def row_outcomes(path: Path) -> dict[str, dict]:
+    """:func:`outcomes` from the rows of ``bench_families.py --json`` (judged when they were
+    written), with the validation RMS after [K; µm for P1] and the fit time [s]; the base's
+    RMS is not in them."""
+    try:
+        rows = json.loads(path.read_text(encoding="utf-8"))
+        return {r["run"]: {"family": r["family"], "named": r["named"], "verdict": r["verdict"],
+                           "unexplained": r["unexplained"], "right": r["right"],
+                           "first": bool(r["first"]), "wrong": r["wrong"], "base_rms_tol": None,
+                           "rms_after": r["validation_rmse"], "fit_s": r["fit_s"]}
+                for r in rows}
+    except (ValueError, TypeError, KeyError) as e:
+        print(f"error: {path}: not the rows of bench_families.py --json ({e!r})", file=sys.stderr)
+        raise SystemExit(2) from None
+
+
 def outcomes(folder: Path, peers: dict) -> dict[str, dict]:
     """Per run: the family, the verdict judged against the truth, the named effects and the
     base's median validation RMS over its channels [tolerances]."""
     import numpy as np
 
+    if folder.is_file():
+        return row_outcomes(folder)
     out = {}
     for p in sorted(folder.glob("*.json")):
         doc = json.loads(p.read_text(encoding="utf-8"))
@@ -97,7 +123,31 @@ def compare(before: dict, after: dict) -> dict:
                 "right": [before[r]["right"], after[r]["right"]]}
                for r in runs if (before[r]["named"], before[r]["verdict"])
                != (after[r]["named"], after[r]["verdict"])]
-    return {"families": table, "changed": changed}
+    result = {"families": table, "changed": changed}
+    if all("rms_after" in x[r] for x in (before, after) for r in runs):
+        result.update(rms_moves(before, after, runs))
+    return result
+
+
+def rms_moves(before: dict, after: dict, runs: list[str]) -> dict:
+    """Over the runs with a validation RMS in both: how many moved by more than 0.001 and 0.01
+    (K; µm for P1) on some channel, and the largest move; the fit times' median and maximum."""
+    import numpy as np
+
+    moves = []
+    for r in runs:
+        b, a = before[r]["rms_after"], after[r]["rms_after"]
+        if b and a:
+            moves.append(max(abs(a[c] - b[c]) for c in b if c in a))
+    moves = np.asarray(moves)
+    return {"rms_moved": {"runs": len(moves), "over_0.001": int((moves > 1e-3).sum()),
+                          "over_0.01": int((moves > 1e-2).sum()),
+                          "largest": round(float(moves.max()), 3) if len(moves) else None,
+                          "unit": "K; um for P1"},
+            "fit_s": {tag: {"median": round(float(np.median([x[r]["fit_s"] for r in runs])), 1),
+                            "max": round(float(max(x[r]["fit_s"] for r in runs)), 1),
+                            "total": round(float(sum(x[r]["fit_s"] for r in runs)))}
+                      for tag, x in (("before", before), ("after", after))}}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -118,6 +168,13 @@ def main(argv: list[str] | None = None) -> None:
     for c in result["changed"]:
         print(f"  {c['run']:14} {c['before']} -> {c['after']}  right {c['right'][0]} -> "
               f"{c['right'][1]}")
+    if "rms_moved" in result:
+        m, t = result["rms_moved"], result["fit_s"]
+        print(f"validation RMS after moved on {m['over_0.001']} of {m['runs']} runs by more "
+              f"than 0.001 ({m['over_0.01']} by more than 0.01), at most {m['largest']} "
+              f"({m['unit']})")
+        print("fit time: " + ", ".join(f"{k} median {v['median']} s, max {v['max']} s, total "
+                                       f"{v['total']} s" for k, v in t.items()))
     if args.json:
         from figures import write_figures
 

@@ -52,3 +52,44 @@ def test_a_benchmark_refuses_other_code_with_status_2(monkeypatch, tmp_path):
     assert r.returncode == 2, r.stderr
     assert "spindle/outputs.py differs" in r.stderr and "pip install -e" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def _row(run: str, named: list, right: bool, rms_T1: float, fit_s: float) -> dict:
+    return {"family": run.split("-")[0], "run": run, "named": named,
+            "verdict": "named" if named else "base adequate", "unexplained": False,
+            "right": right, "first": right, "wrong": False,
+            "validation_rmse": {"T1": rms_T1, "P1": 0.2}, "fit_s": fit_s}
+
+
+def test_compare_reports_compares_two_files_of_rows(monkeypatch, tmp_path):
+    """Rows of bench_families --json, before and after: the counts per family, the run whose
+    verdict changed, the runs whose validation RMS moved (by 0.005 and by 0.3 on T1: one above
+    0.01) and the fit times; a folder against a file is refused with status 2."""
+    import json
+
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import compare_reports
+
+    before = [_row("two-1", ["windage_loss", "mount_conduction"], True, 0.1, 10.0),
+              _row("two-2", ["fixture_expansion"], True, 0.2, 20.0),
+              _row("clean-1", [], True, 0.1, 6.0)]
+    after = [_row("two-1", ["windage_loss"], False, 0.4, 12.0),
+             _row("two-2", ["fixture_expansion"], True, 0.205, 22.0),
+             _row("clean-1", [], True, 0.1, 6.0)]
+    paths = []
+    for name, rows in (("before.json", before), ("after.json", after)):
+        paths.append(tmp_path / name)
+        paths[-1].write_text(json.dumps(rows), encoding="utf-8")
+    out = tmp_path / "trade.json"
+    compare_reports.main([str(paths[0]), str(paths[1]), "--json", str(out)])
+    doc = json.loads(out.read_text(encoding="utf-8"))
+    assert doc["families"]["two"]["before"]["right"] == 2
+    assert doc["families"]["two"]["after"]["right"] == 1
+    assert doc["changed"] == [{"run": "two-1", "before": ["windage_loss", "mount_conduction"],
+                               "after": ["windage_loss"], "right": [True, False]}]
+    assert doc["rms_moved"] == {"runs": 3, "over_0.001": 2, "over_0.01": 1, "largest": 0.3,
+                                "unit": "K; um for P1"}
+    assert doc["fit_s"]["after"]["max"] == 22.0 and doc["fit_s"]["before"]["total"] == 36
+    r = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "compare_reports.py"),
+                        str(tmp_path), str(paths[1])], capture_output=True, text=True)
+    assert r.returncode == 2 and "compare two of a kind" in r.stderr, r.stderr

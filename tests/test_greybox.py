@@ -450,3 +450,42 @@ def test_a_parameter_the_run_does_not_determine_leaves_the_others_identifiable()
     for i, k in enumerate(("a", "b")):
         half = 0.5 * (ci[k][1] - ci[k][0])
         assert half == pytest.approx(1.96 * sd[i] * (params[k].hi - params[k].lo), rel=1e-9)
+
+
+def test_the_optimizer_tolerance_decides_where_a_calibration_stops(setup):
+    """Criteria.optimizer_tol is least_squares' ftol and xtol: on noise-free data from
+    h_coolant = 1.3, a tolerance of 1e-10 recovers it to round-off (1e-6 relative: the
+    finite-difference Jacobian's step is 1e-4) in more evaluations than a loose 1e-1, which
+    stops farther from it."""
+    spec, _, inp = setup
+    gb = GreyBox(spec, DRIVES["spl2782"], inp)
+    data = Measured(inp.grid_s, gb.simulate({"h_coolant": 1.3}))
+    fits = {}
+    for tol in (1e-1, 1e-10):
+        cal = Calibrator(gb, data, CHANNELS, tol=tol)
+        fits[tol] = cal.fit(free=["h_coolant"], start={"h_coolant": 0.5})
+    assert fits[1e-10].theta["h_coolant"] == pytest.approx(1.3, rel=1e-6)
+    assert abs(fits[1e-1].theta["h_coolant"] - 1.3) > abs(fits[1e-10].theta["h_coolant"] - 1.3)
+    assert fits[1e-1].nfev < fits[1e-10].nfev
+
+
+def test_the_criteria_optimizer_tolerance_reaches_the_calibration(monkeypatch):
+    """run's calibrator takes Criteria.optimizer_tol (so that ``--criterion`` in the
+    benchmark and the report's criteria table are what the optimizer used)."""
+    from compare.fit import run as fit_run
+
+    class Reached(Exception):
+        pass
+
+    def first_fit(self, *args, **kwargs):
+        raise Reached(self.tol)
+
+    monkeypatch.setattr(Calibrator, "fit", first_fit)
+    spec = load_spec("spl2782")
+    from pathlib import Path
+
+    path = Path(__file__).parent / "data" / "peer-runs" / "bench-runs" / "dev-06.csv"
+    with pytest.raises(Reached) as got:
+        fit_run.calibrate_base(path, spec, fem_level=None,
+                               criteria=Criteria(optimizer_tol=3e-7))
+    assert got.value.args == (3e-7,)

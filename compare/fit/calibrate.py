@@ -201,6 +201,8 @@ class Calibrator:
     measured: Measured
     channels: Sequence[str]
     max_nfev: int = 60
+    #: least_squares' ftol and xtol (compare.fit.criteria.Criteria.optimizer_tol)
+    tol: float = 1e-6
     progress: Callable[[str], None] | None = None
     #: prior centres (the spec's values, compare.fit.discrepancy); the widths are Param.prior_sd
     prior: dict[str, float] | None = None
@@ -317,7 +319,7 @@ class Calibrator:
                                    self.prior_scale * self._prior_terms(params, free, z)])
 
         sol = least_squares(vec, z0, bounds=(lo, hi), diff_step=1e-4, x_scale="jac",
-                            max_nfev=max_nfev or self.max_nfev, ftol=1e-6, xtol=1e-6)
+                            max_nfev=max_nfev or self.max_nfev, ftol=self.tol, xtol=self.tol)
         theta.update({k: _from_z(params[k], float(v)) for k, v in zip(free, sol.x, strict=True)})
         out = gb.simulate(theta)
         res = self.residuals(out, "fit")

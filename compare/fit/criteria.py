@@ -117,6 +117,12 @@ class Criteria:
         1.0, "W/K", "a conductance the spec lacks (G_seat_W_K) is reported as needed above "
         "1 W/K: that moves a bearing ring carrying 30-60 W of friction by several kelvin, far "
         "above the sensors' resolution")
+    optimizer_tol: float = _c(
+        1e-6, "-", "least_squares' ftol and xtol (the relative change of the cost and of the "
+        "scaled parameters at which a calibration stops): a computing budget. 1e-8 was "
+        "measured on the main and held-out sets: 9 % more time, no verdict better, and the "
+        "validation RMS as sensitive to round-off as at 1e-6, since it moves along directions "
+        "the run does not determine (docs/fit-history.md, 2026-11-28)")
     refit_nfev: int = _c(
         20, "evaluations", "computing budget of the refit of the candidate that joins the "
         "model, which starts from its Gauss-Newton fit and converges in a few iterations")

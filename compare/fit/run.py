@@ -148,7 +148,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     def calibrator(on: Inputs) -> Calibrator:
         return Calibrator(GreyBox(spec, drive, on, nodes, base_extra=base_extra,
                                   speed_bin_rel=criteria.speed_bin_rel), measured,
-                          channels, progress=say)
+                          channels, progress=say, tol=criteria.optimizer_tol)
 
     cal = calibrator(inputs)
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
