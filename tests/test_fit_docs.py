@@ -112,7 +112,9 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-withdraw-held-out": "fit-trade-withdraw-held-out.json",
           "trade-complements": "fit-trade-complements.json",
           "trade-complements-held-out": "fit-trade-complements-held-out.json",
-          "trade-complements-fresh": "fit-trade-complements-fresh.json"}
+          "trade-complements-fresh": "fit-trade-complements-fresh.json",
+          "trade-optimizer-tol": "fit-trade-optimizer-tol.json",
+          "trade-optimizer-tol-held-out": "fit-trade-optimizer-tol-held-out.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
@@ -123,6 +125,40 @@ def test_each_trade_is_its_figures_file(block):
 
     doc = json.loads((ROOT / "docs" / "figures" / TRADES[block]).read_text(encoding="utf-8"))
     assert_block("docs/fit.md", block, trade_table(doc))
+
+
+def optimizer_tol_text() -> str:
+    """docs/fit.md's figures of the optimizer's tolerance, from the files compare_reports.py
+    wrote from rows (validation RMS moves and fit times)."""
+    import json
+    import textwrap
+
+    def doc(name: str) -> dict:
+        return json.loads((ROOT / "docs" / "figures" / name).read_text(encoding="utf-8"))
+
+    def moved(d: dict) -> str:
+        m = d["rms_moved"]
+        return (f"{m['over_0.001']} of {m['runs']} runs, by more than 0.01 on {m['over_0.01']}, "
+                f"at most {m['largest']}")
+
+    main, held = doc("fit-trade-optimizer-tol.json"), doc("fit-trade-optimizer-tol-held-out.json")
+    r6, r8 = doc("fit-roundoff-1e-6.json"), doc("fit-roundoff-1e-8.json")
+    t = main["fit_s"]
+    return textwrap.fill(
+        f"At 1e-8 the validation RMS moved by more than 0.001 (K or µm) on {moved(main)}; held "
+        f"out on {moved(held)}. The fits took {t['after']['total']} s in all against "
+        f"{t['before']['total']} s: median {t['before']['median']} → {t['after']['median']} s, "
+        f"maximum {t['before']['max']} → {t['after']['max']} s. The round-off change moved the "
+        f"validation RMS by more than 0.001 on {moved(r6)} at 1e-6, and on {moved(r8)} at "
+        "1e-8 (docs/figures/fit-roundoff-1e-6.json and -1e-8.json: the rows before the "
+        "stamps, at 1e-6 and with 1e-8 written into that tree, against those after).",
+        width=92)
+
+
+def test_the_optimizer_tolerance_figures_are_their_files():
+    from tests.docs_blocks import assert_block
+
+    assert_block("docs/fit.md", "optimizer-tol-figures", optimizer_tol_text())
 
 
 #: issue 32's targets: the summary's line, the bound and its direction
