@@ -161,3 +161,49 @@ def test_a_run_at_standstill_throughout_is_fitted_not_a_traceback(tmp_path):
     assert main(["fit", str(run), "--out", str(out), "--quiet", "--no-pictures"]) == 0
     verdict = json.loads((out / "report.json").read_text(encoding="utf-8"))["verdict"]
     assert verdict["kind"] != "base adequate"
+
+
+def test_advice_on_a_parameter_the_run_determines_only_in_a_pair_names_the_pair():
+    """alpha_eff and axial_scale both scale P1: a run determines their product, not each. An
+    implausible alpha_eff whose partner is axial_scale (Fit.partners) is said with both
+    places to look; without partners the advice is the parameter's own."""
+    spec = {**SPEC, "alpha_eff": 1.0, "axial_scale": 1.0}
+    theta = {"h_coolant": 1.0, "f0": 0.3, "alpha_eff": 0.7, "axial_scale": 0.8}
+    args = (_errors({"P1": (0.1, 0.2)}), theta, spec,
+            {"h_coolant": 0.0, "f0": 0.0, "alpha_eff": -(IMPLAUSIBLE_Z + 1.0),
+             "axial_scale": -1.5})
+    alone = base_adequacy(*args)
+    paired = base_adequacy(*args, partners={"alpha_eff": ("axial_scale", -0.97)})
+    assert alone["implausible"] == paired["implausible"] == ["alpha_eff"]
+    assert "together with" not in alone["statement"]
+    assert ("this run does not determine alpha_eff alone but together with axial_scale "
+            "(correlation -0.97): look at the axial dimensions") in paired["statement"]
+    # axial_scale on its bound has its own advice: the pair is named, its place said once
+    on_bound = base_adequacy(*args, bounds={"axial_scale": (0.8, 1.25)},
+                             partners={"alpha_eff": ("axial_scale", -0.97)})
+    assert on_bound["at_bound"] == ["axial_scale"]
+    assert "together with axial_scale (correlation -0.97))" in on_bound["statement"]
+    assert on_bound["statement"].count("the axial dimensions") == 1
+
+
+def test_the_partner_of_a_parameter_is_the_one_it_is_determined_with():
+    """_intervals on a Jacobian whose first two columns nearly coincide (the data determine a
+    + b, hardly a - b) and a third of its own, on three log-scaled parameters (h_coolant's
+    prior and range): a and b are not identifiable, each the other's partner (correlation
+    near -1, and fixing one determines the other); c is identifiable and has none. A column
+    of zeros (d) is free alone and with any partner, so it has none either."""
+    from compare.fit.calibrate import _intervals
+    from compare.fit.params import BASE_PARAMS
+
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(400, 2))
+    J = np.column_stack([x[:, 0], x[:, 0] + 1e-3 * x[:, 1], rng.normal(size=400),
+                         np.zeros(400)])
+    r = 0.05 * rng.normal(size=400)
+    names = ["a", "b", "c", "d"]
+    params = dict.fromkeys(names, BASE_PARAMS["h_coolant"])
+    _, corr, ident, partners = _intervals(J, r, 400, 400.0, names, params, np.zeros(4))
+    assert ident == {"a": False, "b": False, "c": True, "d": False}
+    assert set(partners) == {"a", "b"}
+    assert partners["a"][0] == "b" and partners["b"][0] == "a"
+    assert partners["a"][1] < -0.99

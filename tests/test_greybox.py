@@ -443,8 +443,9 @@ def test_a_parameter_the_run_does_not_determine_leaves_the_others_identifiable()
     params = {k: Param(k, "-", 0.5, 0.0, 1.0, k, log=False) for k in ("a", "b", "c")}
     free = ["a", "b", "c"]
     z = np.array([0.5, 0.5, 0.5])  # mid-range: no interval is cut by a bound
-    ci, _, ident = _intervals(J, r, n, float(n), free, params, z)
+    ci, _, ident, partners = _intervals(J, r, n, float(n), free, params, z)
     assert ident == {"a": True, "b": True, "c": False}
+    assert partners == {}  # c does nothing, with any other fixed or not
     s2 = float(r @ r) / (n - 3)
     sd = np.sqrt(np.diag(np.linalg.inv(J[:, :2].T @ J[:, :2]) * s2))
     for i, k in enumerate(("a", "b")):

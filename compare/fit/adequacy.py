@@ -56,7 +56,8 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
                   theta: Mapping[str, float], spec_values: Mapping[str, float],
                   prior_z: Mapping[str, float] | None,
                   bounds: Mapping[str, tuple[float, float]] | None = None,
-                  criteria=None) -> dict:
+                  criteria=None,
+                  partners: Mapping[str, tuple[str, float]] | None = None) -> dict:
     """The base-adequacy verdict of a calibrated base model.
 
     ``errors``: :meth:`compare.fit.calibrate.Calibrator.errors` of the base fit (per window
@@ -66,7 +67,10 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     parameters' ranges (lo, hi), to say which ran to a bound (a bound that is the spec's own
     value is no advice: a path the spec lacks calibrated to nothing); ``criteria``
     (compare.fit.criteria.Criteria; default the defaults) gives the plausible range (at its
-    alpha), the bound's width and the least missing conductance.
+    alpha), the bound's width and the least missing conductance; ``partners``
+    (:attr:`compare.fit.calibrate.Fit.partners`) the parameter each one the run does not
+    determine alone moves with: its advice names the pair, since the run pushed the two
+    together and either may be the one that is off.
 
     Returns ``{"adequate": bool, "channels": {c: {window: rmse_w}}, "inadequate_channels":
     [...], "moved": [{name, spec, calibrated, z}], "implausible": [...], "at_bound": [...],
@@ -107,6 +111,18 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
             # where the calibration says "not needed": no advice
             if (on_lo and abs(spec - lo) > tol) or (on_hi and abs(spec - hi) > tol):
                 at_bound.append(k)
+
+    def where(k: str, default: str) -> str:
+        text = WHERE_IN_SPEC.get(k, default)
+        if k in (partners or {}):
+            other, r = partners[k]
+            said = other in (*implausible, *at_bound, *missing)  # its own advice follows
+            text += (f"; this run does not determine {k} alone but together with {other} "
+                     f"(correlation {r:+.2f})"
+                     + (f": look at {WHERE_IN_SPEC[other]} too"
+                        if other in WHERE_IN_SPEC and not said else ""))
+        return text
+
     worst: dict[str, tuple[str, float]] = {}
     for c, window, r in bad:
         if r > worst.get(c, ("", 0.0))[1]:
@@ -119,17 +135,17 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     if implausible:
         parts.append("needs implausible values to fit the run: " + "; ".join(
             f"{k} {theta[k]:.3g} (the spec's {spec_values[k]:.3g}, {z[k]:+.1f} prior sd; look "
-            f"at {WHERE_IN_SPEC.get(k, 'its value in the spec')})" for k in implausible))
+            f"at {where(k, 'its value in the spec')})" for k in implausible))
     adequate = not worst and not implausible
     statement = ("explains the run within the tolerances with every base parameter inside its "
                  "prior range" if adequate else "; ".join(parts))
     if at_bound:
         statement += ("; " + "; ".join(
             f"{k} ran to the bound of its range ({theta[k]:.3g}, spec {spec_values[k]:.3g}): "
-            f"look at {WHERE_IN_SPEC.get(k, 'its value in the spec')}" for k in at_bound))
+            f"look at {where(k, 'its value in the spec')}" for k in at_bound))
     if missing:  # the calibrated base has it; the spec does not: say so either way
         statement += ("; it needed a path the spec lacks: " + "; ".join(
-            f"{k} = {theta[k]:.3g} (spec 0): look at {WHERE_IN_SPEC.get(k, 'the spec')}"
+            f"{k} = {theta[k]:.3g} (spec 0): look at {where(k, 'the spec')}"
             for k in missing))
     return {"adequate": adequate, "channels": channels,
             "inadequate_channels": sorted(worst), "moved": moved,

@@ -181,6 +181,9 @@ class Fit:
     runtime_s: float = 0.0
     nfev: int = 0
     penalty: float = 0.0  # 1/2 sum ((z - z_ref) / sd)^2 over the free parameters with a prior
+    #: for a parameter the run does not determine alone, the one it is determined with:
+    #: (name, correlation), where fixing that one would make it identifiable (_intervals)
+    partners: dict[str, tuple[str, float]] = field(default_factory=dict)
 
     @property
     def k(self) -> int:
@@ -328,10 +331,10 @@ class Calibrator:
         n_eff = max(effective_samples(res), len(free) + 2.0)
         J = sol.jac[:n]  # the data rows: the intervals say what this run alone determines
         penalty = 0.5 * float(np.sum(self._prior_terms(params, free, sol.x) ** 2))
-        ci, corr, ident = _intervals(J, r_all, n, n_eff, free, params, sol.x)
+        ci, corr, ident, partners = _intervals(J, r_all, n, n_eff, free, params, sol.x)
         return Fit(tuple(effects), theta, free, ci, corr, ident,
                    concentrated_loglik(res.values()), n, n_eff, out, self.errors(out),
-                   time.perf_counter() - t0, nfev, penalty)
+                   time.perf_counter() - t0, nfev, penalty, partners)
 
 
 def over_tolerance(window_errors: Mapping[str, Mapping[str, float]]) -> dict[str, float]:
@@ -368,7 +371,10 @@ def effective_samples(res: dict[str, np.ndarray]) -> float:
 
 def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[str],
                params: dict[str, Param], z: np.ndarray):
-    """95 % intervals in the parameters' own units, correlations, identifiability."""
+    """95 % intervals in the parameters' own units, correlations, identifiability, and for
+    each parameter that is not identifiable the one it is determined with: the parameter of
+    largest |correlation| r, where with that one fixed its interval (sd sqrt(1 - r^2)) would
+    fit its range. Where none would, the run leaves it free with several others."""
     p = len(free)
     s2 = float(np.dot(r, r)) / max(n - p, 1) * (n / n_eff)
     ci: dict[str, tuple[float, float]] = {}
@@ -392,7 +398,17 @@ def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[st
         b_lo, b_hi = _bounds_z(pr)
         ci[k] = (_from_z(pr, max(lo_z, b_lo)), _from_z(pr, min(hi_z, b_hi)))
         ident[k] = bool(np.isfinite(sd[i]) and 3.92 * sd[i] < (b_hi - b_lo))
-    return ci, corr, ident
+    partners: dict[str, tuple[str, float]] = {}
+    for i, k in enumerate(free):
+        if ident[k] or p < 2 or not np.isfinite(sd[i]):
+            continue
+        r = np.nan_to_num(corr[i].copy())
+        r[i] = 0.0
+        j = int(np.argmax(np.abs(r)))
+        b_lo, b_hi = _bounds_z(params[k])
+        if 3.92 * sd[i] * np.sqrt(max(1.0 - r[j] ** 2, 0.0)) < (b_hi - b_lo):
+            partners[k] = (free[j], float(r[j]))
+    return ci, corr, ident, partners
 
 
 # ---------------------------------------------------------------------- tests

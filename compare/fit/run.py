@@ -328,9 +328,10 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                        for c in channels}, dt, ins, alpha=criteria.alpha)
     ranges = {k: (p.lo, p.hi) for k, p in cal.gb.parameters().items()}
     adequacy = base_adequacy(sel.base.errors, sel.base.theta, prep.spec_values,
-                             cal.prior_z(sel.base), ranges, criteria)
+                             cal.prior_z(sel.base), ranges, criteria, sel.base.partners)
     adequacy["with_effects"] = base_adequacy(final.errors, final.theta, prep.spec_values,
-                                             cal.prior_z(final), ranges, criteria)
+                                             cal.prior_z(final), ranges, criteria,
+                                             final.partners)
     warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
                                    measured.fit_points())
     warns += [f"{g.text()} inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} h); the change "
