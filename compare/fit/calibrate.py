@@ -402,12 +402,12 @@ def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[st
     for i, k in enumerate(free):
         if ident[k] or p < 2 or not np.isfinite(sd[i]):
             continue
-        r = np.nan_to_num(corr[i].copy())
-        r[i] = 0.0
-        j = int(np.argmax(np.abs(r)))
+        rho = np.nan_to_num(corr[i].copy())
+        rho[i] = 0.0
+        j = int(np.argmax(np.abs(rho)))
         b_lo, b_hi = _bounds_z(params[k])
-        if 3.92 * sd[i] * np.sqrt(max(1.0 - r[j] ** 2, 0.0)) < (b_hi - b_lo):
-            partners[k] = (free[j], float(r[j]))
+        if 3.92 * sd[i] * np.sqrt(max(1.0 - rho[j] ** 2, 0.0)) < (b_hi - b_lo):
+            partners[k] = (free[j], float(rho[j]))
     return ci, corr, ident, partners
 
 
