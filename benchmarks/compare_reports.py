@@ -138,7 +138,7 @@ def rms_moves(before: dict, after: dict, runs: list[str]) -> dict:
     for r in runs:
         b, a = before[r]["rms_after"], after[r]["rms_after"]
         if b and a:
-            moves.append(max(abs(a[c] - b[c]) for c in b if c in a))
+            moves.append(max((abs(a[c] - b[c]) for c in b if c in a), default=0.0))
     moves = np.asarray(moves)
     return {"rms_moved": {"runs": len(moves), "over_0.001": int((moves > 1e-3).sum()),
                           "over_0.01": int((moves > 1e-2).sum()),
