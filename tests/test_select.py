@@ -459,6 +459,25 @@ def test_the_verdict_says_when_an_effect_was_named_for_the_base_it_spares():
     assert "prior's range" not in moved and moved.startswith("Named: mount_conduction")
 
 
+def test_an_adequate_base_with_implausible_values_says_so_in_the_verdict():
+    """report.verdict_lines: "nothing named, base adequate" (the tolerances are met) points to
+    the base parameters outside their prior range where the adequacy lists some, so that the
+    verdict and the adequacy's "needs implausible values" below it do not read as a
+    contradiction; a plausible base's verdict stays as it was."""
+    from compare.fit.report import verdict_lines
+
+    def doc(implausible):
+        return {"verdict": {"kind": "base adequate", "unexplained": False}, "effects": [],
+                "base_adequacy": {"implausible": implausible},
+                "error_before": {"validation": {}}, "error_after": {"validation": {}}}
+
+    assert verdict_lines(doc(["stator_contact"]))[0] == (
+        "Nothing named, base adequate: the calibrated base model explains the run within the "
+        "tolerances, with stator_contact outside its prior range (the base's adequacy, below).")
+    assert verdict_lines(doc([]))[0] == ("Nothing named, base adequate: the calibrated base "
+                                         "model explains the run within the tolerances.")
+
+
 def test_the_verdict_says_which_fitted_effect_was_withdrawn_and_why():
     """report.verdict_lines on a hand-written report document: a candidate withdrawn after
     the selection (final_model_adequate False) is named as fitted and withdrawn, with the

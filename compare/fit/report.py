@@ -142,8 +142,13 @@ def verdict_lines(doc: dict) -> list[str]:
         lines.append("Unexplained: no effect of the library explains this run, and something "
                      f"else does: {v['where']}{_where_more(v)}.")
     elif v["kind"] == "base adequate":
+        # adequate to the tolerances; whether its values are plausible is the adequacy's
+        # statement below, which this points to so that the two do not read as a contradiction
+        far = (doc.get("base_adequacy") or {}).get("implausible") or []
         lines.append("Nothing named, base adequate: the calibrated base model explains the run "
-                     "within the tolerances.")
+                     "within the tolerances" + (
+                         f", with {', '.join(far)} outside {'its' if len(far) == 1 else 'their'}"
+                         " prior range (the base's adequacy, below)" if far else "") + ".")
     else:
         lines.append("Nothing named, base inadequate: the calibrated base model misses the "
                      "tolerances, and neither an effect of the library nor something at one "
