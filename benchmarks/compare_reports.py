@@ -82,15 +82,16 @@ def row_outcomes(path: Path) -> dict[str, dict]:
         raise SystemExit(2) from None
 
 
-def outcomes(folder: Path, peers: dict) -> dict[str, dict]:
+def outcomes(path: Path, peers: dict) -> dict[str, dict]:
     """Per run: the family, the verdict judged against the truth, the named effects and the
-    base's median validation RMS over its channels [tolerances]."""
+    base's median validation RMS over its channels [tolerances]; from a folder of reports, or
+    from a file of rows (:func:`row_outcomes`)."""
     import numpy as np
 
-    if folder.is_file():
-        return row_outcomes(folder)
+    if path.is_file():
+        return row_outcomes(path)
     out = {}
-    for p in sorted(folder.glob("*.json")):
+    for p in sorted(path.glob("*.json")):
         doc = json.loads(p.read_text(encoding="utf-8"))
         o = fit_outcome(doc)
         v = judge_verdict(truth_of(p.stem, peers), o["named_plain"], o["unexplained"])

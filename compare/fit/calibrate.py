@@ -392,20 +392,18 @@ def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[st
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(sd, sd)
+    partners: dict[str, tuple[str, float]] = {}
     for i, k in enumerate(free):
         pr = params[k]
         lo_z, hi_z = z[i] - 1.96 * sd[i], z[i] + 1.96 * sd[i]
         b_lo, b_hi = _bounds_z(pr)
         ci[k] = (_from_z(pr, max(lo_z, b_lo)), _from_z(pr, min(hi_z, b_hi)))
         ident[k] = bool(np.isfinite(sd[i]) and 3.92 * sd[i] < (b_hi - b_lo))
-    partners: dict[str, tuple[str, float]] = {}
-    for i, k in enumerate(free):
         if ident[k] or p < 2 or not np.isfinite(sd[i]):
             continue
         rho = np.nan_to_num(corr[i].copy())
         rho[i] = 0.0
         j = int(np.argmax(np.abs(rho)))
-        b_lo, b_hi = _bounds_z(params[k])
         if 3.92 * sd[i] * np.sqrt(max(1.0 - rho[j] ** 2, 0.0)) < (b_hi - b_lo):
             partners[k] = (free[j], float(rho[j]))
     return ci, corr, ident, partners
