@@ -430,7 +430,9 @@ class ThermalSystem:
         key = ("modes", round(float(dt_s), 9), float(speed_rpm))
         if key not in self._cache:
             K, B, _, _ = self.matrices(speed_rpm, None)
-            if self.temperature_dependent or not np.allclose(K, K.T, rtol=1e-12, atol=0.0):
+            # np.allclose(K, K.T, rtol=1e-12, atol=0) for a finite K, without its checks for
+            # infinities and nan: a fit asks this at every speed of every parameter set
+            if self.temperature_dependent or not np.all(np.abs(K - K.T) <= 1e-12 * np.abs(K.T)):
                 self._cache[key] = None
             else:
                 s = 1.0 / np.sqrt(self.C)

@@ -47,6 +47,46 @@ def test_greybox_is_the_lumped_model(setup):
     np.testing.assert_allclose(out["P1"], tr.growth_m["P1"] - tr.growth_m["P1"][0], atol=1e-14)
 
 
+@pytest.mark.parametrize("lab", [None, "bearing_preload", "coolant_dynamics", "windage_loss",
+                                 "mount_conduction", "sensor_lag(T1)"])
+def test_a_simulation_does_not_depend_on_the_parameter_sets_simulated_before(setup, lab):
+    """A calibration asks for thousands of parameter sets, and the grey box keeps what they
+    share: each speed-dependent conductance read once per speed (shared by every set's
+    system), the systems and their modes, the sources, the effects' flows configured in
+    place. The channels of one set must then be the same, bit for bit, from a fresh grey box
+    as from one that simulated other films, contacts, friction, lengths and effect values
+    first; only then is a fit's result independent of the path its optimizer took. (That the
+    shared readings are the right ones is test_greybox_is_the_lumped_model's: at the spec's
+    values every speed-dependent film goes through them.) The base, and the effects that
+    enter the network's flows, conductances or the sensors' dynamics."""
+    spec, _, inp = setup
+    extra = ("G_seat_W_K", "axial_scale", "friction_exponent")
+    effects = () if lab is None else (lab,)
+
+    def grey_box() -> GreyBox:
+        return GreyBox(spec, DRIVES["spl2782"], inp, base_extra=extra).variant(effects)
+
+    params = grey_box().parameters()
+    own = [k for k in params if k not in GreyBox(spec, DRIVES["spl2782"], inp,
+                                                  base_extra=extra).parameters()]
+
+    def at(share: float) -> dict[str, float]:  # the effect's parameters across their range
+        return {k: params[k].lo + share * (params[k].hi - params[k].lo) for k in own}
+
+    theta = {"h_coolant": 0.8, "h_air": 1.3, "h_rotating": 1.7, "contact": 0.6,
+             "stator_contact": 1.4, "f0": 1.1, "axial_scale": 1.05, "G_seat_W_K": 2.0,
+             "friction_exponent": 0.1, **at(0.3)}
+    fresh = grey_box().simulate(theta)
+    warm = grey_box()
+    for other in ({}, {"h_rotating": 0.5, "axial_scale": 0.9, **at(0.7)},
+                  {**theta, "h_rotating": 1.2, **at(0.1)}, {**theta, "f0": 0.9, "contact": 1.6}):
+        moved = warm.simulate(other)
+        assert np.max(np.abs(moved["T1"] - fresh["T1"])) > 0.01  # they are other sets
+    again = warm.simulate(theta)
+    for c in CHANNELS:
+        np.testing.assert_array_equal(again[c], fresh[c])
+
+
 #: one candidate label per library effect (a per-channel effect on P1)
 LABELS = [label(n, "P1" if e.per_channel else None) for n, e in sorted(LIBRARY.items())]
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.params import EXTRA_BASE_PARAMS, Param, base_params
-from lumped.blocks import Convection, FixedTemperature
+from lumped.blocks import Convection, FixedTemperature, varies_with_speed
 from lumped.build import build_network
 from lumped.simulation import LumpedModel
 from spindle.bench_inputs import interval_heat_W
@@ -270,12 +270,14 @@ class GreyBox:
             scale = theta.get("axial_scale", 1.0)
             edge_exp, cap_exp = (self._stretch()[0][scale > 1.0] if scale != 1.0
                                  else (np.zeros(len(base.edges)), np.zeros(len(base.capacity))))
+            memos = self._cache.setdefault(("conductance_memos", self.nodes, self.effects,
+                                            self._seats), [{} for _ in base.edges])
             edges = []
             for k, (i, j, G, name) in enumerate(base.edges):
                 g = edge_group[k]
                 factor = (theta[g] if g is not None else 1.0) * scale ** edge_exp[k]
-                if factor != 1.0:
-                    G = _scaled(G, factor)
+                if factor != 1.0 or varies_with_speed(G):
+                    G = _scaled(G, factor, memos[k])
                 if name in owned:
                     G = owned[name]
                 if name.startswith("seat:"):
@@ -445,9 +447,12 @@ def _touches_stator(spec: Spec, block_name: str) -> bool:
     return any(spec.part(p).role == "stator" for p in _edge_parts(block_name))
 
 
-def _scaled(G, factor: float):
+def _scaled(G, factor: float, memo: dict[float, float] | None = None):
+    """``factor`` times the conductance G [W/K]; a G that varies with speed is read once per
+    speed into ``memo`` (shared by every parameter set's system, as G is), so a new set of
+    films costs a product, not the film correlation, at each of the run's speed levels."""
     if callable(G) and not isinstance(G, int | float):
-        return _Scaled(G, factor)
+        return _Scaled(G, factor, {} if memo is None else memo)
     return float(G) * factor
 
 
@@ -455,8 +460,14 @@ def _scaled(G, factor: float):
 class _Scaled:
     G: object
     factor: float
+    #: speed [rpm] -> conductance_at(G, speed) [W/K]; the product below is the same float as
+    #: without it
+    memo: dict[float, float] = field(default_factory=dict, compare=False, repr=False)
 
     def __call__(self, speed_rpm: float) -> float:
         from lumped.blocks import conductance_at
 
-        return self.factor * conductance_at(self.G, speed_rpm)
+        g = self.memo.get(speed_rpm)
+        if g is None:
+            g = self.memo[speed_rpm] = conductance_at(self.G, speed_rpm)
+        return self.factor * g
