@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from compare.fit.adequacy import base_adequacy, extrapolation_warnings
+from compare.fit.adequacy import WHERE_IN_SPEC, base_adequacy, extrapolation_warnings
 from compare.fit.criteria import Criteria
 
 IMPLAUSIBLE_Z = Criteria().implausible_z()  # the plausible range at the default alpha
@@ -182,7 +182,8 @@ def test_advice_on_a_parameter_the_run_determines_only_in_a_pair_names_the_pair(
     on_bound = base_adequacy(*args, bounds={"axial_scale": (0.8, 1.25)},
                              partners={"alpha_eff": ("axial_scale", -0.97)})
     assert on_bound["at_bound"] == ["axial_scale"]
-    assert "together with axial_scale (correlation -0.97))" in on_bound["statement"]
+    assert ("together with axial_scale (correlation -0.97); axial_scale ran to the bound"
+            in on_bound["statement"])
     assert on_bound["statement"].count("the axial dimensions") == 1
 
 
@@ -207,3 +208,28 @@ def test_the_partner_of_a_parameter_is_the_one_it_is_determined_with():
     assert set(partners) == {"a", "b"}
     assert partners["a"][0] == "b" and partners["b"][0] == "a"
     assert partners["a"][1] < -0.99
+
+
+def _depth(text: str) -> int:
+    """The deepest nesting of parentheses in ``text``."""
+    depth = deepest = 0
+    for ch in text:
+        depth += (ch == "(") - (ch == ")")
+        deepest = max(deepest, depth)
+    assert depth == 0, text
+    return deepest
+
+
+@pytest.mark.parametrize("name", sorted(WHERE_IN_SPEC))
+def test_the_advice_for_an_implausible_parameter_reads_without_nested_parentheses(name):
+    """Each parameter's place in the spec carries its own parentheses (the drive file's
+    [motor] rotor_loss_share, ...): the statement around it must not wrap it in another pair,
+    as "h_rotating 3.43 (the spec's 1, +3.1 prior sd; look at ... (shaft and tool surfaces,
+    correlation d_m))" did (issue 32: each sentence reads as a sentence)."""
+    theta = {**SPEC, name: 2.0}
+    out = base_adequacy(_errors({"T1": (0.1, 0.2)}), theta, {**SPEC, name: 1.0},
+                        {name: IMPLAUSIBLE_Z + 1.0})
+    assert out["implausible"] == [name]
+    assert f"{name} 2, +{IMPLAUSIBLE_Z + 1.0:.1f} prior sd from the spec's 1: look at" \
+        in out["statement"]
+    assert _depth(out["statement"]) <= 1, out["statement"]

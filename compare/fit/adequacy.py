@@ -134,8 +134,9 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
             for c, (w, r) in sorted(worst.items(), key=lambda kv: -kv[1][1])))
     if implausible:
         parts.append("needs implausible values to fit the run: " + "; ".join(
-            f"{k} {theta[k]:.3g} (the spec's {spec_values[k]:.3g}, {z[k]:+.1f} prior sd; look "
-            f"at {where(k, 'its value in the spec')})" for k in implausible))
+            # no parentheses around the advice: it has its own
+            f"{k} {theta[k]:.3g}, {z[k]:+.1f} prior sd from the spec's {spec_values[k]:.3g}: "
+            f"look at {where(k, 'its value in the spec')}" for k in implausible))
     adequate = not worst and not implausible
     statement = ("explains the run within the tolerances with every base parameter inside its "
                  "prior range" if adequate else "; ".join(parts))
