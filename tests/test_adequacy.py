@@ -233,3 +233,17 @@ def test_the_advice_for_an_implausible_parameter_reads_without_nested_parenthese
     assert f"{name} 2, +{IMPLAUSIBLE_Z + 1.0:.1f} prior sd from the spec's 1: look at" \
         in out["statement"]
     assert _depth(out["statement"]) <= 1, out["statement"]
+
+
+def test_a_base_that_misses_and_needs_implausible_values_says_both_in_one_sentence():
+    """"The base model misses T2 by 1.7 times its tolerance (...); needs implausible values"
+    lost its subject after the semicolon (dev2-03's report): the second clause says "it"."""
+    out = base_adequacy(_errors({"T2": (0.5, 1.7)}), {**SPEC, "f0": 0.9}, SPEC,
+                        {"f0": IMPLAUSIBLE_Z + 1.0, "h_coolant": 0.0})
+    assert out["inadequate_channels"] == ["T2"] and out["implausible"] == ["f0"]
+    assert out["statement"].startswith("misses T2 by 1.7 times its tolerance")
+    assert "validation window); it needs implausible values to fit the run: f0 0.9" \
+        in out["statement"]
+    alone = base_adequacy(_errors({"T2": (0.1, 0.2)}), {**SPEC, "f0": 0.9}, SPEC,
+                          {"f0": IMPLAUSIBLE_Z + 1.0, "h_coolant": 0.0})
+    assert alone["statement"].startswith("needs implausible values to fit the run: f0 0.9")

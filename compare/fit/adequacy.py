@@ -132,8 +132,8 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
         parts.append("misses " + "; ".join(
             f"{c} by {r:.1f} times its tolerance (open-loop RMS, {w} window)"
             for c, (w, r) in sorted(worst.items(), key=lambda kv: -kv[1][1])))
-    if implausible:
-        parts.append("needs implausible values to fit the run: " + "; ".join(
+    if implausible:  # after a miss, a clause of its own: "...; it needs ..."
+        parts.append(("it " if parts else "") + "needs implausible values to fit the run: " + "; ".join(
             # no parentheses around the advice: it has its own
             f"{k} {theta[k]:.3g}, {z[k]:+.1f} prior sd from the spec's {spec_values[k]:.3g}: "
             f"look at {where(k, 'its value in the spec')}" for k in implausible))
