@@ -459,6 +459,22 @@ def test_the_verdict_says_when_an_effect_was_named_for_the_base_it_spares():
     assert "prior's range" not in moved and moved.startswith("Named: mount_conduction")
 
 
+@pytest.mark.parametrize("unit, shown", [("um/krpm^2", "µm/krpm²"), ("W/krpm^3", "W/krpm³"),
+                                         ("um/K", "µm/K"), ("K/W", "K/W"), ("s", "s")])
+def test_a_named_effect_states_its_unit_as_the_other_lines_do(unit, shown):
+    """The verdict's error line says µm; the named effect's value said "0.0519 um/krpm^2"
+    (dev-01), the code's ASCII spelling. It says µm/krpm² now; report.json keeps the code's."""
+    from compare.fit.report import verdict_lines
+
+    effect = {"label": "centrifugal_shortening", "parameters": {"c": 0.0519},
+              "units": {"c": unit}, "confidence_intervals": {"c": [0.04, 0.064]},
+              "evidence": {"z": 25.3, "p_value": 1e-10}, "route": "signature", "criteria": {}}
+    doc = {"verdict": {"kind": "named", "unexplained": False}, "effects": [effect],
+           "error_before": {"validation": {}}, "error_after": {"validation": {}}}
+    assert verdict_lines(doc)[0].startswith(
+        f"Named: centrifugal_shortening, c = 0.0519 {shown} (95 %: 0.04 to 0.064).")
+
+
 def test_an_adequate_base_with_implausible_values_says_so_in_the_verdict():
     """report.verdict_lines: "nothing named, base adequate" (the tolerances are met) points to
     the base parameters outside their prior range where the adequacy lists some, so that the

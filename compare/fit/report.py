@@ -112,6 +112,12 @@ def _where_more(v: dict) -> str:
     return f"; {text}" if text else ""
 
 
+def shown_unit(unit: str) -> str:
+    """A parameter's unit as a reader sees it: the code's ASCII ``um/krpm^2`` as µm/krpm²
+    (report.json keeps the code's spelling)."""
+    return unit.replace("um", "µm").replace("^2", "²").replace("^3", "³")
+
+
 def verdict_lines(doc: dict) -> list[str]:
     """The verdict in sentences: what was found, then the error before and after."""
     v = doc["verdict"]
@@ -119,7 +125,8 @@ def verdict_lines(doc: dict) -> list[str]:
     if v["kind"] == "named":
         for e in doc["effects"]:
             vals = "; ".join(
-                f"{k} = {x:.3g} {e['units'].get(k, '')} (95 %: {ci[0]:.3g} to {ci[1]:.3g})"
+                f"{k} = {x:.3g} {shown_unit(e['units'].get(k, ''))} (95 %: {ci[0]:.3g} to "
+                f"{ci[1]:.3g})"
                 for k, x in e["parameters"].items() if isinstance(x, int | float)
                 for ci in [e["confidence_intervals"].get(k, (math.nan, math.nan))])
             ev = e["evidence"]
