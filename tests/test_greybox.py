@@ -87,6 +87,32 @@ def test_a_simulation_does_not_depend_on_the_parameter_sets_simulated_before(set
         np.testing.assert_array_equal(again[c], fresh[c])
 
 
+def test_grey_boxes_on_other_inputs_may_share_a_cache_without_its_input_keys(setup):
+    """The gap placement (compare.fit.run._place_gap_switches) tries a speed switch at each
+    grid edge inside a logging gap, each a grey box on other inputs sharing one cache (the
+    network does not depend on the inputs), and drops the keys ("src", ...) between them.
+    Everything input-dependent must sit under those keys: a grey box on the trial inputs
+    must then give, bit for bit, what a fresh one does. (The run's operating points, tried
+    under another key, kept the first trial's speeds for every later trial:
+    docs/fit-history.md.)"""
+    from dataclasses import replace
+
+    spec, _, inp = setup
+    shared: dict = {}
+    GreyBox(spec, DRIVES["spl2782"], inp, _cache=shared).simulate({})
+    speed = np.asarray(inp.speed_rpm, dtype=float).copy()
+    speed[100:140] = np.where(speed[100:140] > 0, 0.5 * speed[100:140] + 700.0, 2000.0)
+    trial = replace(inp, speed_rpm=speed)
+    for k in [k for k in shared if isinstance(k, tuple) and k[:1] == ("src",)]:
+        del shared[k]
+    reused = GreyBox(spec, DRIVES["spl2782"], trial, _cache=shared).simulate({})
+    fresh = GreyBox(spec, DRIVES["spl2782"], trial).simulate({})
+    assert np.max(np.abs(fresh["T_stator"] - GreyBox(spec, DRIVES["spl2782"], inp)
+                         .simulate({})["T_stator"])) > 0.5  # the trial's speeds matter
+    for c in CHANNELS:
+        np.testing.assert_array_equal(reused[c], fresh[c])
+
+
 #: one candidate label per library effect (a per-channel effect on P1)
 LABELS = [label(n, "P1" if e.per_channel else None) for n, e in sorted(LIBRARY.items())]
 
