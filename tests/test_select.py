@@ -460,7 +460,8 @@ def test_the_verdict_says_when_an_effect_was_named_for_the_base_it_spares():
 
 
 @pytest.mark.parametrize("unit, shown", [("um/krpm^2", "µm/krpm²"), ("W/krpm^3", "W/krpm³"),
-                                         ("um/K", "µm/K"), ("K/W", "K/W"), ("s", "s")])
+                                         ("um/K", "µm/K"), ("K/W", "K/W"), ("s", "s"),
+                                         ("kg/m^3", "kg/m³"), ("drum/s", "drum/s")])
 def test_a_named_effect_states_its_unit_as_the_other_lines_do(unit, shown):
     """The verdict's error line says µm; the named effect's value said "0.0519 um/krpm^2"
     (dev-01), the code's ASCII spelling. It says µm/krpm² now; report.json keeps the code's."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
@@ -115,7 +116,7 @@ def _where_more(v: dict) -> str:
 def shown_unit(unit: str) -> str:
     """A parameter's unit as a reader sees it: the code's ASCII ``um/krpm^2`` as µm/krpm²
     (report.json keeps the code's spelling)."""
-    return unit.replace("um", "µm").replace("^2", "²").replace("^3", "³")
+    return re.sub(r"\bum\b", "µm", unit).replace("^2", "²").replace("^3", "³")
 
 
 def verdict_lines(doc: dict) -> list[str]:
