@@ -270,8 +270,10 @@ class GreyBox:
             scale = theta.get("axial_scale", 1.0)
             edge_exp, cap_exp = (self._stretch()[0][scale > 1.0] if scale != 1.0
                                  else (np.zeros(len(base.edges)), np.zeros(len(base.capacity))))
-            memos = self._cache.setdefault(("conductance_memos", self.nodes, self.effects,
-                                            self._seats), [{} for _ in base.edges])
+            memo_key = ("conductance_memos", self.nodes, self.effects, self._seats)
+            if memo_key not in self._cache:  # one memo per edge, made once per structure
+                self._cache[memo_key] = [{} for _ in base.edges]
+            memos = self._cache[memo_key]
             edges = []
             for k, (i, j, G, name) in enumerate(base.edges):
                 g = edge_group[k]
