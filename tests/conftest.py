@@ -2,6 +2,13 @@
 
 from __future__ import annotations
 
+# first, before numpy loads: one BLAS thread, as the spindle-verify command runs (see
+# compare/entry.py), so that the tests compute what the command computes, and two test workers
+# on two cores do not each start two BLAS threads (on 2 cores the default run took 3:08 with one
+# thread per worker and 5:43 with two; docs/verification.md, "Running the tests")
+import compare.entry  # noqa: F401
+
+# isort: split
 import textwrap
 from pathlib import Path
 
