@@ -36,7 +36,8 @@ CASES = [
 #: (measured 2026-11-28, python -m pytest -m slow tests/test_peer_inject.py)
 KNOWN_MISSED = [
     ("dev-06", "sensor_lag", {"tau_s": 1200.0}, "T_stator",
-     "named when the slow set was last run whole (2026-11-26), missed on 2026-11-28: "
+     "the case of the rule 'a lag's need judged on its channel; a failing P1 term does not "
+     "block it': named when the slow set was last run whole (2026-11-26), missed on 2026-11-28: "
      "T_stator's onset test does not apply on this run (p None) and the base, with h_rotating "
      "and stator_contact outside their prior ranges, fits within the tolerances (validation "
      "RMS T_stator 0.23 K): nothing named, base adequate"),

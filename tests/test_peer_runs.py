@@ -55,7 +55,7 @@ KNOWN_OVER_TOLERANCE: dict[str, str] = {
 }
 
 
-def _xfail(known: dict[str, str]) -> list:
+def _runs(known: dict[str, str]) -> list:
     # one xdist group a run: its three tests share one fit (_fit's cache) in one worker
     return [pytest.param(k, marks=[pytest.mark.xdist_group(k)]
                          + ([pytest.mark.xfail(strict=True, reason=known[k])] if k in known
@@ -93,7 +93,7 @@ def _true_effects(truth) -> list[str]:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("label", _xfail(KNOWN_WRONG))
+@pytest.mark.parametrize("label", _runs(KNOWN_WRONG))
 def test_no_wrong_cause_is_named(label):
     doc = _fit(label)
     true = _true_effects(TRUTHS[label][1])
@@ -104,7 +104,7 @@ def test_no_wrong_cause_is_named(label):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("label", _xfail(KNOWN_NOT_RIGHT))
+@pytest.mark.parametrize("label", _runs(KNOWN_NOT_RIGHT))
 def test_the_verdict_is_right(label):
     doc = _fit(label)
     truth = TRUTHS[label][1]
@@ -119,7 +119,7 @@ def test_the_verdict_is_right(label):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("label", _xfail(KNOWN_OVER_TOLERANCE))
+@pytest.mark.parametrize("label", _runs(KNOWN_OVER_TOLERANCE))
 def test_validation_error_within_the_tolerances_where_the_verdict_claims_it(label):
     """Issue 32: a named effect or an adequate base carries the validation RMS within the
     paper's 1 K / 1.5 um (spindle.tolerances); other verdicts claim nothing about it."""
