@@ -462,9 +462,9 @@ def _scaled(G, factor: float, memo: dict[float, float] | None = None):
 class _Scaled:
     G: object
     factor: float
-    #: speed [rpm] -> conductance_at(G, speed) [W/K]; the product below is the same float as
-    #: without it
-    memo: dict[float, float] = field(default_factory=dict, compare=False, repr=False)
+    #: speed [rpm] -> conductance_at(G, speed) [W/K], given by _scaled; the product below is
+    #: the same float as without it
+    memo: dict[float, float] = field(compare=False, repr=False)
 
     def __call__(self, speed_rpm: float) -> float:
         from lumped.blocks import conductance_at
