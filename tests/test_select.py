@@ -309,6 +309,72 @@ def _smooth_block_regressors(rng, rows: int, blocks: int, channels: int):
     return Regressors(np.arange(blocks + 1, dtype=float), heat, offset), channel
 
 
+class _RunsAway:
+    """An effect for the test below: T1 rises by k times 5 K over the run, and beyond
+    ``k_max`` the model becomes non-finite, as a feedback beyond its stability does (a
+    preload near 1/K on a spindle whose base calibrated a high friction: found on a peer run
+    exported with T1 alone, where fit used to stop with a LinAlgError)."""
+
+    def __new__(cls, k_max: float):
+        from compare.fit.effects import Effect
+        from compare.fit.params import Param
+
+        class RunsAway(Effect):
+            name = "test_runs_away"
+            params = (Param("k_runs_away", "-", 0.0, 0.0, 1.0, "the rise's share",
+                            log=False),)
+            channels = ("T1",)
+
+            def as_measured(self, out, theta, inputs, channel):
+                k = theta["k_runs_away"]
+                if k > k_max:
+                    return {c: v * np.nan for c, v in out.items()}
+                g = np.asarray(inputs.grid_s, dtype=float)
+                return {**out, "T1": out["T1"] + k * 5.0 * (g - g[0]) / (g[-1] - g[0])}
+
+        return RunsAway()
+
+
+@pytest.mark.parametrize("k_true, k_max, start, expect", [
+    (0.3, 0.6, 0.95, "near truth"),  # a start where the model runs away is halved to 0.475
+    (0.9, 0.6, None, "at the edge"),  # every step towards the truth lands beyond the edge
+    (0.3, 0.0, None, "none"),  # the model runs away wherever the effect is
+])
+def test_a_candidate_that_makes_the_model_run_away_is_fitted_where_it_does_not(
+        setup, k_true, k_max, start, expect):
+    """compare.fit.linear.fit_effect halves a start or a Gauss-Newton step that lands where
+    the model is not finite, back towards where it is; where it is nowhere but at the neutral
+    value, there is no estimate (None), and the selection goes on without the candidate
+    instead of failing."""
+    from compare.fit.effects import register, unregister
+    from compare.fit.linear import fit_effect, local
+
+    spec, inp = setup
+    truth = GreyBox(spec, DRIVES["spl2782"], inp).simulate({"f0": 0.4})
+    g = inp.grid_s
+    truth["T1"] = truth["T1"] + k_true * 5.0 * (g - g[0]) / (g[-1] - g[0])
+    vals = _noisy(truth, len(g), 11)
+    effect = register(_RunsAway(k_max))
+    try:
+        cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(g, vals), CHANNELS)
+        base = cal.fit()
+        ef = fit_effect(local(cal, base), effect.name,
+                        None if start is None else {"k_runs_away": start})
+        if expect == "none":
+            assert ef is None
+            sel = select(cal, base, [effect.name], Criteria())
+            assert sel.steps == [] and sel.judged == [], sel.judged
+            return
+        k = ef.values["k_runs_away"]
+        assert np.all(np.isfinite(ef.shift)) and np.isfinite(ef.gain) and k <= k_max
+        if expect == "near truth":  # the linear rise is found exactly but for the noise
+            assert k == pytest.approx(k_true, abs=0.02), k
+        else:  # halved towards the edge: within the last halving of it
+            assert k >= 0.5 * k_max, k
+    finally:
+        unregister(effect.name)
+
+
 def test_the_verdicts_scan_has_its_stated_level_on_noise_and_is_sharper_than_bonferroni():
     """compare.fit.competitor.scan_threshold: the scan's largest statistic on white noise
     it has not drawn exceeds the critical value at about the rate alpha (Monte Carlo test,

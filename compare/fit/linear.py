@@ -221,13 +221,14 @@ class EffectFit:
 
 
 def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
-               iterations: int = 6) -> EffectFit:
+               iterations: int = 6) -> EffectFit | None:
     """The effect ``label`` fitted jointly with the base parameters on the linearized model
     ``loc``: the base parameters enter through the Jacobian, the effect's own parameters
     exactly (the model is simulated at their value, and their columns taken there), by a
     few Gauss-Newton iterations within their bounds. ``start``: the effect's parameters to
     start from (default: a tenth into their range). Costs one simulation per iteration and
-    parameter, and one more per iteration."""
+    parameter, and one more per iteration. None where the model runs away (becomes
+    non-finite) wherever the effect was tried: a feedback beyond its stability."""
     cal, fit = loc.cal, loc.fit
     gb = cal.gb.variant(fit.effects + (label,))
     params = effect_of(label).params
@@ -253,9 +254,18 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
             simulated[key] = at(zv)
         return simulated[key]
 
+    def finite(zv: np.ndarray) -> bool:
+        return bool(np.all(np.isfinite(at_once(zv))))
+
     r_neutral = at_once(z_n)
+    # a feedback beyond its stability (a preload near 1/K) runs away, which no spindle on a
+    # bench does: a start or a step that lands there is halved towards where the model is
+    for _ in range(30):
+        if finite(z):
+            break
+        z = z_n + 0.5 * (z - z_n)
     best = None
-    for _ in range(iterations):
+    for _ in range(iterations if finite(z) else 0):
         r_z = at_once(z)
         cols = np.empty((len(r_z), len(params)))
         for i in range(len(params)):
@@ -263,12 +273,20 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
             zz = z.copy()
             zz[i] += h
             cols[:, i] = (at(zz) - r_z) / h
+        if not np.all(np.isfinite(cols)):  # at the edge of a runaway: stop where it is
+            break
         # the base parameters' step from the current model and the effect's from z
         shifted = replace(loc, r0=r_z)
         step = shifted.step(rows, cols, list(zip(lo - z, hi - z, strict=True)))
+        for _ in range(30):
+            z_new = np.clip(z + step[kb:], lo, hi)
+            if finite(z_new):
+                break
+            step = 0.5 * step
+        else:
+            break
         r1 = shifted.residual(step, cols)
         gain = loc.gain_of(r1, step)
-        z_new = np.clip(z + step[kb:], lo, hi)
         # the gain is that of the stepped parameters, so the estimate is where the step lands
         # (not where it was taken from: a mount fitted from 0 W/K to 3 W/K has the gain of
         # 3 W/K, and its shift at 0 W/K is nothing)
@@ -277,6 +295,8 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
         if np.max(np.abs(z_new - z)) < 1e-4 * np.max(hi - lo):
             break
         z = z_new
+    if best is None:  # the model runs away wherever the effect was tried: no estimate
+        return None
     gain, z, delta, r1, cols = best
     values = {p.name: _from_z(p, float(v)) for p, v in zip(params, z, strict=True)}
     return EffectFit(label, z, values, delta, r1, cols, float(gain), at_once(z) - r_neutral)

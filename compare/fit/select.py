@@ -270,7 +270,12 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
             from_signature = _signature_start(lab, sig.get(lab))
             if from_signature:
                 tries.append(fit_effect(loc, lab, from_signature))
-            fits[lab] = max(tries, key=lambda f: f.gain)
+            tries = [f for f in tries if f is not None]
+            if tries:
+                fits[lab] = max(tries, key=lambda f: f.gain)
+            else:
+                say(f"round {rnd}: {lab} makes the model run away wherever it was tried; "
+                    "not judged")
         say(f"round {rnd}: fitting something else")
         shrink = current.n_eff / max(current.n, 1)
         found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit & known_inputs(loc, unknown_inputs),
