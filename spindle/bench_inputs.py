@@ -26,8 +26,11 @@ def bench_grid(run: BenchRun, grid_s: float | None = None) -> np.ndarray:
     """Times of the model's inputs [s]: the multiples of ``grid_s`` (default 60 s) from the
     last one at or before the run's first sample to its end, plus the run's first and last
     sample times; strictly increasing (points closer than 1e-6 grid_s to the run's start or
-    end are dropped in their favour). A run whose clock does not start near 0 (a bench that
-    logs the time of day) gets the same grid as the run shifted to start there."""
+    end are dropped in their favour). A run whose clock starts a multiple of ``grid_s`` late
+    (a bench that logs the time of day from a full minute) gets the grid of the same run
+    logged from 0, shifted; a start between two multiples moves the grid's phase against
+    the samples, which can move a verdict that lies near a criterion's edge
+    (benchmarks/bench_perturb.py, ``clock``)."""
     step = DEFAULT_GRID_S if grid_s is None else float(grid_s)
     if not math.isfinite(step) or step <= 0:
         raise InputError(str(run.path), "grid_s", f"{grid_s!r} is not a time step > 0 s",

@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -93,3 +95,40 @@ def test_compare_reports_compares_two_files_of_rows(monkeypatch, tmp_path):
     r = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "compare_reports.py"),
                         str(tmp_path), str(paths[1])], capture_output=True, text=True)
     assert r.returncode == 2 and "compare two of a kind" in r.stderr, r.stderr
+
+
+def test_the_logging_perturbations_leave_the_data_as_they_say(monkeypatch, tmp_path):
+    """benchmarks/bench_perturb.py measures whether a verdict survives a change of logging,
+    so each perturbation must change the logging alone, read back through the bench reader:
+    ``reorder`` the same columns to the bit, ``clock`` every time shifted by one offset that
+    is not a multiple of the 60 s grid, ``decimate`` rows at least 30 s apart holding each
+    channel's last logged value, ``sparse`` half of each measured channel's values (a peer's
+    run logged by exception)."""
+    from spindle.bench import read_bench
+
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import bench_perturb
+
+    src = ROOT / "tests" / "data" / "peer-runs" / "bench-runs-2" / "dev2-04.csv"
+    text = src.read_text(encoding="utf-8")
+    runs = {}
+    for p in ("none", *bench_perturb.PERTURBATIONS):
+        path = tmp_path / f"{p}.csv"
+        path.write_text(bench_perturb.perturbed_text(text, p, 7), encoding="utf-8", newline="")
+        runs[p] = read_bench(path)
+    base, cols = runs["none"], ("speed_rpm", "power_kW", "T1_C", "P1_um")
+    for c in cols:
+        np.testing.assert_array_equal(runs["reorder"].columns[c], base.columns[c])
+    shift = runs["clock"].time_s - base.time_s
+    np.testing.assert_allclose(shift, shift[0], rtol=0, atol=1e-3)  # written to 1 ms
+    assert shift[0] > 0 and abs(shift[0] / 60.0 - round(shift[0] / 60.0)) > 1e-3
+    dec = runs["decimate"]
+    assert np.all(np.diff(dec.time_s) >= bench_perturb.DECIMATE_S - 1e-9)  # to round-off
+    for c in cols:  # each kept row holds the channel's last value logged at or before it
+        logged = np.isfinite(base.columns[c])
+        t, y = base.time_s[logged], base.columns[c][logged]
+        i = np.searchsorted(t, dec.time_s, side="right") - 1
+        np.testing.assert_array_equal(dec.columns[c][i >= 0], y[i[i >= 0]])
+    for c in ("T1_C", "P1_um"):
+        n0 = np.isfinite(base.columns[c]).sum()
+        assert np.isfinite(runs["sparse"].columns[c]).sum() == n0 - n0 // 2
