@@ -38,7 +38,7 @@ import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from bench_families import PEER_RUNS, wilson
+from bench_families import PEER_RUNS, rate_line
 from verdicts import fit_outcome, judge_verdict, named_text, read_truth, run_verdicts
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
@@ -128,31 +128,32 @@ def one(case: Case) -> dict:
 def summary(rows: list[dict]) -> str:
     """Per perturbation: verdicts that stay, right verdicts, and the runs that changed."""
     base = {r["run"]: r for r in rows if r["perturbation"] == "none"}
-    lines = [f"runs: {len(base)} as exported; rates with 95 % Wilson intervals"]
 
-    def rate(label: str, k: int, n: int) -> str:
-        p, lo, hi = wilson(k, n)
-        return f"  {label:44} {k:3d} of {n:3d}  {100 * p:5.1f} %  [{100 * lo:5.1f}, {100 * hi:5.1f}]"
+    def stays(r: dict) -> bool:
+        b = base[r["run"]]
+        return (r["named"], r["unexplained"]) == (b["named"], b["unexplained"])
 
-    right = [r for r in base.values() if r["right"]]
-    lines.append(rate("right verdict, as exported", len(right), len(base)))
-    lines.append(rate("a wrong effect named, as exported",
-                      sum(r["wrong"] for r in base.values()), len(base)))
+    def right(r: dict) -> bool:
+        return r["right"]
+
+    def wrong(r: dict) -> bool:
+        return r["wrong"]
+
+    exported = list(base.values())
+    lines = [f"runs: {len(base)} as exported; rates with 95 % Wilson intervals",
+             rate_line("right verdict, as exported", exported, right),
+             rate_line("a wrong effect named, as exported", exported, wrong)]
     for p in dict.fromkeys(r["perturbation"] for r in rows if r["perturbation"] != "none"):
         mine = [r for r in rows if r["perturbation"] == p and r["run"] in base]
-        same = [r for r in mine if (r["named"], r["unexplained"])
-                == (base[r["run"]]["named"], base[r["run"]]["unexplained"])]
-        lines.append(f"{p}:")
-        lines.append(rate("verdict stays", len(same), len(mine)))
-        lines.append(rate("right verdict", sum(r["right"] for r in mine), len(mine)))
-        lines.append(rate("a wrong effect named", sum(r["wrong"] for r in mine), len(mine)))
-        for r in mine:
+        lines += [f"{p}:", rate_line("verdict stays", mine, stays),
+                  rate_line("right verdict", mine, right),
+                  rate_line("a wrong effect named", mine, wrong)]
+        for r in (r for r in mine if not stays(r)):
             b = base[r["run"]]
-            if r not in same:
-                lines.append(f"    {r['run']:8} {named_text(b['named'], b['unexplained'])} -> "
-                             f"{named_text(r['named'], r['unexplained'])} "
-                             f"({'right' if b['right'] else 'not right'} -> "
-                             f"{'right' if r['right'] else 'not right'})")
+            lines.append(f"    {r['run']:8} {named_text(b['named'], b['unexplained'])} -> "
+                         f"{named_text(r['named'], r['unexplained'])} "
+                         f"({'right' if b['right'] else 'not right'} -> "
+                         f"{'right' if r['right'] else 'not right'})")
     return "\n".join(lines)
 
 

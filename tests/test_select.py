@@ -11,8 +11,9 @@ import pytest
 from compare.fit.calibrate import Calibrator, Measured
 from compare.fit.competitor import WindowHeat
 from compare.fit.criteria import Criteria
-from compare.fit.effects import candidates, hypothesis
+from compare.fit.effects import Effect, candidates, hypothesis
 from compare.fit.greybox import GreyBox
+from compare.fit.params import Param
 from compare.fit.select import Judgement, select, signature_outcome
 from compare.fit.signatures import EventTest
 from spindle.cycle_files import load_cycle
@@ -309,30 +310,25 @@ def _smooth_block_regressors(rng, rows: int, blocks: int, channels: int):
     return Regressors(np.arange(blocks + 1, dtype=float), heat, offset), channel
 
 
-class _RunsAway:
+class _RunsAway(Effect):
     """An effect for the test below: T1 rises by k times 5 K over the run, and beyond
     ``k_max`` the model becomes non-finite, as a feedback beyond its stability does (a
     preload near 1/K on a spindle whose base calibrated a high friction: found on a peer run
     exported with T1 alone, where fit used to stop with a LinAlgError)."""
 
-    def __new__(cls, k_max: float):
-        from compare.fit.effects import Effect
-        from compare.fit.params import Param
+    name = "test_runs_away"
+    params = (Param("k_runs_away", "-", 0.0, 0.0, 1.0, "the rise's share", log=False),)
+    channels = ("T1",)
 
-        class RunsAway(Effect):
-            name = "test_runs_away"
-            params = (Param("k_runs_away", "-", 0.0, 0.0, 1.0, "the rise's share",
-                            log=False),)
-            channels = ("T1",)
+    def __init__(self, k_max: float):
+        self.k_max = k_max
 
-            def as_measured(self, out, theta, inputs, channel):
-                k = theta["k_runs_away"]
-                if k > k_max:
-                    return {c: v * np.nan for c, v in out.items()}
-                g = np.asarray(inputs.grid_s, dtype=float)
-                return {**out, "T1": out["T1"] + k * 5.0 * (g - g[0]) / (g[-1] - g[0])}
-
-        return RunsAway()
+    def as_measured(self, out, theta, inputs, channel):
+        k = theta["k_runs_away"]
+        if k > self.k_max:
+            return {c: v * np.nan for c, v in out.items()}
+        g = np.asarray(inputs.grid_s, dtype=float)
+        return {**out, "T1": out["T1"] + k * 5.0 * (g - g[0]) / (g[-1] - g[0])}
 
 
 @pytest.mark.parametrize("k_true, k_max, start, expect", [
