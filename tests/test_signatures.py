@@ -97,6 +97,18 @@ def test_centrifugal_jump_is_recovered(c_true):
     assert test.significant(0.01)
 
 
+
+def test_a_jump_test_on_p1_logged_every_30_s_says_the_logging_is_too_sparse():
+    """The shortening of the test above, P1 logged every 30 s: the 10-80 s after a step hold
+    two or three samples, fewer than a line's four, so the jumps cannot be read. The test is
+    not applicable and says why (the logging, not the cycle's steps)."""
+    n = _step_speed(T_EV)
+    p1_um = _thermal(T_EV, 300.0, 1e-3) - 0.06 * (n / 1000.0) ** 2
+    every_30 = slice(None, None, 30)
+    test = jump_test(T_EV[every_30], p1_um[every_30] * 1e-6, _steps(T_EV, n), CRITERIA)
+    assert math.isnan(test.p_value) and test.n_steps == 0
+    assert "5 step(s) have fewer than 4 of P1's samples within 10-80 s" in test.meaning
+
 def test_no_jump_is_not_called_a_jump():
     """The same fast thermal response without the shortening: no significant shortening (at
     the fit's 1 % level), over 20 noise draws."""
@@ -149,6 +161,7 @@ def test_the_long_onset_scale_reads_a_slow_lag_on_a_noisy_channel():
     assert lagged.scales[0]["z"] < 2.58  # the short scale alone: not significant at 1 %
     assert all(not lag_test("P1", T_EV, bench(y, s), steps, model, CRITERIA).significant(0.01)
                for s in range(20))
+
 
 
 def test_event_signatures_on_the_peer_runs():

@@ -68,10 +68,14 @@ def jump_test(t_s: np.ndarray, p1_m: np.ndarray, steps, criteria) -> EventTest:
     from scipy.stats import norm
 
     J, X, S, rows = [], [], [], []
+    sparse = 0  # steps large enough whose windows hold too few of P1's samples
     for s in steps:
+        if abs(s.dn2_krpm2) < 1.0:
+            continue
         before = line_fit(t_s, p1_m, criteria.jump_before_s, s.t_s)
         after = line_fit(t_s, p1_m, criteria.jump_after_s, s.t_s)
-        if before is None or after is None or abs(s.dn2_krpm2) < 1.0:
+        if before is None or after is None:
+            sparse += 1
             continue
         jump_um = (after[0] - before[0]) * 1e6
         se_um = math.hypot(after[2], before[2]) * 1e6
@@ -81,8 +85,13 @@ def jump_test(t_s: np.ndarray, p1_m: np.ndarray, steps, criteria) -> EventTest:
         rows.append({"t_s": s.t_s, "n_before_rpm": s.n_before_rpm, "n_after_rpm": s.n_after_rpm,
                      "jump_um": jump_um, "se_um": se_um})
     if len(J) < 2:
+        why = "too few clean speed steps to read P1's jumps"
+        if sparse:
+            a, b = criteria.jump_after_s
+            why += (f": {sparse} step(s) have fewer than 4 of P1's samples within {a:g}-{b:g} s"
+                    " after them or in the minutes before (P1 logged too sparsely to see a jump)")
         return EventTest("centrifugal_shortening", "P1", math.nan, math.nan, math.nan, math.nan,
-                         len(J), "um/krpm^2", "too few clean speed steps to read P1's jumps")
+                         len(J), "um/krpm^2", why)
     c, se = through_origin(np.array(J), np.array(X), np.array(S))
     z = c / se
     return EventTest("centrifugal_shortening", "P1", c, se, z, float(norm.sf(z)), len(J),
