@@ -164,6 +164,40 @@ def test_the_long_onset_scale_reads_a_slow_lag_on_a_noisy_channel():
 
 
 
+def test_the_onset_test_applies_only_where_the_model_is_concave_beyond_its_own_scatter():
+    """The lag test reads a channel's onset against the model's: it applies where the model's
+    onset ratio clears concave_ratio by z_(1-alpha) of the ratio's own standard error over the
+    model's steps. The lagged channel of the test above, against a model ratio 1.9 with se 0.5
+    (a scatter such as a peer run's T_stator shows: 0.85 +- 1.91): at alpha 0.01 the lower
+    bound 1.9 - 2.33 * 0.5 = 0.74 is below 1.15, so nothing is read (without the se the lag is
+    found); at alpha 0.1, 1.9 - 1.28 * 0.5 = 1.26 clears it and the lag is found: --alpha
+    reaches the gate. The model's own se (the concave two-mass signal, noiseless) is small and
+    leaves the test as it was."""
+    from dataclasses import replace
+
+    scales = CRITERIA.onset_scales
+    n = _step_speed(T_EV)
+    y = _thermal(T_EV, 1800.0, 3e-4) + _thermal(T_EV, 300.0, 1e-4)
+    steps = {sc.name: _steps(T_EV, n, sc) for sc in scales}
+    own = {sc.name: onset_ratio(T_EV, y, steps[sc.name], sc)[:2] for sc in scales}
+    rng = np.random.default_rng(2)
+    bench = np.round((first_order_lag(T_EV, y, 900.0) + rng.normal(0.0, 0.05, len(T_EV)))
+                     / 0.1) * 0.1
+    with_own_se = lag_test("P1", T_EV, bench, steps, {k: v[0] for k, v in own.items()},
+                           CRITERIA, {k: v[1] for k, v in own.items()})
+    assert [s["applicable"] for s in with_own_se.scales] == [True, True]
+    assert with_own_se.p_value < 0.01
+
+    ambiguous = {sc.name: 1.9 for sc in scales}
+    scatter = {sc.name: 0.5 for sc in scales}
+    assert lag_test("P1", T_EV, bench, steps, ambiguous, CRITERIA).p_value < 0.01
+    vetoed = lag_test("P1", T_EV, bench, steps, ambiguous, CRITERIA, scatter)
+    assert not any(s["applicable"] for s in vetoed.scales) and math.isnan(vetoed.p_value)
+    assert all(s["model_ratio_se"] == 0.5 for s in vetoed.scales)
+    lenient = lag_test("P1", T_EV, bench, steps, ambiguous, replace(CRITERIA, alpha=0.1),
+                       scatter)
+    assert all(s["applicable"] for s in lenient.scales) and lenient.p_value < 0.1
+
 def test_event_signatures_on_the_peer_runs():
     """On a peer's nine runs (an independent simulator): P1 jumps significantly with n^2 only
     on the centrifugal-shortening run, and T1's onset is S-shaped (ratio below 1 by more than

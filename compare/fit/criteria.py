@@ -177,7 +177,8 @@ class Criteria:
     concave_ratio: float = _c(
         1.15, "-", "the model's onset ratio above which a channel is expected to respond at "
         "once (a concave onset): the ratio of a first-order response's slope change over "
-        "the two windows is 1.3 and falls to 1 for a ramp; 1.15 is half-way")
+        "the two windows is 1.3 and falls to 1 for a ramp; 1.15 is half-way. The model's "
+        "ratio must clear it by its own one-sided interval at alpha")
     lag_grid_s: tuple[float, ...] = _c(
         (0.0, 15.0, 30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1800.0, 3600.0), "s",
         "the lag time constants the onset ratio is mapped over, doubling up to the library's "

@@ -202,6 +202,8 @@ class ModelOnsets:
     steps: dict[str, list[Step]]
     ratios: dict[str, dict[str, float]]
     lag_grid_s: tuple[float, ...]
+    #: the ratios' standard errors (their scatter over the model's steps)
+    ratio_se: dict[str, dict[str, float]] = field(default_factory=dict)
 
     def lag_for_ratio(self, channel: str, ratio: float, scale: OnsetScale) -> float:
         """The first-order lag time constant [s] that brings the model's onset ratio of
@@ -236,9 +238,12 @@ def model_onsets(gb, theta: dict[str, float], channels, criteria, sub: int = 6) 
     n_end = np.concatenate([[model.inputs.speed_rpm[0]], model.inputs.speed_rpm])
     steps = {sc.name: speed_steps(t, n_end, criteria.step_rpm, sc.quiet_s)
              for sc in criteria.onset_scales}
-    ratios = {c: {sc.name: onset_ratio(t, out[c], steps[sc.name], sc)[0]
-                  for sc in criteria.onset_scales} for c in channels if c in out}
-    return ModelOnsets(t, {c: out[c] for c in ratios}, steps, ratios, criteria.lag_grid_s)
+    fits = {c: {sc.name: onset_ratio(t, out[c], steps[sc.name], sc)[:2]
+                for sc in criteria.onset_scales} for c in channels if c in out}
+    ratios = {c: {k: v[0] for k, v in f.items()} for c, f in fits.items()}
+    ratio_se = {c: {k: v[1] for k, v in f.items()} for c, f in fits.items()}
+    return ModelOnsets(t, {c: out[c] for c in ratios}, steps, ratios, criteria.lag_grid_s,
+                       ratio_se)
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,8 @@ class SensorLag(Effect):
         onsets = ctx.model_onsets()
         for c in ctx.channels:
             test = lag_test(c, *ctx.run.channel(c), ctx.steps_by_scale(),
-                            onsets.ratios.get(c, {}), ctx.criteria)
+                            onsets.ratios.get(c, {}), ctx.criteria,
+                            onsets.ratio_se.get(c, {}))
             if np.isfinite(test.z):
                 sc = next(s for s in ctx.criteria.onset_scales if s.name == test.scale)
                 lo, hi = test.estimate - 1.96 * test.se, test.estimate + 1.96 * test.se
@@ -76,10 +77,12 @@ class SensorLag(Effect):
 
 
 def lag_test(channel: str, t_s: np.ndarray, y: np.ndarray, steps: dict, model_ratios: dict,
-             criteria) -> EventTest:
+             criteria, model_se: dict | None = None) -> EventTest:
     """The onset test of one channel at every onset scale of ``criteria``: z = (1 - ratio) /
-    se at the scales where the model expects the channel to respond at once (its ratio >=
-    ``criteria.concave_ratio``); the test reports the scale with the largest z, its one-sided
+    se at the scales where the model expects the channel to respond at once: its ratio
+    (``model_ratios``) minus z_(1-alpha) times its standard error (``model_se``, the ratio's
+    scatter over the model's own steps; 0 where not given) is at least
+    ``criteria.concave_ratio``. The test reports the scale with the largest z, its one-sided
     p multiplied by the number of such scales (Bonferroni). Not applicable (p = nan) at no
     such scale."""
     from scipy.stats import norm
@@ -90,10 +93,15 @@ def lag_test(channel: str, t_s: np.ndarray, y: np.ndarray, steps: dict, model_ra
     for sc in criteria.onset_scales:
         ratio, se, rows = onset_ratio(t_s, y, steps[sc.name], sc)
         ref = model_ratios.get(sc.name, math.nan)
-        ok = bool(np.isfinite(ratio) and np.isfinite(ref) and ref >= criteria.concave_ratio)
+        ref_se = (model_se or {}).get(sc.name, 0.0)
+        # the model's ratio scatters over its own steps: a ratio above concave_ratio by less
+        # than its one-sided interval at alpha does not say the channel responds at once
+        lower = ref - float(norm.isf(criteria.alpha)) * ref_se
+        ok = bool(np.isfinite(ratio) and np.isfinite(lower) and lower >= criteria.concave_ratio)
         z = (1.0 - ratio) / se if ok else math.nan
         scales.append({"scale": sc.name, "ratio": ratio, "se": se, "model_ratio": ref,
-                       "applicable": ok, "z": z, "n_steps": len(rows)})
+                       "model_ratio_se": ref_se, "applicable": ok, "z": z,
+                       "n_steps": len(rows)})
         if ok and (best is None or z > best[3]):
             best = (sc, ratio, se, z, ref, rows)
     if best is None:
