@@ -97,7 +97,6 @@ def test_centrifugal_jump_is_recovered(c_true):
     assert test.significant(0.01)
 
 
-
 def test_a_jump_test_on_p1_logged_every_30_s_says_the_logging_is_too_sparse():
     """The shortening of the test above, P1 logged every 30 s: the 10-80 s after a step hold
     two or three samples, fewer than a line's four, so the jumps cannot be read. The test is
@@ -161,7 +160,6 @@ def test_the_long_onset_scale_reads_a_slow_lag_on_a_noisy_channel():
     assert lagged.scales[0]["z"] < 2.58  # the short scale alone: not significant at 1 %
     assert all(not lag_test("P1", T_EV, bench(y, s), steps, model, CRITERIA).significant(0.01)
                for s in range(20))
-
 
 
 def test_the_onset_test_applies_only_where_the_model_is_concave_beyond_its_own_scatter():
