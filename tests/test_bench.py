@@ -305,9 +305,8 @@ def test_grid_every_60_s_plus_the_runs_start_and_end(tmp_path):
 def test_a_run_whose_clock_starts_late_gets_the_grid_of_the_shifted_run(tmp_path):
     """A bench that logs the time of day (the run starts at 25,200 s, 7 am, a multiple of the
     grid) gets the grid and the inputs of the same run logged from 0, shifted: the grid
-    started at 0 before, so the
-    fit window (the grid's first 60 %) held no sample and fit refused every channel (found by
-    shifting a peer's run by 1e6 s)."""
+    started at 0 before, so the fit window (the grid's first 60 %) held no sample and fit
+    refused every channel (found by shifting a peer's run by 1e6 s)."""
     lines = good_rows()
     shift = 25_200.0
     late = [",".join([str(float(x.split(",")[0]) + shift), *x.split(",")[1:]]) for x in lines]

@@ -108,6 +108,7 @@ def test_a_jump_test_on_p1_logged_every_30_s_says_the_logging_is_too_sparse():
     assert math.isnan(test.p_value) and test.n_steps == 0
     assert "5 step(s) have fewer than 4 of P1's samples within 10-80 s" in test.meaning
 
+
 def test_no_jump_is_not_called_a_jump():
     """The same fast thermal response without the shortening: no significant shortening (at
     the fit's 1 % level), over 20 noise draws."""
@@ -195,6 +196,7 @@ def test_the_onset_test_applies_only_where_the_model_is_concave_beyond_its_own_s
     lenient = lag_test("P1", T_EV, bench, steps, ambiguous, replace(CRITERIA, alpha=0.1),
                        scatter)
     assert all(s["applicable"] for s in lenient.scales) and lenient.p_value < 0.1
+
 
 def test_event_signatures_on_the_peer_runs():
     """On a peer's nine runs (an independent simulator): P1 jumps significantly with n^2 only
