@@ -568,3 +568,26 @@ def test_the_criteria_optimizer_tolerance_reaches_the_calibration(monkeypatch):
         fit_run.calibrate_base(path, spec, fem_level=None,
                                criteria=Criteria(optimizer_tol=3e-7))
     assert got.value.args == (3e-7,)
+
+
+def test_every_fitted_parameter_cites_the_source_of_its_range_and_prior():
+    """Each parameter a fit can move (the base's, the extras', every library effect's) states
+    where its bounds and prior width come from (Param.source), and report.json's parameter
+    table carries it: a reader judges a calibrated value against its prior's reason."""
+    from compare.fit.calibrate import parameters_table
+    from compare.fit.effects import LIBRARY
+    from compare.fit.params import BASE_PARAMS, EXTRA_BASE_PARAMS
+
+    params = [*BASE_PARAMS.values(), *EXTRA_BASE_PARAMS.values(),
+              *(p for e in LIBRARY.values() for p in e.params)]
+    assert [p.name for p in params if len(p.source) < 15] == []
+
+    class _Fit:  # the fields parameters_table reads
+        free = ("h_air", "G_mount_W_K")
+        theta = {"h_air": 1.2, "G_mount_W_K": 30.0}
+        ci95 = {"h_air": (1.0, 1.4), "G_mount_W_K": (10.0, 50.0)}
+        identifiable = {"h_air": True, "G_mount_W_K": True}
+
+    rows = {r["name"]: r for r in parameters_table(_Fit())}
+    assert rows["h_air"]["source"] == BASE_PARAMS["h_air"].source
+    assert rows["G_mount_W_K"]["source"] == LIBRARY["mount_conduction"].params[0].source

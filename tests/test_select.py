@@ -557,6 +557,35 @@ def test_an_adequate_base_with_implausible_values_says_so_in_the_verdict():
                                          "model explains the run within the tolerances.")
 
 
+def test_an_adequate_base_says_how_near_the_verdicts_test_came():
+    """report.verdict_lines: where nothing is named, the line after the verdict gives the
+    scan's likeliest event with its likelihood ratio against the critical value (a P1 drift
+    of the electronics at 16.8 against 20.7 reads as a near miss, not as nothing); one above
+    the critical value that the verdict set aside is said to be too small to matter, with
+    its peak; without a hypothesis, or with the test off (no finite critical value),
+    nothing is said."""
+    from compare.fit.report import verdict_lines
+
+    def doc(hypothesis, lr=16.8, threshold=20.7):
+        return {"verdict": {"kind": "base adequate", "unexplained": False}, "effects": [],
+                "alpha": 0.01, "base_adequacy": {"implausible": []},
+                "something_else": {"unexplained": False, "lr": lr, "threshold": threshold,
+                                   "where": "P1 off by -1.03 tolerances, 12.0-13.5 h",
+                                   "hypothesis": hypothesis},
+                "error_before": {"validation": {}}, "error_after": {"validation": {}}}
+
+    offset = {"kind": "offset", "peak_tolerances": 0.08}
+    assert verdict_lines(doc(offset))[1] == (
+        "Not significant: the likeliest event the library lacks, P1 off by -1.03 tolerances, "
+        "12.0-13.5 h (likelihood ratio 16.8, critical value 20.7 at alpha 0.01).")
+    assert verdict_lines(doc(offset, lr=38.2))[1] == (
+        "Too small to matter: the likeliest event the library lacks, P1 off by -1.03 "
+        "tolerances, 12.0-13.5 h, is significant (likelihood ratio 38.2, critical value 20.7 "
+        "at alpha 0.01) but moves no channel by more than 0.08 tolerances.")
+    assert verdict_lines(doc(None))[1].startswith("Validation error")
+    assert verdict_lines(doc(offset, threshold=None))[1].startswith("Validation error")
+
+
 def test_the_verdict_says_which_fitted_effect_was_withdrawn_and_why():
     """report.verdict_lines on a hand-written report document: a candidate withdrawn after
     the selection (final_model_adequate False) is named as fitted and withdrawn, with the

@@ -430,9 +430,8 @@ def parameters_table(fit: Fit) -> list[dict]:
         p = params[k]
         rows.append({"name": k, "unit": p.unit, "value": fit.theta[k],
                      "ci95": list(fit.ci95[k]), "identifiable": fit.identifiable[k],
-                     "meaning": p.doc})
+                     "meaning": p.doc, "source": p.source})
     return rows
-
 
 
 def error_row(channel: str, d: np.ndarray) -> dict:

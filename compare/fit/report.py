@@ -161,6 +161,18 @@ def verdict_lines(doc: dict) -> list[str]:
         lines.append("Nothing named, base inadequate: the calibrated base model misses the "
                      "tolerances, and neither an effect of the library nor something at one "
                      "time of the run explains the misfit; look at the spec (below).")
+    se = doc.get("something_else") or {}
+    h, crit = se.get("hypothesis"), se.get("threshold")
+    if v["kind"].startswith("base") and h and crit is not None and math.isfinite(crit):
+        # how near the verdict's own test came, so that a near miss does not read as nothing
+        stat = (f"likelihood ratio {se['lr']:.1f}, critical value {crit:.1f} at alpha "
+                f"{doc.get('alpha', 0.01):g}")
+        lines.append(
+            f"Not significant: the likeliest event the library lacks, {se['where']} ({stat})."
+            if se["lr"] <= crit else
+            f"Too small to matter: the likeliest event the library lacks, {se['where']}, is "
+            f"significant ({stat}) but moves no channel by more than "
+            f"{h['peak_tolerances']:.2g} tolerances.")
     gone = [c["candidate"] for c in doc.get("candidates", [])
             if c["criteria"].get("final_model_adequate") is False]
     if gone:
@@ -445,10 +457,11 @@ def _html(rep, doc: dict, out: Path, pngs: Sequence[tuple[str, str]]) -> str:
                           ["s", "s", ".3f", ".3f", "+.3f", "s", ".1f"])
 
     params = html_table(
-        ["name", "value", "95 %", "unit", "identifiable", "meaning"],
+        ["name", "value", "95 %", "unit", "identifiable", "meaning", "prior's source"],
         [[p["name"], p["value"], f"{p['ci95'][0]:.4g} .. {p['ci95'][1]:.4g}", p["unit"],
-          "yes" if p["identifiable"] else "NO", p["meaning"]] for p in doc["parameters"]],
-        ["s", ".4g", "s", "s", "s", "s"])
+          "yes" if p["identifiable"] else "NO", p["meaning"], p.get("source", "")]
+         for p in doc["parameters"]],
+        ["s", ".4g", "s", "s", "s", "s", "s"])
     ad = doc.get("base_adequacy") or {}
     crit = html_table(["criterion", "value", "unit", "reason"],
                       [[c["name"], str(c["value"]), c["unit"], c["reason"]]

@@ -49,11 +49,11 @@ qualifies. Then the final model is stepped to the whole run (a model calibrated 
 window misses the validation window by its extrapolation, which a window there would take up)
 and the competitor scanned on it: where it is significant (its largest likelihood-ratio
 statistic above the level-``alpha`` critical value of the same scan on white noise, a Monte
-Carlo test) and material, the verdict says
-``unexplained`` and where. Before that, an effect named by the open loop is withdrawn where
-the final model still misses one of its channels' tolerances on held-out data
-(:func:`withdraw_unsupported`, ``Criteria.open_loop_adequate_model``): a likelihood-ratio
-test holds only under a model that explains the data.
+Carlo test) and material, the verdict says ``unexplained`` and where. Before that,
+an effect named by the open loop is withdrawn where the final model still misses one of its
+channels' tolerances on held-out data (:func:`withdraw_unsupported`,
+``Criteria.open_loop_adequate_model``): a likelihood-ratio test holds only under a model that
+explains the data.
 """
 
 from __future__ import annotations
@@ -104,11 +104,9 @@ class Judgement:
     @property
     def route(self) -> str | None:
         c = self.criteria
-        if c.get("final_model_adequate") is False:  # withdrawn after the selection
-            return None
-        if not c["material"] or c["signature"] is False:
-            return None
-        if not c["significant"]:
+        # withdrawn after the selection, or short of what both routes ask
+        if (c.get("final_model_adequate") is False or not c["material"]
+                or c["signature"] is False or not c["significant"]):
             return None
         if c["signature"]:
             return "signature"
