@@ -1,59 +1,27 @@
 """Which effects a bench run supports: forward selection against "something else".
 
 Each round linearizes the current model in its base parameters (compare.fit.linear) and fits
-every candidate of the library not yet in it jointly with them: the base parameters through
-the Jacobian, the candidate's own exactly, by a few Gauss-Newton iterations
-(compare.fit.linear.fit_effect). The competitor (compare.fit.competitor: an unexplained heat
-or offset in a window of the run) is fitted the same way. Each candidate is judged by the
-named criteria of :class:`compare.fit.criteria.Criteria`; the one that joins the model is
-then refitted to convergence. Every candidate must be
+every candidate of the library not yet in it jointly with them (the candidate's own
+parameters exactly, by a few Gauss-Newton iterations: compare.fit.linear.fit_effect), and the
+competitor (compare.fit.competitor) the same way. Each candidate is judged by the named
+criteria of :class:`compare.fit.criteria.Criteria` (their reasons are its table's; the method
+is docs/fit.md, step 4):
 
-- ``material``: at its estimate it moves one of its channels by ``material_peak`` tolerances;
-- ``significant``: its likelihood-ratio test against the current model at ``alpha``
-  (the likelihood of compare.fit.calibrate; the null is the current model refitted by the
-  same linearized step without the candidate, so that what a base fit stopped short of its
-  optimum gains by one more step counts for no candidate), on both routes: a signature
-  tells which effect a misfit is, the likelihood that the model needs one (an intersection
-  of the two tests, each at ``alpha``; a joint test of the two would name an effect the fit
-  does not want on a signature alone);
+- ``material`` and ``significant`` (a likelihood-ratio test against the current model
+  refitted by the same step without the candidate) on both routes; then
+- **its signature**: its test on the raw samples (compare.fit.signatures), where one
+  applies, is significant too (an intersection of two tests at alpha: a joint test would
+  name an effect the fit does not want on its signature alone); one that applies and is not
+  vetoes the effect on both routes;
+- or **the open loop**, where none applies: ``predicts`` (blocked cross-validation),
+  ``beats_something_else`` (BIC), ``distinct`` from every alternative on its channels
+  (:func:`complements` are none), and :func:`model_changes`.
 
-and then show that it is *this* effect, by one of two routes:
-
-- **its signature** (``signature``): its test on the raw samples, where one applies, is
-  significant at ``alpha``: evidence no misfit of the base model, no other effect and no
-  window of something else can give. Where the test applies and is not significant, the
-  effect does not qualify by either route: its own test looked for it and did not find it;
-- **the open loop**, where no signature test applies to the run, all of:
-
-  - ``predicts``: it lowers the blocked cross-validated error above the noise floor on its
-    channels by ``cv_gain`` (a law of the inputs predicts the blocks it was not fitted on;
-    something at one time does not);
-  - ``beats_something_else``: its gain, less half ln(n_eff) per parameter (BIC), is at
-    least the competitor's best, less the same for its three (amplitude, start, end);
-  - ``changes_prediction`` (``Criteria.open_loop_material_change``): the fitted model's
-    prediction, with the base re-adjusted around the effect, moves by ``material_peak`` on
-    one of its channels; or else ``restores_plausible_base`` (``Criteria.plausible_base_route``):
-    without the effect the base needs a value outside its prior's (1 - alpha) range, with it
-    none;
-  - ``distinct``: its penalised gain exceeds that of every other candidate acting on one of
-    its channels by half the chi-square quantile of one degree of freedom at ``alpha``
-    (3.3 at 1 %): two effects that explain the run alike are a guess, not a finding. A
-    candidate that adds a significant gain to this one, and this one to it, is a complement,
-    not an alternative, and is no rival (:func:`complements`,
-    ``Criteria.distinct_among_alternatives``);
-
-A qualifying candidate joins the model if it adds the most likelihood among those that
-qualify, and the next round judges the rest against the model that holds it (a second effect
-earns its place against the first, not against the base). The selection stops when none
-qualifies. Then the final model is stepped to the whole run (a model calibrated on the fit
-window misses the validation window by its extrapolation, which a window there would take up)
-and the competitor scanned on it: where it is significant (its largest likelihood-ratio
-statistic above the level-``alpha`` critical value of the same scan on white noise, a Monte
-Carlo test) and material, the verdict says ``unexplained`` and where. Before that,
-an effect named by the open loop is withdrawn where the final model still misses one of its
-channels' tolerances on held-out data (:func:`withdraw_unsupported`,
-``Criteria.open_loop_adequate_model``): a likelihood-ratio test holds only under a model that
-explains the data.
+The qualifying candidate that adds the most likelihood joins the model and is refitted; the
+next round judges the rest against the model that holds it. When none qualifies, an effect
+named by the open loop whose final model still misses one of its channels on held-out data
+is withdrawn (:func:`withdraw_unsupported`), and the competitor is scanned on the final model
+stepped to the whole run (:func:`verdict_on`): ``unexplained`` and where, or not.
 """
 
 from __future__ import annotations
