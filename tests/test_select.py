@@ -559,11 +559,10 @@ def test_an_adequate_base_with_implausible_values_says_so_in_the_verdict():
 
 def test_an_adequate_base_says_how_near_the_verdicts_test_came():
     """report.verdict_lines: where nothing is named, the line after the verdict gives the
-    scan's likeliest event with its likelihood ratio against the critical value (a P1 drift
-    of the electronics at 16.8 against 20.7 reads as a near miss, not as nothing); one above
-    the critical value that the verdict set aside is said to be too small to matter, with
-    its peak; without a hypothesis, or with the test off (no finite critical value),
-    nothing is said."""
+    scan's likeliest event with its likelihood ratio against the critical value (an offset
+    at 16.8 against 20.7 reads as a near miss, not as nothing); one above the critical value
+    that the verdict set aside is said to be too small to matter, with its peak; without a
+    hypothesis, or with the test off (no finite critical value), nothing is said."""
     from compare.fit.report import verdict_lines
 
     def doc(hypothesis, lr=16.8, threshold=20.7):
