@@ -21,7 +21,9 @@ The qualifying candidate that adds the most likelihood joins the model and is re
 next round judges the rest against the model that holds it. When none qualifies, an effect
 named by the open loop whose final model still misses one of its channels on held-out data
 is withdrawn (:func:`withdraw_unsupported`), and the competitor is scanned on the final model
-stepped to the whole run (:func:`verdict_on`): ``unexplained`` and where, or not.
+stepped to the whole run (:func:`verdict_on`; stepped, since a model calibrated on the fit
+window misses the validation window by its extrapolation, which a window there would take
+up): ``unexplained`` and where, or not.
 """
 
 from __future__ import annotations
