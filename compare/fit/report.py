@@ -164,7 +164,8 @@ def verdict_lines(doc: dict) -> list[str]:
     se = doc.get("something_else") or {}
     h, crit = se.get("hypothesis"), se.get("threshold")
     if v["kind"].startswith("base") and h and crit is not None and math.isfinite(crit):
-        # how near the verdict's own test came, so that a near miss does not read as nothing
+        # how near the verdict's own test came, so that a near miss does not read as nothing;
+        # above the critical value and still not unexplained, verdict_on found it immaterial
         stat = (f"likelihood ratio {se['lr']:.1f}, critical value {crit:.1f} at alpha "
                 f"{doc.get('alpha', 0.01):g}")
         lines.append(
@@ -459,7 +460,7 @@ def _html(rep, doc: dict, out: Path, pngs: Sequence[tuple[str, str]]) -> str:
     params = html_table(
         ["name", "value", "95 %", "unit", "identifiable", "meaning", "prior's source"],
         [[p["name"], p["value"], f"{p['ci95'][0]:.4g} .. {p['ci95'][1]:.4g}", p["unit"],
-          "yes" if p["identifiable"] else "NO", p["meaning"], p.get("source", "")]
+          "yes" if p["identifiable"] else "NO", p["meaning"], p["source"]]
          for p in doc["parameters"]],
         ["s", ".4g", "s", "s", "s", "s", "s"])
     ad = doc.get("base_adequacy") or {}
