@@ -242,7 +242,7 @@ def test_resample_leaves_gaps_empty():
     t = np.concatenate([np.arange(0, 600, 1.0), np.arange(1800, 2400, 1.0)])
     y = t * 0.01
     g = np.arange(0, 2401, 60.0)
-    r = resample(t, y, g)
+    r = resample(t, y, g, Criteria().gap_min_steps)
     assert np.isnan(r[(g > 660) & (g < 1740)]).all()  # inside the 20 min gap
     np.testing.assert_allclose(r[g <= 540], g[g <= 540] * 0.01)
 

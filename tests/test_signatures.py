@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -43,7 +44,7 @@ SHORT = CRITERIA.onset_scales[0]  # the onset scale of the minutes: 2 min over t
 
 def _steps(t: np.ndarray, n: np.ndarray, scale=SHORT):
     """The clean speed steps at ``scale`` with the criteria's step size."""
-    return speed_steps(t, n, CRITERIA.step_rpm, scale.quiet_s)
+    return speed_steps(t, n, CRITERIA, scale.quiet_s)
 
 
 # =================================================================== events at the speed steps
@@ -109,6 +110,30 @@ def test_a_jump_test_on_p1_logged_every_30_s_says_the_logging_is_too_sparse():
     assert "5 step(s) have fewer than 4 of P1's samples within 10-80 s" in test.meaning
 
 
+def test_the_step_and_line_criteria_are_the_ones_the_rules_read():
+    """The entries of Criteria that steps, lines and jumps read change what they find: a step made
+    in two, 5 s apart, is one step, and none where changes 2 s apart are not grouped (its
+    halves are too near each other to be clean); a line that asks more samples than the 70 of a
+    1 Hz log in the 10-80 s after a step, or a span longer than its window, reads no jump; no
+    step of the cycle enters a jump regression that asks n^2 to change by 100 krpm^2 (10,000
+    rpm from standstill); and no step enters an onset ratio that asks an impossible z of the
+    late slope change."""
+    n = _step_speed(T_EV).astype(float)
+    n[(T_EV >= 9000.0) & (T_EV < 9005.0)] = 4000.0  # 2000 -> 4000, 5 s later -> 6000 rpm
+    assert 9000.0 in [round(s.t_s, -2) for s in _steps(T_EV, n)]
+    ungrouped = speed_steps(T_EV, n, replace(CRITERIA, step_ramp_s=2.0), SHORT.quiet_s)
+    assert [round(s.t_s, -2) for s in ungrouped] == [3600.0, 16000.0, 22000.0, 29000.0]
+    p1 = (_thermal(T_EV, 300.0, 1e-3) - 0.06 * (_step_speed(T_EV) / 1000.0) ** 2) * 1e-6
+    assert jump_test(T_EV, p1, _steps(T_EV, n), CRITERIA).n_steps == 5
+    for strict in (replace(CRITERIA, line_min_samples=100), replace(CRITERIA, line_min_span=1.1),
+                   replace(CRITERIA, jump_min_dn2_krpm2=100.0)):
+        assert jump_test(T_EV, p1, _steps(T_EV, n), strict).n_steps == 0
+    y = _thermal(T_EV, 900.0, 1e-3)
+    assert math.isfinite(onset_ratio(T_EV, y, _steps(T_EV, n), SHORT, CRITERIA)[0])
+    assert math.isnan(onset_ratio(T_EV, y, _steps(T_EV, n), SHORT,
+                                  replace(CRITERIA, onset_min_late_z=1e9))[0])
+
+
 def test_no_jump_is_not_called_a_jump():
     """The same fast thermal response without the shortening: no significant shortening (at
     the fit's 1 % level), over 20 noise draws."""
@@ -129,12 +154,13 @@ def test_onset_ratio_tells_a_lagging_sensor():
     n = _step_speed(T_EV)
     y = _thermal(T_EV, 900.0, 1e-3)
     steps = _steps(T_EV, n)
-    ratio, se, _ = onset_ratio(T_EV, y, steps, SHORT)
+    ratio, se, _ = onset_ratio(T_EV, y, steps, SHORT, CRITERIA)
     expected = ((math.exp(-10 / 900) - math.exp(-120 / 900)) / 110) / (
         (math.exp(-120 / 900) - math.exp(-360 / 900)) / 240)
     # tolerance: the straight-line fits over each window approximate the mean slope; 3 %
     assert ratio == pytest.approx(expected, rel=0.03)
-    lagged, se_l, _ = onset_ratio(T_EV, first_order_lag(T_EV, y, 300.0), steps, SHORT)
+    lagged, se_l, _ = onset_ratio(T_EV, first_order_lag(T_EV, y, 300.0), steps, SHORT,
+                           CRITERIA)
     assert lagged < 1.0 - 3 * max(se_l, 1e-3)
 
 
@@ -148,7 +174,7 @@ def test_the_long_onset_scale_reads_a_slow_lag_on_a_noisy_channel():
     n = _step_speed(T_EV)
     y = _thermal(T_EV, 1800.0, 3e-4) + _thermal(T_EV, 300.0, 1e-4)  # µm, concave, two masses
     steps = {sc.name: _steps(T_EV, n, sc) for sc in scales}
-    model = {sc.name: onset_ratio(T_EV, y, steps[sc.name], sc)[0] for sc in scales}
+    model = {sc.name: onset_ratio(T_EV, y, steps[sc.name], sc, CRITERIA)[0] for sc in scales}
 
     def bench(signal: np.ndarray, seed: int) -> np.ndarray:
         rng = np.random.default_rng(seed)
@@ -178,7 +204,7 @@ def test_the_onset_test_applies_only_where_the_model_is_concave_beyond_its_own_s
     n = _step_speed(T_EV)
     y = _thermal(T_EV, 1800.0, 3e-4) + _thermal(T_EV, 300.0, 1e-4)
     steps = {sc.name: _steps(T_EV, n, sc) for sc in scales}
-    own = {sc.name: onset_ratio(T_EV, y, steps[sc.name], sc)[:2] for sc in scales}
+    own = {sc.name: onset_ratio(T_EV, y, steps[sc.name], sc, CRITERIA)[:2] for sc in scales}
     rng = np.random.default_rng(2)
     bench = np.round((first_order_lag(T_EV, y, 900.0) + rng.normal(0.0, 0.05, len(T_EV)))
                      / 0.1) * 0.1
@@ -211,7 +237,7 @@ def test_event_signatures_on_the_peer_runs():
         steps = _steps(run.time_s, run.columns["speed_rpm"])
         cf = jump_test(*run.channel("P1"), steps, CRITERIA)
         assert cf.significant(0.01) == (t["truth"] == "centrifugal_shortening"), label
-        ratio, se, _ = onset_ratio(*run.channel("T1"), steps, SHORT)
+        ratio, se, _ = onset_ratio(*run.channel("T1"), steps, SHORT, CRITERIA)
         lag = ratio < 1.0 - 3 * se
         assert lag == (t["truth"] == "sensor_lag"), (label, ratio, se)
         if not lag:

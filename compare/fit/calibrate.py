@@ -2,7 +2,7 @@
 
 - **Data.** The measured channels (T1, T2, T_stator in K, P1 in m) are resampled onto the
   model grid (the value at each grid point, linear between valid samples; a point inside a
-  gap of more than two grid steps is left out). The run is split in time: the first part
+  logging gap, Criteria.gap_min_steps, is left out). The run is split in time: the first part
   (default 60 %) is the fit window, the rest the validation window.
 - **Weighted least squares** (scipy.optimize.least_squares): residuals are divided by the
   channel's tolerance (1 K, 1.5 µm, paper section 3), so the channels weigh alike at their
@@ -116,9 +116,10 @@ class Measured:
         return ok
 
 
-def resample(t_s: np.ndarray, y: np.ndarray, grid_s: np.ndarray) -> np.ndarray:
+def resample(t_s: np.ndarray, y: np.ndarray, grid_s: np.ndarray, gap_steps: float
+             ) -> np.ndarray:
     """Values at the grid points: linear between valid samples; NaN outside the samples and
-    inside gaps longer than two grid steps."""
+    inside gaps longer than ``gap_steps`` grid steps (Criteria.gap_min_steps)."""
     ok = ~np.isnan(y)
     t, v = t_s[ok], y[ok]
     out = np.full(len(grid_s), np.nan)
@@ -128,7 +129,7 @@ def resample(t_s: np.ndarray, y: np.ndarray, grid_s: np.ndarray) -> np.ndarray:
     out[inside] = np.interp(grid_s[inside], t, v)
     step = np.median(np.diff(grid_s))
     k = np.clip(np.searchsorted(t, grid_s), 1, len(t) - 1)
-    gap = (t[k] - t[k - 1]) > 2 * step
+    gap = (t[k] - t[k - 1]) > gap_steps * step
     out[gap & inside] = np.nan
     return out
 

@@ -159,6 +159,26 @@ class Criteria:
         SPEED_BAND_RPM, "rpm", "a logged speed within max(20 rpm, 1 %) of the current step "
         "belongs to it: a drive's scatter around its set speed (spindle.bench_inputs)")
     speed_band_rel: float = _c(SPEED_BAND_REL, "-", "as speed_band_rpm")
+    step_ramp_s: float = _c(
+        30.0, "s", "speed changes beyond step_rpm less than 30 s apart are one step: a "
+        "drive's ramp (about 10 s) logged over several samples, with room for an on-change "
+        "log's spacing; short against the onset windows (2 min and longer)")
+    line_min_samples: int = _c(
+        4, "samples", "a straight line before or after a step is read from at least four "
+        "samples: two for the line, two degrees of freedom for its standard errors")
+    line_min_span: float = _c(
+        0.5, "of the window", "and its samples must span half its window: a line through a "
+        "burst of samples at one end of the window is extrapolated over the rest")
+    onset_min_late_z: float = _c(
+        2.0, "se", "a step enters the onset ratio only where its late slope change is two "
+        "standard errors from nothing: the ratio is regressed on it, and a regressor with a "
+        "relative error above one half biases the slope towards zero and gives it heavy tails "
+        "(errors in variables)")
+    jump_min_dn2_krpm2: float = _c(
+        1.0, "krpm^2", "a step enters P1's jump regression where n^2 changes by 1 krpm^2 "
+        "(1000 rpm from standstill, 100 rpm at 5000): a smaller step's jump is under P1's "
+        "0.1 um resolution for any shortening below 0.1 um/krpm^2, seven times the FEM's own "
+        "for spl2782, so it adds nothing but a thermal transient to the regression")
     jump_before_s: tuple[float, float] = _c(
         (-180.0, -10.0), "s from a step", "the line before a speed step for P1's jump: three "
         "minutes, short against the thermal response, the ramp's last 10 s left out")
@@ -197,9 +217,9 @@ class Criteria:
     drift_late_s: float = _c(
         900.0, "s", "the late power: the segment's last quarter of an hour")
     window_min_samples: int = _c(
-        3, "samples", "a window's mean power carries the standard error of its own samples' "
-        "scatter: three samples give it two degrees of freedom (an on-change log holds a "
-        "few samples in minutes)")
+        3, "samples", "a window's mean (of the power, of a block of residual) carries the "
+        "standard error of its own samples' scatter: three samples give it two degrees of "
+        "freedom (an on-change log holds a few samples in minutes)")
     power_resolution_W: float = _c(
         0.05, "W", "the least standard error of a mean power: a drive's power reading resolves "
         "about 0.1 W")

@@ -141,7 +141,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
                          "add [power_balance] preset to the spec")
     raw = greybox_inputs(run, grid_s, criteria.gap_min_steps)
-    measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks)
+    measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks, criteria)
     inputs, switches = _place_gap_switches(run, spec, drive, raw, measured, channels, nodes,
                                            base_extra, say, criteria)
 
@@ -351,7 +351,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
 
 
 def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fraction: float,
-              blocks: int) -> Measured:
+              blocks: int, criteria: Criteria) -> Measured:
     """The measured channels on the model grid, with the windows; refuses a channel with too
     few samples in either window."""
     if not 1 <= blocks <= 20:
@@ -360,7 +360,7 @@ def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fracti
     values = {}
     for c in channels:
         t, y = run.channel(c)
-        values[c] = resample(t, y, grid_s)
+        values[c] = resample(t, y, grid_s, criteria.gap_min_steps)
     measured = Measured(grid_s, values, fit_fraction, blocks)
     for c in channels:
         if measured.mask(c, "fit").sum() < 10 or measured.mask(c, "validation").sum() < 5:

@@ -93,17 +93,17 @@ class EventTest:
                 "parameter": self.parameter, "scale": self.scale, "scales": self.scales}
 
 
-def speed_steps(t_s: np.ndarray, speed_rpm: np.ndarray, min_step_rpm: float,
+def speed_steps(t_s: np.ndarray, speed_rpm: np.ndarray, criteria,
                 quiet_s: tuple[float, float]) -> list[Step]:
-    """Speed steps of a logged run with no other step in the ``quiet_s`` window around them
-    (NaN speeds are skipped; the step instant is midway between the two samples; a ramp
-    logged over several samples within 30 s is one step)."""
+    """Speed steps (beyond ``criteria.step_rpm``) of a logged run with no other step in the
+    ``quiet_s`` window around them (NaN speeds are skipped; the step instant is midway
+    between the two samples; changes within ``criteria.step_ramp_s`` are one step)."""
     ok = np.isfinite(speed_rpm)
     t, n = np.asarray(t_s, float)[ok], np.asarray(speed_rpm, float)[ok]
-    idx = np.where(np.abs(np.diff(n)) > min_step_rpm)[0]
+    idx = np.where(np.abs(np.diff(n)) > criteria.step_rpm)[0]
     groups: list[list[int]] = []
     for i in idx:
-        if groups and t[i] - t[groups[-1][-1] + 1] <= 30.0:
+        if groups and t[i] - t[groups[-1][-1] + 1] <= criteria.step_ramp_s:
             groups[-1].append(i)
         else:
             groups.append([i])
@@ -118,12 +118,13 @@ def speed_steps(t_s: np.ndarray, speed_rpm: np.ndarray, min_step_rpm: float,
     return keep
 
 
-def line_fit(t: np.ndarray, y: np.ndarray, window: tuple[float, float], t0: float
+def line_fit(t: np.ndarray, y: np.ndarray, window: tuple[float, float], t0: float, criteria
              ) -> tuple[float, float, float, float] | None:
     """(value at t0, slope, se of value, se of slope) of a straight line through the samples
-    in ``t0 + window``; None with fewer than 4 samples or too short a span."""
+    in ``t0 + window``; None with too few samples or too short a span (``criteria``)."""
     m = (t >= t0 + window[0]) & (t <= t0 + window[1]) & np.isfinite(y)
-    if m.sum() < 4 or np.ptp(t[m]) < 0.5 * (window[1] - window[0]):
+    if (m.sum() < criteria.line_min_samples
+            or np.ptp(t[m]) < criteria.line_min_span * (window[1] - window[0])):
         return None
     x = t[m] - t0
     A = np.column_stack([np.ones_like(x), x])
@@ -147,15 +148,14 @@ def through_origin(y: np.ndarray, x: np.ndarray, se: np.ndarray) -> tuple[float,
     return b, math.sqrt(max(chi2, 1.0) / sxx)
 
 
-def onset_ratio(t_s: np.ndarray, y: np.ndarray, steps: list[Step], scale: OnsetScale
-                ) -> tuple[float, float, list[dict]]:
+def onset_ratio(t_s: np.ndarray, y: np.ndarray, steps: list[Step], scale: OnsetScale,
+                criteria) -> tuple[float, float, list[dict]]:
     """(ratio, se, per step) of the change of slope early after the steps to that late after
     them (``scale``'s windows), regressed over the steps (units of y cancel)."""
     early, late, se_e, rows = [], [], [], []
     for s in steps:
-        b = line_fit(t_s, y, scale.before_s, s.t_s)
-        e = line_fit(t_s, y, scale.early_s, s.t_s)
-        la = line_fit(t_s, y, scale.late_s, s.t_s)
+        b, e, la = (line_fit(t_s, y, w, s.t_s, criteria)
+                    for w in (scale.before_s, scale.early_s, scale.late_s))
         if b is None or e is None or la is None:
             continue
         early.append(e[1] - b[1])
@@ -166,8 +166,7 @@ def onset_ratio(t_s: np.ndarray, y: np.ndarray, steps: list[Step], scale: OnsetS
     if len(early) < 2:
         return math.nan, math.nan, rows
     x, yv, se = np.array(late), np.array(early), np.array(se_e)
-    # steps whose late response is lost in the noise say nothing about the onset's shape
-    keep = np.abs(x) > 2.0 * se
+    keep = np.abs(x) > criteria.onset_min_late_z * se
     if keep.sum() < 2:
         return math.nan, math.nan, rows
     ratio, err = through_origin(yv[keep], x[keep], np.maximum(se[keep], 1e-12))
@@ -201,7 +200,7 @@ class ModelOnsets:
     outputs: dict[str, np.ndarray]
     steps: dict[str, list[Step]]
     ratios: dict[str, dict[str, float]]
-    lag_grid_s: tuple[float, ...]
+    criteria: object  # compare.fit.criteria.Criteria
     #: the ratios' standard errors (their scatter over the model's steps)
     ratio_se: dict[str, dict[str, float]] = field(default_factory=dict)
 
@@ -211,11 +210,12 @@ class ModelOnsets:
         grid's longest lag when even that does not)."""
         from lumped.elastic import first_order_lag
 
-        grid = self.lag_grid_s
+        grid = self.criteria.lag_grid_s
         ratios = [self.ratios[channel][scale.name]]
         for tau in grid[1:]:
             y = first_order_lag(self.t_s, self.outputs[channel], tau)
-            ratios.append(onset_ratio(self.t_s, y, self.steps[scale.name], scale)[0])
+            ratios.append(onset_ratio(self.t_s, y, self.steps[scale.name], scale,
+                                      self.criteria)[0])
         r = np.array(ratios)
         if not np.isfinite(ratio) or ratio >= r[0]:
             return 0.0
@@ -236,14 +236,13 @@ def model_onsets(gb, theta: dict[str, float], channels, criteria, sub: int = 6) 
     out = model.simulate(theta)
     t = model.inputs.grid_s
     n_end = np.concatenate([[model.inputs.speed_rpm[0]], model.inputs.speed_rpm])
-    steps = {sc.name: speed_steps(t, n_end, criteria.step_rpm, sc.quiet_s)
+    steps = {sc.name: speed_steps(t, n_end, criteria, sc.quiet_s)
              for sc in criteria.onset_scales}
-    fits = {c: {sc.name: onset_ratio(t, out[c], steps[sc.name], sc)[:2]
+    fits = {c: {sc.name: onset_ratio(t, out[c], steps[sc.name], sc, criteria)[:2]
                 for sc in criteria.onset_scales} for c in channels if c in out}
     ratios = {c: {k: v[0] for k, v in f.items()} for c, f in fits.items()}
     ratio_se = {c: {k: v[1] for k, v in f.items()} for c, f in fits.items()}
-    return ModelOnsets(t, {c: out[c] for c in ratios}, steps, ratios, criteria.lag_grid_s,
-                       ratio_se)
+    return ModelOnsets(t, {c: out[c] for c in ratios}, steps, ratios, criteria, ratio_se)
 
 
 @dataclass(frozen=True)
@@ -259,7 +258,7 @@ class Segment:
     t_s: np.ndarray
     power_W: np.ndarray
     no_load: bool
-    min_samples: int = 3  # compare.fit.criteria.Criteria.window_min_samples
+    min_samples: int  # a window's mean needs this many (Criteria.window_min_samples)
 
     @property
     def duration_s(self) -> float:
@@ -329,7 +328,7 @@ class Context:
         """The run's clean speed steps per onset scale (no other step within its windows)."""
         t, n = self.run.time_s, self.run.columns["speed_rpm"]
         return self._once("steps", lambda: {
-            sc.name: speed_steps(t, n, self.criteria.step_rpm, sc.quiet_s)
+            sc.name: speed_steps(t, n, self.criteria, sc.quiet_s)
             for sc in self.criteria.onset_scales})
 
     def steps(self) -> list[Step]:

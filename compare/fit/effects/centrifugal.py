@@ -70,10 +70,10 @@ def jump_test(t_s: np.ndarray, p1_m: np.ndarray, steps, criteria) -> EventTest:
     J, X, S, rows = [], [], [], []
     sparse = 0  # steps large enough whose windows hold too few of P1's samples
     for s in steps:
-        if abs(s.dn2_krpm2) < 1.0:
+        if abs(s.dn2_krpm2) < criteria.jump_min_dn2_krpm2:
             continue
-        before = line_fit(t_s, p1_m, criteria.jump_before_s, s.t_s)
-        after = line_fit(t_s, p1_m, criteria.jump_after_s, s.t_s)
+        before = line_fit(t_s, p1_m, criteria.jump_before_s, s.t_s, criteria)
+        after = line_fit(t_s, p1_m, criteria.jump_after_s, s.t_s, criteria)
         if before is None or after is None:
             sparse += 1
             continue
@@ -88,8 +88,9 @@ def jump_test(t_s: np.ndarray, p1_m: np.ndarray, steps, criteria) -> EventTest:
         why = "too few clean speed steps to read P1's jumps"
         if sparse:
             a, b = criteria.jump_after_s
-            why += (f": {sparse} step(s) have fewer than 4 of P1's samples within {a:g}-{b:g} s"
-                    " after them or in the minutes before (P1 logged too sparsely to see a jump)")
+            why += (f": {sparse} step(s) have fewer than {criteria.line_min_samples} of P1's "
+                    f"samples within {a:g}-{b:g} s after them or in the minutes before (P1 "
+                    "logged too sparsely to see a jump)")
         return EventTest("centrifugal_shortening", "P1", math.nan, math.nan, math.nan, math.nan,
                          len(J), "um/krpm^2", why)
     c, se = through_origin(np.array(J), np.array(X), np.array(S))

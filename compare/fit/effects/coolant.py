@@ -100,12 +100,13 @@ def load_plateaus(run, criteria) -> list[tuple[float, float]]:
     return out
 
 
-def _block_rows(t: np.ndarray, e: np.ndarray, X: np.ndarray, a: float, block_s: float
+def _block_rows(t: np.ndarray, e: np.ndarray, X: np.ndarray, a: float, criteria
                 ) -> tuple[np.ndarray, np.ndarray]:
-    """Block means of the residual ``e`` and the regressors ``X`` over a plateau starting at
-    ``a``, relative to the plateau's mean."""
-    blk = ((t - a) // block_s).astype(int)
-    keys = [k for k in np.unique(blk) if np.sum(blk == k) >= 3]
+    """Block means (``criteria.load_block_s``, each of ``criteria.window_min_samples``
+    samples or more) of the residual ``e`` and the regressors ``X`` over a plateau starting
+    at ``a``, relative to the plateau's mean."""
+    blk = ((t - a) // criteria.load_block_s).astype(int)
+    keys = [k for k in np.unique(blk) if np.sum(blk == k) >= criteria.window_min_samples]
     if len(keys) < 2:
         return np.empty(0), np.empty((0, X.shape[1]))
     eb = np.array([e[blk == k].mean() for k in keys])
@@ -147,7 +148,7 @@ def load_response_test(run, gb, theta: dict[str, float], criteria) -> EventTest:
             m = (tc >= a + criteria.load_settle_s) & (tc < b) & np.isfinite(yc)
             e = yc[m] - np.interp(tc[m], grid, base[c])
             Xc = np.column_stack([np.interp(tc[m], grid, s) for s in sens[c].T])
-            eb, Xb = _block_rows(tc[m], e, Xc, a, criteria.load_block_s)
+            eb, Xb = _block_rows(tc[m], e, Xc, a, criteria)
             E.append(eb)
             X.append(Xb)
             P.append(np.full(len(eb), a))

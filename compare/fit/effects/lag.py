@@ -50,7 +50,7 @@ class SensorLag(Effect):
                 # beyond the lagged model's floor (a long lag turns the onset into a ramp
                 # whose ratio stops falling) the ratio says "lagged" but not by how much: no
                 # prior on tau then, the fit over the whole run estimates it
-                if tau < onsets.lag_grid_s[-1]:
+                if tau < ctx.criteria.lag_grid_s[-1]:
                     test.parameter = {"name": "tau_s", "value": tau,
                                       "ci95": [onsets.lag_for_ratio(c, hi, sc),
                                                onsets.lag_for_ratio(c, lo, sc)]}
@@ -91,7 +91,7 @@ def lag_test(channel: str, t_s: np.ndarray, y: np.ndarray, steps: dict, model_ra
                "at once; below 1: reads through a lag)")
     scales, best = [], None
     for sc in criteria.onset_scales:
-        ratio, se, rows = onset_ratio(t_s, y, steps[sc.name], sc)
+        ratio, se, rows = onset_ratio(t_s, y, steps[sc.name], sc, criteria)
         ref = model_ratios.get(sc.name, math.nan)
         ref_se = (model_se or {}).get(sc.name, 0.0)
         # the model's ratio scatters over its own steps: a ratio above concave_ratio by less
