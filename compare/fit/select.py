@@ -278,12 +278,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
             break
         best = max(qualified, key=lambda j: j.gain)
         say(f"round {rnd}: refitting with {best.label}")
-        start = {**current.theta, **fits[best.label].values}
-        params = cal.gb.variant(current.effects).parameters()
-        for k, d in zip(current.free, fits[best.label].delta, strict=True):
-            start[k] = _from_z(params[k], _to_z(params[k], current.theta[k]) + float(d))
-        best.fit = cal.fit(current.effects + (best.label,), start=start,
-                           max_nfev=criteria.refit_nfev)
+        best.fit, best.figures["refit_from"] = refit(cal, current, fits[best.label], criteria)
         steps.append(Step(best, current))
         current = best.fit
         loc = local(cal, current)
@@ -293,6 +288,27 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
     say("fitting something else on the final model")
     return Selection(base, steps, judged, verdict_on(loc, reg, criteria,
                                                      unknown_inputs=unknown_inputs))
+
+
+def refit(cal: Calibrator, current: Fit, ef, criteria: Criteria) -> tuple[Fit, str]:
+    """The nonlinear fit of ``current``'s model with the candidate ``ef`` (its
+    compare.fit.linear.EffectFit) added, started twice: at the linearized step (the base
+    parameters moved by its delta) and at ``current`` with only the effect's values added.
+    The better log-posterior (counted in ``current``'s effective samples, as every gain of
+    the selection) is kept, with the start it came from ("step" or "nested"). The step
+    extrapolates the linearization over the whole change, and where the base must move far it
+    can land in another basin of the least squares than the one the current model is in; the
+    second start is the nested model's own optimum, from which the effect only adds."""
+    params = cal.gb.variant(current.effects).parameters()
+    stepped = {**current.theta, **ef.values}
+    for k, d in zip(current.free, ef.delta, strict=True):
+        stepped[k] = _from_z(params[k], _to_z(params[k], current.theta[k]) + float(d))
+    shrink = current.n_eff / max(current.n, 1)
+    fits = {name: cal.fit(current.effects + (ef.label,), start=start,
+                          max_nfev=criteria.refit_nfev)
+            for name, start in (("step", stepped), ("nested", {**current.theta, **ef.values}))}
+    best = max(fits, key=lambda k: fits[k].loglik * shrink - fits[k].penalty)
+    return fits[best], best
 
 
 def withdraw_unsupported(steps: list[Step], final: Fit, criteria: Criteria) -> Fit:
