@@ -51,6 +51,21 @@ def test_a_candidates_route_follows_its_named_criteria(changes, route):
     assert j.route == route and j.qualifies is (route is not None)
 
 
+def test_a_candidate_its_signature_found_joins_before_a_larger_open_loop_gain():
+    """In one round a centrifugal shortening qualifies by its signature (gain 18) and a lag
+    of P1 by the open loop alone (gain 45), as on a held-out run with a shortening and no
+    lag: the shortening joins, and the lag is judged again against the model that holds it.
+    Between two of one route the larger gain joins."""
+    from compare.fit.select import joins_first
+
+    signature = Judgement("centrifugal_shortening", 1, None, 18.0, 36.0, 1e-9, 3.0,
+                          {**ALL_PASS, "signature": True})
+    open_loop = Judgement("sensor_lag(P1)", 1, None, 45.0, 90.0, 1e-20, 2.0, dict(ALL_PASS))
+    assert joins_first([open_loop, signature]) is signature
+    larger = Judgement("fixture_expansion", 1, None, 60.0, 120.0, 1e-26, 2.0, dict(ALL_PASS))
+    assert joins_first([open_loop, larger]) is larger
+
+
 def _test(z: float, value: float, ci: tuple[float, float]) -> EventTest:
     from scipy.stats import norm
 

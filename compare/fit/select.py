@@ -17,13 +17,14 @@ is docs/fit.md, step 4):
   ``beats_something_else`` (BIC), ``distinct`` from every alternative on its channels
   (:func:`complements` are none), and :func:`model_changes`.
 
-The qualifying candidate that adds the most likelihood joins the model and is refitted; the
-next round judges the rest against the model that holds it. When none qualifies, an effect
-named by the open loop whose final model still misses one of its channels on held-out data
-is withdrawn (:func:`withdraw_unsupported`), and the competitor is scanned on the final model
-stepped to the whole run (:func:`verdict_on`; stepped, since a model calibrated on the fit
-window misses the validation window by its extrapolation, which a window there would take
-up): ``unexplained`` and where, or not.
+One qualifying candidate joins the model (:func:`joins_first`: a signature's before the open
+loop's, then the most likelihood) and is refitted (:func:`refit`); the next round judges the
+rest against the model that holds it. When none qualifies, an effect named by the open loop
+whose final model still misses one of its channels on held-out data is withdrawn
+(:func:`withdraw_unsupported`), and the competitor is scanned on the final model stepped to the
+whole run (:func:`verdict_on`; stepped, since a model calibrated on the fit window misses the
+validation window by its extrapolation, which a window there would take up): ``unexplained``
+and where, or not.
 """
 
 from __future__ import annotations
@@ -276,7 +277,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         qualified = [j for j in round_judged if j.qualifies]
         if not qualified:
             break
-        best = max(qualified, key=lambda j: j.gain)
+        best = joins_first(qualified)
         say(f"round {rnd}: refitting with {best.label}")
         best.fit, best.figures["refit_from"] = refit(cal, current, fits[best.label], criteria)
         steps.append(Step(best, current))
@@ -288,6 +289,15 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
     say("fitting something else on the final model")
     return Selection(base, steps, judged, verdict_on(loc, reg, criteria,
                                                      unknown_inputs=unknown_inputs))
+
+
+def joins_first(qualified: Sequence[Judgement]) -> Judgement:
+    """The qualifying candidate that joins the model this round: one qualified by its
+    signature before one the open loop alone supports, then the largest gain. A signature's
+    evidence is the raw samples', whatever model it is judged against; the open loop's is the
+    model's likelihood, which the signature's effect changes, so an open-loop candidate is
+    judged again in the next round against the model that holds it."""
+    return max(qualified, key=lambda j: (j.route == "signature", j.gain))
 
 
 def refit(cal: Calibrator, current: Fit, ef, criteria: Criteria) -> tuple[Fit, str]:
