@@ -118,7 +118,7 @@ def test_the_calibrated_model_places_the_switch_where_the_spec_model_cannot():
     run = BenchRun(None, {}, t, cols, {}, [], ["T1", "T2", "T_stator", "P1"], float(t[-1]))
     inputs = greybox_inputs(run)
     channels = ["T1", "T2", "T_stator", "P1"]
-    measured = _measured(run, channels, inputs.grid_s, 0.6, 1)
+    measured = _measured(run, channels, inputs.grid_s, 0.6, 1, Criteria())
 
     def place(th):
         return _place_gap_switches(run, spec, drive, inputs, measured, channels, 11, (),
