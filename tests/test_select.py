@@ -492,7 +492,6 @@ def test_the_linearized_models_prior_distances_are_the_calibrators(setup):
     fitted scale: at the fit (no step) and after a step of the base (to round-off)."""
     from types import SimpleNamespace
 
-    from compare.fit.calibrate import _from_z
     from compare.fit.linear import local
     from compare.fit.params import default_theta
 
@@ -503,13 +502,10 @@ def test_the_linearized_models_prior_distances_are_the_calibrators(setup):
     centre = default_theta(cal.gb.parameters())
     _, fit = cal.fit_with_prior(centre)
     loc = local(cal, fit)
-    params = cal.gb.parameters()
     rng = np.random.default_rng(0)
     for delta in (np.zeros(len(fit.free)), rng.normal(scale=0.3, size=len(fit.free))):
-        moved = {k: _from_z(params[k], z + d)
-                 for k, z, d in zip(fit.free, loc.z0, delta, strict=True)}
         want = cal.prior_z(SimpleNamespace(effects=fit.effects, free=fit.free,
-                                           theta={**fit.theta, **moved}))
+                                           theta=loc.theta_after(delta)))
         got = dict(zip(fit.free, loc.prior_sds(delta), strict=True))
         assert want and all(got[k] == pytest.approx(v, abs=1e-9) for k, v in want.items())
 
@@ -685,7 +681,6 @@ def test_the_refit_of_a_joining_effect_is_no_worse_than_its_nested_start(setup):
     than from the nested start, and the refit must not."""
     from dataclasses import replace
 
-    from compare.fit.calibrate import _from_z, _to_z
     from compare.fit.linear import fit_effect, local
     from compare.fit.select import refit
 
@@ -696,7 +691,8 @@ def test_the_refit_of_a_joining_effect_is_no_worse_than_its_nested_start(setup):
         {"k_preload_1_K": 0.15, "k_preload_rear_1_K": 0.15, "h_coolant": 0.7}))
     cal = Calibrator(gb, Measured(inp.grid_s, _noisy(out, len(inp.grid_s), 0)), CHANNELS)
     base = cal.fit()
-    ef = fit_effect(local(cal, base), "bearing_preload")
+    loc = local(cal, base)
+    ef = fit_effect(loc, "bearing_preload")
     far = replace(ef, delta=ef.delta + 2.0)
     crit = Criteria()
 
@@ -707,11 +703,8 @@ def test_the_refit_of_a_joining_effect_is_no_worse_than_its_nested_start(setup):
         return cal.fit(base.effects + (ef.label,), start=start, max_nfev=crit.refit_nfev)
 
     nested = posterior(from_start({**base.theta, **ef.values}))
-    stepped = dict(base.theta, **ef.values)
-    params = gb.variant(base.effects).parameters()
-    for k, d in zip(base.free, far.delta, strict=True):
-        stepped[k] = _from_z(params[k], _to_z(params[k], base.theta[k]) + float(d))
+    stepped = {**loc.theta_after(far.delta), **ef.values}
     # the case the second start is for (half a unit of log-posterior: more than round-off)
     assert posterior(from_start(stepped)) < nested - 0.5
-    fit, start = refit(cal, base, far, crit)
+    fit, start = refit(cal, loc, far, crit)
     assert posterior(fit) >= nested - 1e-6 and start == "nested"

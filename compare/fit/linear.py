@@ -95,6 +95,14 @@ class Local:
         kb = self.J.shape[1]
         return self.prior_rows * (self.z0 + delta[:kb] - self.prior_z)
 
+    def theta_after(self, delta: np.ndarray) -> dict[str, float]:
+        """The parameter values of the fit with its free parameters moved by the step
+        ``delta`` on the fitted scale (extra amplitudes beyond them are not parameters)."""
+        params = self.cal.gb.variant(self.fit.effects).parameters()
+        free = self.fit.free
+        return {**self.fit.theta, **{k: _from_z(params[k], float(z + d)) for k, z, d
+                                     in zip(free, self.z0, delta[:len(free)], strict=True)}}
+
     def prior_sds(self, delta: np.ndarray) -> np.ndarray:
         """Each base parameter's distance from its prior centre after the step ``delta``, in
         prior standard deviations (0 where it has no prior)."""

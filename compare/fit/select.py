@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from compare.fit.calibrate import Calibrator, Fit, _from_z, _to_z, over_tolerance
+from compare.fit.calibrate import Calibrator, Fit, over_tolerance
 from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan, scan_threshold
 from compare.fit.criteria import Criteria
 from compare.fit.effects import effect_of, parse_label
@@ -279,7 +279,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
             break
         best = joins_first(qualified)
         say(f"round {rnd}: refitting with {best.label}")
-        best.fit, best.figures["refit_from"] = refit(cal, current, fits[best.label], criteria)
+        best.fit, best.figures["refit_from"] = refit(cal, loc, fits[best.label], criteria)
         steps.append(Step(best, current))
         current = best.fit
         loc = local(cal, current)
@@ -300,23 +300,22 @@ def joins_first(qualified: Sequence[Judgement]) -> Judgement:
     return max(qualified, key=lambda j: (j.route == "signature", j.gain))
 
 
-def refit(cal: Calibrator, current: Fit, ef, criteria: Criteria) -> tuple[Fit, str]:
-    """The nonlinear fit of ``current``'s model with the candidate ``ef`` (its
-    compare.fit.linear.EffectFit) added, started twice: at the linearized step (the base
-    parameters moved by its delta) and at ``current`` with only the effect's values added.
+def refit(cal: Calibrator, loc: Local, ef, criteria: Criteria) -> tuple[Fit, str]:
+    """The nonlinear fit of the current model (``loc.fit``, linearized as ``loc``) with the
+    candidate ``ef`` (its compare.fit.linear.EffectFit) added, started twice: at the
+    linearized step (the base parameters moved by its delta) and at the current model with
+    only the effect's values added.
     The better log-posterior (counted in ``current``'s effective samples, as every gain of
     the selection) is kept, with the start it came from ("step" or "nested"). The step
     extrapolates the linearization over the whole change, and where the base must move far it
     can land in another basin of the least squares than the one the current model is in; the
     second start is the nested model's own optimum, from which the effect only adds."""
-    params = cal.gb.variant(current.effects).parameters()
-    stepped = {**current.theta, **ef.values}
-    for k, d in zip(current.free, ef.delta, strict=True):
-        stepped[k] = _from_z(params[k], _to_z(params[k], current.theta[k]) + float(d))
+    current = loc.fit
     shrink = current.n_eff / max(current.n, 1)
+    starts = {"step": {**loc.theta_after(ef.delta), **ef.values},
+              "nested": {**current.theta, **ef.values}}
     fits = {name: cal.fit(current.effects + (ef.label,), start=start,
-                          max_nfev=criteria.refit_nfev)
-            for name, start in (("step", stepped), ("nested", {**current.theta, **ef.values}))}
+                          max_nfev=criteria.refit_nfev) for name, start in starts.items()}
     best = max(fits, key=lambda k: fits[k].loglik * shrink - fits[k].penalty)
     return fits[best], best
 
