@@ -21,7 +21,8 @@ One qualifying candidate joins the model (:func:`joins_first`: a signature's bef
 loop's, then the most likelihood) and is refitted (:func:`refit`); the next round judges the
 rest against the model that holds it. When none qualifies, an effect named by the open loop
 whose final model still misses one of its channels on held-out data is withdrawn
-(:func:`withdraw_unsupported`), and the competitor is scanned on the final model stepped to the
+(:func:`withdraw_unsupported`) and the selection goes on from the model before it, without
+it; when nothing is withdrawn, the competitor is scanned on the final model stepped to the
 whole run (:func:`verdict_on`; stepped, since a model calibrated on the fit window misses the
 validation window by its extrapolation, which a window there would take up): ``unexplained``
 and where, or not.
@@ -223,72 +224,94 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
     current = base
     steps: list[Step] = []
     judged: list[Judgement] = []
+    withdrawn: set[str] = set()
     reg = regressors(cal, base, criteria)
     loc = local(cal, current)
     while True:
-        rnd = len(steps) + 1
+        rnd = judged[-1].round + 1 if judged else 1
         have = {parse_label(e)[0] for e in current.effects}
-        pending = [c for c in candidates if parse_label(c)[0] not in have]
-        if not pending:
-            break
-        fits = {}
-        for lab in pending:
-            say(f"round {rnd}: fitting {lab}")
-            # from a tenth into its range, and from its signature's estimate where there is one
-            tries = [fit_effect(loc, lab)]
-            from_signature = _signature_start(lab, sig.get(lab))
-            if from_signature:
-                tries.append(fit_effect(loc, lab, from_signature))
-            tries = [f for f in tries if f is not None]
-            if tries:
-                fits[lab] = max(tries, key=lambda f: f.gain)
-            else:
-                say(f"round {rnd}: {lab} makes the model run away wherever it was tried; "
-                    "not judged")
-        say(f"round {rnd}: fitting something else")
-        shrink = current.n_eff / max(current.n, 1)
-        found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit & known_inputs(loc, unknown_inputs),
-                        shrink)
-        # the null of every test: the current model refitted by the same step without a
-        # candidate (a nonlinear fit stopped short of its optimum leaves the step a gain of
-        # its own, which is no candidate's)
-        null = NullStep.of(loc)
-        g_gain = joint_gain(loc, reg, found) - null.gain
-        # every candidate's gain over the null, penalised by half ln(n_eff) per parameter (BIC)
-        pen = 0.5 * math.log(max(current.n_eff, 2.0))
-        penalised = {lab: f.gain - null.gain - pen * len(effect_of(lab).params)
-                     for lab, f in fits.items()}
-        cv_now = loc.cross_validate(criteria.cv_blocks) if criteria.cv_blocks else None
-        round_judged = []
-        margin = criteria.distinct_margin()
-        for lab, ef in fits.items():
-            near = {other: v for other, v in penalised.items() if other != lab
-                    and parse_label(other)[0] != parse_label(lab)[0]
-                    and set(_own(other)) & set(_own(lab))}
-            # only a rival that could make it fail is asked whether it is a complement
-            comp = [other for other, v in near.items() if criteria.distinct_among_alternatives
-                    and v + margin > penalised[lab]
-                    and complements(loc, ef, fits[other], margin)]
-            rival = max((v for other, v in near.items() if other not in comp),
-                        default=-math.inf)
-            round_judged.append(judge(loc, ef, sig.get(lab), criteria, penalised[lab],
-                                      g_gain - 3 * pen, rival, cv_now, rnd, null, comp))
+        pending = [c for c in candidates if parse_label(c)[0] not in have and c not in withdrawn]
+        fits = _fit_candidates(loc, pending, sig, rnd, say)
+        round_judged = _judge_round(loc, fits, sig, criteria, reg, unknown_inputs, rnd, say)
         judged += round_judged
         qualified = [j for j in round_judged if j.qualifies]
-        if not qualified:
+        if qualified:
+            best = joins_first(qualified)
+            say(f"round {rnd}: refitting with {best.label}")
+            best.fit, best.figures["refit_from"] = refit(cal, loc, fits[best.label], criteria)
+            steps.append(Step(best, current))
+            current = best.fit
+            loc = local(cal, current)
+            continue
+        # a withdrawn effect's failure says nothing of the candidates judged with it: the
+        # selection goes on from the model before it, without it
+        kept, gone = withdraw_unsupported(steps, current, criteria)
+        if gone is None:
             break
-        best = joins_first(qualified)
-        say(f"round {rnd}: refitting with {best.label}")
-        best.fit, best.figures["refit_from"] = refit(cal, loc, fits[best.label], criteria)
-        steps.append(Step(best, current))
-        current = best.fit
-        loc = local(cal, current)
-    kept = withdraw_unsupported(steps, current, criteria)
-    if kept is not current:
+        withdrawn.add(gone)
         current, loc = kept, local(cal, kept)
     say("fitting something else on the final model")
     return Selection(base, steps, judged, verdict_on(loc, reg, criteria,
                                                      unknown_inputs=unknown_inputs))
+
+
+def _fit_candidates(loc: Local, pending: Sequence[str], sig: Mapping[str, object], rnd: int,
+                    say: Callable[[str], None]) -> dict:
+    """Each pending candidate fitted on the linearized model, by label (EffectFit), from a
+    tenth into its range and from its signature's estimate where there is one; one that makes
+    the model run away from every start is left out."""
+    fits = {}
+    for lab in pending:
+        say(f"round {rnd}: fitting {lab}")
+        tries = [fit_effect(loc, lab)]
+        from_signature = _signature_start(lab, sig.get(lab))
+        if from_signature:
+            tries.append(fit_effect(loc, lab, from_signature))
+        tries = [f for f in tries if f is not None]
+        if tries:
+            fits[lab] = max(tries, key=lambda f: f.gain)
+        else:
+            say(f"round {rnd}: {lab} makes the model run away wherever it was tried; "
+                "not judged")
+    return fits
+
+
+def _judge_round(loc: Local, fits: Mapping, sig: Mapping[str, object], criteria: Criteria,
+                 reg, unknown_inputs: Sequence[tuple[float, float]], rnd: int,
+                 say: Callable[[str], None]) -> list[Judgement]:
+    """Every fitted candidate of one round judged against the current model (``loc``), the
+    competitor and each other (module docstring)."""
+    if not fits:
+        return []
+    current = loc.fit
+    say(f"round {rnd}: fitting something else")
+    shrink = current.n_eff / max(current.n, 1)
+    found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit & known_inputs(loc, unknown_inputs),
+                    shrink)
+    # the null of every test: the current model refitted by the same step without a
+    # candidate (a nonlinear fit stopped short of its optimum leaves the step a gain of
+    # its own, which is no candidate's)
+    null = NullStep.of(loc)
+    g_gain = joint_gain(loc, reg, found) - null.gain
+    # every candidate's gain over the null, penalised by half ln(n_eff) per parameter (BIC)
+    pen = 0.5 * math.log(max(current.n_eff, 2.0))
+    penalised = {lab: f.gain - null.gain - pen * len(effect_of(lab).params)
+                 for lab, f in fits.items()}
+    cv_now = loc.cross_validate(criteria.cv_blocks) if criteria.cv_blocks else None
+    margin = criteria.distinct_margin()
+    out = []
+    for lab, ef in fits.items():
+        near = {other: v for other, v in penalised.items() if other != lab
+                and parse_label(other)[0] != parse_label(lab)[0]
+                and set(_own(other)) & set(_own(lab))}
+        # only a rival that could make it fail is asked whether it is a complement
+        comp = [other for other, v in near.items() if criteria.distinct_among_alternatives
+                and v + margin > penalised[lab]
+                and complements(loc, ef, fits[other], margin)]
+        rival = max((v for other, v in near.items() if other not in comp), default=-math.inf)
+        out.append(judge(loc, ef, sig.get(lab), criteria, penalised[lab], g_gain - 3 * pen,
+                         rival, cv_now, rnd, null, comp))
+    return out
 
 
 def joins_first(qualified: Sequence[Judgement]) -> Judgement:
@@ -320,22 +343,24 @@ def refit(cal: Calibrator, loc: Local, ef, criteria: Criteria) -> tuple[Fit, str
     return fits[best], best
 
 
-def withdraw_unsupported(steps: list[Step], final: Fit, criteria: Criteria) -> Fit:
+def withdraw_unsupported(steps: list[Step], final: Fit,
+                         criteria: Criteria) -> tuple[Fit, str | None]:
     """Criteria.open_loop_adequate_model: where the ``final`` model misses the tolerance of
     one of an open-loop step's own channels on held-out data, the first such step and every
     step after it are withdrawn (``steps`` is cut; their judgements' ``final_model_adequate``
     set False). A misfit on a channel the effect does not act on leaves its likelihood ratio
-    as it was. Returns the model that remains."""
+    as it was. Returns the model that remains and the first withdrawn step's label (None:
+    nothing withdrawn)."""
     misses = held_out_misses(final.errors) if criteria.open_loop_adequate_model else {}
     first = next((i for i, s in enumerate(steps) if s.judgement.route == "open loop"
                   and set(_own(s.label)) & set(misses)), None)
     if first is None:
-        return final
-    kept = steps[first].before
+        return final, None
+    kept, label = steps[first].before, steps[first].label
     for s in steps[first:]:
         s.judgement.criteria["final_model_adequate"] = False
     del steps[first:]
-    return kept
+    return kept, label
 
 
 #: the amplitude of a candidate's fitted shift in :func:`complements`: from none to twice its
