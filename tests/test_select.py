@@ -627,7 +627,8 @@ def test_an_adequate_base_says_how_near_the_verdicts_test_came():
 def test_the_verdict_says_which_fitted_effect_was_withdrawn_and_why():
     """report.verdict_lines on a hand-written report document: a candidate withdrawn after
     the selection (final_model_adequate False) is named as fitted and withdrawn, with the
-    reason, after the verdict; a run without one says nothing of it."""
+    reason, after the verdict; a run without one says nothing of it, nor does one whose
+    withdrawn candidate was named again once the selection went on."""
     from compare.fit.report import verdict_lines
 
     def doc(adequate):
@@ -643,6 +644,16 @@ def test_the_verdict_says_which_fitted_effect_was_withdrawn_and_why():
     assert lines[1].startswith("Fitted and withdrawn: bearing_preload. The model with it "
                                "still misses the tolerances on held-out data")
     assert not any("withdrawn" in line for line in verdict_lines(doc(None)))
+    # one withdrawn only because it joined after the cause, then named again, is not listed
+    named = {"label": "bearing_preload", "parameters": {"k_preload_1_K": 0.1},
+             "units": {"k_preload_1_K": "1/K"},
+             "confidence_intervals": {"k_preload_1_K": [0.08, 0.12]}, "evidence": None,
+             "route": "open loop", "p_value": 1e-6, "criteria": dict(ALL_PASS)}
+    again = {**doc(False), "effects": [named],
+             "verdict": {"kind": "named", "unexplained": False}}
+    lines = verdict_lines(again)
+    assert lines[0].startswith("Named: bearing_preload")
+    assert not any("withdrawn" in line for line in lines)
 
 
 def test_two_effects_that_each_add_to_the_other_are_complements_not_rivals(setup):

@@ -174,13 +174,16 @@ def verdict_lines(doc: dict) -> list[str]:
             f"Too small to matter: the likeliest event the library lacks, {se['where']}, is "
             f"significant ({stat}) but moves no channel by more than "
             f"{h['peak_tolerances']:.2g} tolerances.")
-    gone = [c["candidate"] for c in doc.get("candidates", [])
-            if c["criteria"].get("final_model_adequate") is False]
+    # one that joined after a withdrawn effect is withdrawn with it and may be named again
+    named = {e["label"] for e in doc["effects"]}
+    gone = list(dict.fromkeys(c["candidate"] for c in doc.get("candidates", [])
+                              if c["criteria"].get("final_model_adequate") is False
+                              and c["candidate"] not in named))
     if gone:
-        lines.append(f"Fitted and withdrawn: {', '.join(gone)}. The model with "
-                     f"{'it' if len(gone) == 1 else 'them'} still misses the tolerances on "
-                     "held-out data, so the open loop's likelihood ratio does not tell the "
-                     "cause.")
+        them = "it" if len(gone) == 1 else "them"
+        lines.append(f"Fitted and withdrawn: {', '.join(gone)}. The model with {them} still "
+                     "misses the tolerances on held-out data, so the open loop's likelihood "
+                     f"ratio does not tell the cause; the selection went on without {them}.")
     lines.append(f"Validation error before -> after: {_change_text(doc)}.")
     return lines
 
