@@ -190,6 +190,12 @@ class Fit:
     def k(self) -> int:
         return len(self.free)
 
+    @property
+    def sample_share(self) -> float:
+        """n_eff / n: the share of the residual's samples the likelihood counts as independent
+        (every log-likelihood gain of the selection is weighed by it)."""
+        return self.n_eff / max(self.n, 1)
+
     def validation_score(self) -> float:
         """Weighted RMS over the validation window (tolerance units)."""
         v = self.errors["validation"]

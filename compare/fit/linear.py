@@ -123,7 +123,7 @@ class Local:
         ``delta`` against this model's own, counted in the fit's effective samples (the
         likelihood of compare.fit.calibrate)."""
         rows = self.in_fit
-        shrink = self.fit.n_eff / max(self.fit.n, 1)
+        shrink = self.fit.sample_share
         return ((self.loglik(r1, rows) - self.loglik(self.r0, rows)) * shrink
                 - (self.penalty(delta) - self.penalty(np.zeros_like(delta))))
 

@@ -285,7 +285,7 @@ def _judge_round(loc: Local, fits: Mapping, sig: Mapping[str, object], criteria:
         return []
     current = loc.fit
     say(f"round {rnd}: fitting something else")
-    shrink = current.n_eff / max(current.n, 1)
+    shrink = current.sample_share
     found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit & known_inputs(loc, unknown_inputs),
                     shrink)
     # the null of every test: the current model refitted by the same step without a
@@ -334,7 +334,7 @@ def refit(cal: Calibrator, loc: Local, ef, criteria: Criteria) -> tuple[Fit, str
     can land in another basin of the least squares than the one the current model is in; the
     second start is the nested model's own optimum, from which the effect only adds."""
     current = loc.fit
-    shrink = current.n_eff / max(current.n, 1)
+    shrink = current.sample_share
     starts = {"step": {**loc.theta_after(ef.delta), **ef.values},
               "nested": {**current.theta, **ef.values}}
     fits = {name: cal.fit(current.effects + (ef.label,), start=start,
@@ -462,7 +462,7 @@ def verdict_on(loc: Local, reg, criteria: Criteria,
     rows = np.ones(len(loc.r0), dtype=bool)
     r = loc.residual(loc.step(rows))
     rows = known_inputs(loc, unknown_inputs)
-    shrink = loc.fit.n_eff / max(loc.fit.n, 1)
+    shrink = loc.fit.sample_share
     found, _ = scan(reg, r, loc.channel, rows, shrink, top=1)
     h = found[0] if found else None
     lr = 2.0 * h.gain if h is not None else 0.0
