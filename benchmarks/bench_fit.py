@@ -2,12 +2,15 @@
 
     python benchmarks/bench_fit.py [--effect fixture_expansion] [--seed 1] [--keep DIR]
     python benchmarks/bench_fit.py --run tests/data/peer-runs/bench-runs/dev-06.csv
+    python benchmarks/bench_fit.py --run ../shared/bench-runs-2/dev2-01.csv --serial-too
 
 Makes a synthetic run with ``spindle-verify synth`` (FEM level 1, not timed), or takes
 ``--run``, a bench export such as a peer's development run; then times reading it, one
 grey-box simulation, and the whole ``fit`` (calibration, forward selection over the library,
-cross-validation, diagnostics, report.json and report.html). Target (issues 6, 13): <= 60 s
-on 2 cores for a 16 h run.
+cross-validation, diagnostics, report.json and report.html), with ``--workers`` processes as
+``spindle-verify fit`` runs (default min(2, CPUs)); ``--serial-too`` times it again with one
+process and prints the ratio (the two reports must be the same: compare/forked.py). Target
+(issues 6, 13, 32): <= 60 s on 2 cores for a 16 h run.
 """
 
 from __future__ import annotations
@@ -28,10 +31,15 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--keep", help="keep the run and the report in this folder")
     ap.add_argument("--run", type=Path, help="time this bench export instead of a synthetic run")
+    ap.add_argument("--workers", type=int, default=None,
+                    help="processes per fit (default min(2, CPUs), as spindle-verify fit)")
+    ap.add_argument("--serial-too", action="store_true",
+                    help="time the fit with one process too and print the ratio")
     args = ap.parse_args(argv)
     if args.run is not None:
         require_files([args.run], "--run")
 
+    from compare.executor import default_workers
     from compare.fit.greybox import GreyBox
     from compare.fit.report import save_report
     from compare.fit.run import greybox_inputs, run_fit
@@ -56,17 +64,40 @@ def main(argv: list[str] | None = None) -> None:
     for _ in range(10):
         gb.simulate({"h_air": 1.01})
     t_sim = (time.perf_counter() - t) / 10
+    workers = args.workers or default_workers()
     t = time.perf_counter()
-    rep = run_fit(run, spec)
+    rep = run_fit(run, spec, workers=workers)
     save_report(rep, folder / "fit")
     t_fit = time.perf_counter() - t
+    serial = ""
+    if args.serial_too and workers > 1:
+        t = time.perf_counter()
+        rep1 = run_fit(run, spec, workers=1)
+        save_report(rep1, folder / "fit-serial")
+        t_one = time.perf_counter() - t
+        same = _same_report(folder / "fit" / "report.json", folder / "fit-serial" / "report.json")
+        serial = (f"; one process {t_one:.1f} s, {t_one / t_fit:.2f}x the time with {workers} "
+                  f"(reports {'the same' if same else 'DIFFER'})")
     named = [s.label for s in rep.selection.steps]
     print(f"{run}: rows {len(bench.time_s)}, {bench.duration_s / 3600:.1f} h"
           + ("" if args.run else f"; synth (FEM, untimed) {t_synth:.1f} s"))
     print(f"read {t_read:.2f} s; one 16 h simulation {t_sim * 1e3:.1f} ms; fit to report "
-          f"{t_fit:.1f} s (target 60 s: {'met' if t_fit <= 60 else 'MISSED'}); "
+          f"{t_fit:.1f} s with {workers} process(es) (target 60 s: "
+          f"{'met' if t_fit <= 60 else 'MISSED'}){serial}; "
           f"{len(rep.selection.judged)} candidate fits; named "
           f"{named or 'nothing'}" + ("" if args.run else f" (injected {args.effect})"))
+
+
+def _same_report(a: Path, b: Path) -> bool:
+    """Whether two report.json files agree but for their runtimes."""
+    import json
+
+    def strip(x):
+        if isinstance(x, dict):
+            return {k: strip(v) for k, v in x.items() if "runtime" not in k and k != "fit_s"}
+        return [strip(v) for v in x] if isinstance(x, list) else x
+
+    return strip(json.loads(a.read_text())) == strip(json.loads(b.read_text()))
 
 
 if __name__ == "__main__":

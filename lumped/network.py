@@ -442,6 +442,60 @@ class ThermalSystem:
                                     V.T * (1.0 / s)[None, :], s[:, None] * V)
         return self._cache[key]
 
+    def prepare_modes(self, dts_s: np.ndarray, speeds_rpm: np.ndarray) -> None:
+        """:meth:`modes` for every pair of step [s] and speed [rpm] at once, into the same
+        cache (nothing for a temperature-dependent network, which has no modes): per step,
+        the matrices, their condensation and the eigenproblems of all speeds go to numpy
+        as stacks, so a new set of conductances costs one call per step, not one per speed.
+        The numbers are those of :meth:`modes`: each stacked slice runs the same LAPACK and
+        BLAS routine on the same values (tests/test_lumped_network.py)."""
+        if self.temperature_dependent:
+            return
+        dts_s, speeds_rpm = np.asarray(dts_s, dtype=float), np.asarray(speeds_rpm, dtype=float)
+        for dt in np.unique(dts_s):
+            self._prepare_modes(float(dt), speeds_rpm[dts_s == dt])
+
+    def _prepare_modes(self, dt_s: float, speeds_rpm: np.ndarray) -> None:
+        dt_key = round(float(dt_s), 9)
+        todo = [n for n in dict.fromkeys(float(v) for v in speeds_rpm)
+                if ("modes", dt_key, n) not in self._cache]
+        if len(todo) < 2:
+            return
+        st = self._stamps()
+        nf = st.K0.shape[0]
+        K = np.repeat(st.K0[None], len(todo), axis=0)
+        B = np.repeat(st.B0[None], len(todo), axis=0)
+        if st.varying:
+            g = np.array([[conductance_at(G, n) for G in st.varying] for n in todo])
+            for k in range(len(todo)):  # as _full: one sparse product per speed
+                K[k] += (st.Kv @ g[k]).reshape(nf, nf)
+                B[k] += (st.Bv @ g[k]).reshape(B.shape[1:])
+        s_, j = self.state, self.junction
+        if len(j):
+            Kjj = K[:, j][:, :, j]
+            R = -np.linalg.solve(Kjj, K[:, j][:, :, s_])
+            S = np.linalg.solve(Kjj, B[:, j])
+            Ksj = K[:, s_][:, :, j]
+            K = K[:, s_][:, :, s_] + Ksj @ R
+            B = B[:, s_] - Ksj @ S
+        sym = np.all(np.abs(K - K.transpose(0, 2, 1)) <= 1e-12 * np.abs(K.transpose(0, 2, 1)),
+                     axis=(1, 2))
+        sc = 1.0 / np.sqrt(self.C)
+        if len(self._cache) > 256:
+            self._cache.clear()
+        for k in np.flatnonzero(~sym):
+            self._cache[("modes", dt_key, todo[k])] = None
+        if not sym.any():
+            return
+        lam, V = np.linalg.eigh(sc[None, :, None] * K[sym] * sc[None, None, :])
+        g = -np.expm1(-lam * dt_s) / lam
+        Vt = V.transpose(0, 2, 1)
+        Bm = (Vt * sc[None, None, :]) @ B[sym] * g[:, :, None]
+        a = np.exp(-lam * dt_s)
+        for i, k in enumerate(np.flatnonzero(sym)):
+            self._cache[("modes", dt_key, todo[k])] = (
+                a[i], Bm[i], Vt[i] * (1.0 / sc)[None, :], sc[:, None] * V[i])
+
     def discretize(self, dt_s: float, speed_rpm: float, q: np.ndarray | None = None,
                    integrals: bool = False) -> tuple[np.ndarray, ...]:
         """Exact zero-order-hold step: x+ = Phi x + Gamma u for inputs held over dt_s [s]

@@ -10,7 +10,7 @@ file, the field and the fix. The loss models that use the set are in spindle.pow
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -49,13 +49,22 @@ class Drive:
     #: the bearings' friction factors times (n / FRICTION_REF_RPM)^e: a speed dependence of
     #: the friction beyond Palmgren's (nu n)^(2/3) (0: Palmgren's law as it stands)
     friction_exponent: float = 0.0
+    #: bearings_at's sets by speed (a fit asks for the same speed levels at hundreds of
+    #: operating points); not a field of the parameter set: replace() starts it empty
+    _bearings_by_speed: dict = field(default_factory=dict, init=False, repr=False,
+                                     compare=False)
 
     def bearings_at(self, speed_rpm: float) -> dict[str, BearingParams]:
         """The bearing sets at ``speed_rpm`` [rpm], with the friction exponent applied."""
         if self.friction_exponent == 0.0:
             return self.bearings
-        scale = (max(float(speed_rpm), 1.0) / FRICTION_REF_RPM) ** self.friction_exponent
-        return {k: replace(b, f0=b.f0 * scale) for k, b in self.bearings.items()}
+        n = float(speed_rpm)
+        out = self._bearings_by_speed.get(n)
+        if out is None:
+            scale = (max(n, 1.0) / FRICTION_REF_RPM) ** self.friction_exponent
+            out = {k: replace(b, f0=b.f0 * scale) for k, b in self.bearings.items()}
+            self._bearings_by_speed[n] = out
+        return out
 
     def heat_W(self, speed_rpm: float, load_torque_Nm: float = 0.0,
                power_kW: float | None = None) -> dict[str, float]:

@@ -148,6 +148,14 @@ def modal_recursion(a: np.ndarray, Bm: np.ndarray, U: np.ndarray, z0: np.ndarray
     n, modes = len(U), len(a)
     a_min = float(a.min())
     L = int(np.clip(np.floor(np.log(1e4) / -np.log(a_min)) if a_min > 0 else 1, 1, 512))
+    if L == 1:  # single-sample blocks: the same sums without the blocks' bookkeeping
+        D = U @ Bm.T
+        Z = np.empty((n, modes))
+        s = z0
+        for k in range(n):
+            s = a * s + D[k]
+            Z[k] = s
+        return Z @ out.T, (Z[-1].copy() if n else np.array(z0, dtype=float))
     nb = -(-n // L)
     Up = np.zeros((nb * L, U.shape[1]))
     Up[:n] = U

@@ -207,3 +207,34 @@ def test_the_stamps_of_a_fine_network_hold_four_entries_per_varying_conductance(
     K, _ = sys_._full(4300.0, None)
     np.testing.assert_allclose(K, _loop_matrices(sys_, 4300.0, None)[0], rtol=0,
                                atol=1e-13 * np.abs(K).max())
+
+
+@pytest.mark.parametrize("nodes, symmetric", [(5, True), (11, True), (11, False)])
+def test_modes_prepared_for_many_speeds_are_those_of_one_speed(nodes, symmetric):
+    """A fit's simulation asks for the modes at every speed level of a run at once
+    (prepare_modes: stacked matrices, one batched eigenproblem); they must be the modes the
+    one-speed path gives, bit for bit, since a fit's result must not depend on which path
+    filled the cache. A K that is not symmetric (made so here by one entry) has no modes:
+    None on both paths."""
+    from dataclasses import replace
+
+    from lumped.build import build_network
+    from spindle.spec_reader import load_spec
+
+    spec = load_spec("spl2782")
+    speeds = [0.0, 120.0, 1234.5, 3000.0, 4300.0, 9000.0]
+    systems = [build_network(spec, nodes).network.assemble() for _ in range(2)]
+    for sys_ in systems:
+        if not symmetric:
+            st = sys_._stamps()
+            K0 = st.K0.copy()
+            K0[0, 1] *= 1.5
+            sys_._stamp = replace(st, K0=K0)
+    batched, single = systems
+    batched.prepare_modes(np.full(len(speeds), 60.0), np.array(speeds))
+    for n in speeds:
+        got = batched._cache[("modes", 60.0, n)]
+        want = single.modes(60.0, n)
+        assert (got is None) == (want is None) == (not symmetric)
+        for g, w in zip(got or (), want or (), strict=True):
+            np.testing.assert_array_equal(g, w)

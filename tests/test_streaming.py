@@ -81,3 +81,23 @@ def test_no_picked_output_reads_nan():
     s = FusedStepper(_discrete, _modal, np.eye(2), np.zeros(2), np.zeros(2), 2, n_first=2,
                      picked=None)
     assert np.isnan(s.step(np.ones(2), 0.0)[1])
+
+
+def test_a_mode_that_decays_within_one_step_takes_single_sample_blocks():
+    """A mode with a = exp(-lam dt) below 1e-4 makes the blocks one sample long (as in a fit
+    on a 60 s grid, whose bearing rings settle in seconds): the recursion is then the plain
+    one, and equals the closed form to round-off; no samples return the entering state."""
+    lam = np.array([12.0, 2e-3])  # a = 6e-6 and 0.998
+    a = np.exp(-lam * DT)
+    rng = np.random.default_rng(5)
+    U = rng.uniform(0, 10, (300, 2))
+    x, want = np.array([1.0, 2.0]), []
+    for u in U:
+        x = a * x + (1 - a) / lam * u
+        want.append(x.copy())
+    Y, last = modal_recursion(a, np.diag((1 - a) / lam), U, np.array([1.0, 2.0]), np.eye(2))
+    np.testing.assert_allclose(Y, np.array(want), rtol=1e-13)
+    np.testing.assert_array_equal(last, Y[-1])
+    Y0, last0 = modal_recursion(a, np.diag((1 - a) / lam), U[:0], np.array([1.0, 2.0]),
+                                np.eye(2))
+    assert Y0.shape == (0, 2) and list(last0) == [1.0, 2.0]

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 from compare.cli.common import (
     NODE_COUNT,
+    WORKERS,
     add_no_pictures,
     add_out,
     add_quiet,
@@ -15,6 +16,7 @@ from compare.cli.common import (
     out_folder,
     with_progress,
 )
+from compare.executor import default_workers
 from spindle.errors import InputError
 
 if TYPE_CHECKING:
@@ -58,7 +60,7 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
                   progress=progress.say,
                   fem_level=None if args.lumped_only else args.fem_level,
                   base_extra=base_extra, blocks=args.blocks,
-                  cv_blocks=args.cv_blocks)
+                  cv_blocks=args.cv_blocks, workers=args.workers)
     with output_dir(out, inputs=[spec.path, args.run], force=args.force) as tmp, progress.pictures():
         save_report(rep, tmp, pictures=not args.no_pictures)
     progress.done()
@@ -111,6 +113,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     f"(default: {' '.join(DEFAULT_BASE_EXTRA)}; "
                     "docs/fit.md)")
     fp.add_argument("--nodes", type=NODE_COUNT, default=11, help="lumped model nodes (default 11)")
+    fp.add_argument("--workers", type=WORKERS, default=default_workers(),
+                    help="processes that share each calibration's finite-difference columns "
+                    "(forked copies of this one, on Linux; the result does not depend on it; "
+                    f"default min(2, CPUs) = {default_workers()}; 1: this process alone)")
     fp.add_argument("--candidates", nargs="+", choices=list(LIBRARY), metavar="EFFECT",
                     help="candidate effects (default: the whole library: "
                     f"{', '.join(LIBRARY)})")

@@ -37,6 +37,7 @@ import numpy as np
 from compare.fit.effects import LIBRARY, effect_of
 from compare.fit.greybox import GreyBox
 from compare.fit.params import BASE_PARAMS, EXTRA_BASE_PARAMS, Param
+from compare.forked import ForkedColumns
 from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
 
 #: the paper's tolerance per bench channel [K; m for P1] (spindle.tolerances)
@@ -223,6 +224,8 @@ class Calibrator:
     floor: dict[str, float] | None = None
     #: what the selection computes once per calibrator (compare.fit.competitor's columns)
     memo: dict = field(default_factory=dict, repr=False)
+    #: processes that evaluate a Jacobian's columns (compare.forked; 1: this one alone)
+    workers: int = 1
 
     def set_floor(self, fit: Fit) -> None:
         """The floor from the noise of ``fit``'s residual, estimated from its second
@@ -328,8 +331,12 @@ class Calibrator:
             return np.concatenate([*self.residuals(out, "fit").values(),
                                    self.prior_scale * self._prior_terms(params, free, z)])
 
-        sol = least_squares(vec, z0, bounds=(lo, hi), diff_step=1e-4, x_scale="jac",
-                            max_nfev=max_nfev or self.max_nfev, ftol=self.tol, xtol=self.tol)
+        costly = set(gb.matrix_params())
+        with ForkedColumns(vec, [k in costly for k in free], self.workers) as columns:
+            sol = least_squares(vec, z0, bounds=(lo, hi), diff_step=1e-4, x_scale="jac",
+                                max_nfev=max_nfev or self.max_nfev, ftol=self.tol,
+                                xtol=self.tol, workers=columns)
+        nfev += columns.child_evaluations
         theta.update({k: _from_z(params[k], float(v)) for k, v in zip(free, sol.x, strict=True)})
         out = gb.simulate(theta)
         res = self.residuals(out, "fit")

@@ -136,8 +136,28 @@ class GreyBox:
         the rotor share of the motor losses."""
         key = ("src", round(f0, 12), round(rotor_share, 12), round(friction_exponent, 12))
         if key not in self._cache:
-            d = (self.drive.with_f0(f0).with_rotor_share(rotor_share)
-                 .with_friction_exponent(friction_exponent))
+            # the motor loss does not depend on its split, so the power balances are made
+            # once per friction law, at a rotor share of 0 (stator = the whole loss), and
+            # split here as spindle.power.motor_losses splits it: rotor = share x loss,
+            # stator = loss - rotor, the same floats
+            whole = self._balances(f0, friction_exponent)
+            out = dict(whole)
+            out["rotor"] = rotor_share * whole["stator"]
+            out["stator"] = whole["stator"] - out["rotor"]
+            srcs = [k2 for k2 in self._cache if isinstance(k2, tuple) and k2[:1] == ("src",)
+                    and k2[1] != "balances"]
+            for k2 in srcs[:-7]:  # keep the last few: a Jacobian visits f0 and the split
+                del self._cache[k2]
+            self._cache[key] = out
+        return self._cache[key]
+
+    def _balances(self, f0: float, friction_exponent: float) -> dict[str, np.ndarray]:
+        """Heat per source [W] and interval at a rotor share of 0 (sources; under a key
+        ("src", ...), as everything that depends on the inputs)."""
+        key = ("src", "balances", round(f0, 12), round(friction_exponent, 12))
+        if key not in self._cache:
+            d = self.drive.with_f0(f0).with_rotor_share(0.0).with_friction_exponent(
+                friction_exponent)
             inp = self.inputs
             memo: dict[tuple, dict[str, float]] = {}
             rows = []
@@ -152,8 +172,9 @@ class GreyBox:
                     else:  # measured P: standstill and P < P_mech handled as the bench does
                         memo[k] = interval_heat_W(d, k[0], k[1], k[2])[0]
                 rows.append(memo[k])
-            srcs = [k2 for k2 in self._cache if isinstance(k2, tuple) and k2[:1] == ("src",)]
-            for k2 in srcs[:-7]:  # keep the last few: a Jacobian visits f0 and the split
+            old = [k2 for k2 in self._cache if isinstance(k2, tuple)
+                   and k2[:2] == ("src", "balances")]
+            for k2 in old[:-3]:  # a Jacobian visits f0 and the friction exponent
                 del self._cache[k2]
             self._cache[key] = {s: np.array([r[s] for r in rows]) for s in rows[0]}
         return self._cache[key]
@@ -258,7 +279,7 @@ class GreyBox:
         # systems (and their cached modes) are kept per set of the parameters that enter the
         # matrices: a Jacobian column for a source or read-out parameter reuses them (the
         # effects' flows, shared by the systems, were configured for these values above)
-        k_names = (*_K_PARAMS, *(k for e, _ in effects for k in e.in_conductance))
+        k_names = self.matrix_params()
         kkey = ("system", self.nodes, self.effects, self._seats,
                 *(round(float(theta.get(k, 0.0)), 12) for k in k_names))
         system = self._cache.get(kkey)
@@ -293,6 +314,11 @@ class GreyBox:
         out.__dict__.update(model.__dict__)
         out.system = system
         return out
+
+    def matrix_params(self) -> tuple[str, ...]:
+        """The parameters that enter the network's matrices: a new value of one needs new
+        modes at every speed level of the run."""
+        return (*_K_PARAMS, *(k for e, _ in self._effects() for k in e.in_conductance))
 
     def simulate(self, theta: dict[str, float], x0_K: float | None = None,
                  extra_rows: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
@@ -330,6 +356,7 @@ class GreyBox:
         Y[0] = readout @ x
         dts = np.diff(inp.grid_s)
         n_K = self.conductance_speeds()
+        sys.prepare_modes(dts, n_K)
         k = 0
         while k < n_int:  # runs of equal (dt, speed): one modal recursion each
             j = k + 1

@@ -119,7 +119,8 @@ class BaseCalibration:
 def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, nodes: int = 11,
                    grid_s: float = 60.0, progress: Callable[[str], None] | None = None,
                    fem_level: int | None = 0, base_extra: tuple[str, ...] | None = None,
-                   blocks: int = 1, criteria: Criteria | None = None) -> BaseCalibration:
+                   blocks: int = 1, criteria: Criteria | None = None,
+                   workers: int = 1) -> BaseCalibration:
     """Read the run, check it against the spec, anchor the grey box to the FEM reference and
     calibrate the base parameters (arguments as :func:`run_fit`)."""
     from compare.fit.discrepancy import fem_discrepancy
@@ -148,7 +149,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     def calibrator(on: Inputs) -> Calibrator:
         return Calibrator(GreyBox(spec, drive, on, nodes, base_extra=base_extra,
                                   speed_bin_rel=criteria.speed_bin_rel), measured,
-                          channels, progress=say, tol=criteria.optimizer_tol)
+                          channels, progress=say, tol=criteria.optimizer_tol, workers=workers)
 
     cal = calibrator(inputs)
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
@@ -281,7 +282,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
             nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
             min_gain: float | None = None, progress: Callable[[str], None] | None = None,
             fem_level: int | None = 0, base_extra: tuple[str, ...] | None = None,
-            blocks: int = 1, cv_blocks: int = 5, criteria: Criteria | None = None) -> FitReport:
+            blocks: int = 1, cv_blocks: int = 5, criteria: Criteria | None = None,
+            workers: int = 1) -> FitReport:
     """The whole loop (module docstring): the base parameters are calibrated on the lumped
     grey box anchored to the FEM (level ``fem_level``; None: the lumped model alone, no
     priors) at the spec's values. ``base_extra``: names of EXTRA_BASE_PARAMS calibrated with
@@ -289,7 +291,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     ``fit_fraction`` validate, spread over the run (1: the fit window is the first
     ``fit_fraction``). ``alpha``, ``min_gain`` (the cross-validated gain asked, a share) and
     ``cv_blocks`` set the criteria of those names (compare.fit.criteria); ``candidates``:
-    the effects to try (default: the library)."""
+    the effects to try (default: the library). ``workers``: processes that share each
+    calibration's Jacobian columns (compare.forked; the result does not depend on it)."""
     from compare.fit.adequacy import base_adequacy, extrapolation_warnings
     from compare.residuals import diagnose
 
@@ -302,7 +305,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
                          f"use some of {', '.join(LIBRARY)}")
     say = progress or (lambda _m: None)
     prep = calibrate_base(path, spec, fit_fraction, nodes, grid_s, progress, fem_level,
-                          base_extra, blocks, criteria)
+                          base_extra, blocks, criteria, workers)
     run, channels, inputs, measured = prep.run, prep.channels, prep.inputs, prep.measured
     cal, base = prep.cal, prep.base
     say("reading the effects' signatures in the raw samples")
