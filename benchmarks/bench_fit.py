@@ -77,7 +77,8 @@ def main(argv: list[str] | None = None) -> None:
         t_one = time.perf_counter() - t
         same = _same_report(folder / "fit" / "report.json", folder / "fit-serial" / "report.json")
         serial = (f"; one process {t_one:.1f} s, {t_one / t_fit:.2f}x the time with {workers} "
-                  f"(reports {'the same' if same else 'DIFFER'})")
+                  f"(run second, on this process's warm caches: a lower bound; reports "
+                  f"{'the same' if same else 'DIFFER'})")
     named = [s.label for s in rep.selection.steps]
     print(f"{run}: rows {len(bench.time_s)}, {bench.duration_s / 3600:.1f} h"
           + ("" if args.run else f"; synth (FEM, untimed) {t_synth:.1f} s"))
