@@ -443,33 +443,33 @@ class ThermalSystem:
         return self._cache[key]
 
     def prepare_modes(self, dts_s: np.ndarray, speeds_rpm: np.ndarray) -> None:
-        """:meth:`modes` for every pair of step [s] and speed [rpm] at once, into the same
-        cache (nothing for a temperature-dependent network, which has no modes): per step,
-        the matrices, their condensation and the eigenproblems of all speeds go to numpy
-        as stacks, so a new set of conductances costs one call per step, not one per speed.
-        The numbers are those of :meth:`modes`: each stacked slice runs the same LAPACK and
-        BLAS routine on the same values (tests/test_lumped_network.py)."""
+        """:meth:`modes` for a sequence of steps [s] and speeds [rpm] at once, into the same
+        cache (nothing for a temperature-dependent network, which has no modes). The
+        matrices, their condensation and the eigenproblems of all new speeds go to numpy as
+        stacks, so a new set of conductances costs a few calls, not a few per speed. The
+        numbers are those of :meth:`modes` called along the sequence: each stacked slice
+        runs the same LAPACK and BLAS routine on the same values, and each cache entry gets
+        the step it is first asked with (tests/test_lumped_network.py)."""
         if self.temperature_dependent:
             return
-        dts_s, speeds_rpm = np.asarray(dts_s, dtype=float), np.asarray(speeds_rpm, dtype=float)
-        for dt in np.unique(dts_s):
-            self._prepare_modes(float(dt), speeds_rpm[dts_s == dt])
-
-    def _prepare_modes(self, dt_s: float, speeds_rpm: np.ndarray) -> None:
-        dt_key = round(float(dt_s), 9)
-        todo = [n for n in dict.fromkeys(float(v) for v in speeds_rpm)
-                if ("modes", dt_key, n) not in self._cache]
+        todo: dict[tuple, float] = {}  # cache key -> the step it is first asked with
+        for dt, n in zip(np.asarray(dts_s, dtype=float).tolist(),
+                         np.asarray(speeds_rpm, dtype=float).tolist(), strict=True):
+            key = ("modes", round(dt, 9), n)
+            if key not in todo and key not in self._cache:
+                todo[key] = dt
         if len(todo) < 2:
             return
+        speeds = list(dict.fromkeys(key[2] for key in todo))
         st = self._stamps()
         nf = st.K0.shape[0]
-        K = np.repeat(st.K0[None], len(todo), axis=0)
-        B = np.repeat(st.B0[None], len(todo), axis=0)
+        K = np.repeat(st.K0[None], len(speeds), axis=0)
+        B = np.repeat(st.B0[None], len(speeds), axis=0)
         if st.varying:
-            g = np.array([[conductance_at(G, n) for G in st.varying] for n in todo])
-            for k in range(len(todo)):  # as _full: one sparse product per speed
-                K[k] += (st.Kv @ g[k]).reshape(nf, nf)
-                B[k] += (st.Bv @ g[k]).reshape(B.shape[1:])
+            for k, n in enumerate(speeds):  # as _full: one sparse product per speed
+                g = np.array([conductance_at(G, n) for G in st.varying])
+                K[k] += (st.Kv @ g).reshape(nf, nf)
+                B[k] += (st.Bv @ g).reshape(B.shape[1:])
         s_, j = self.state, self.junction
         if len(j):
             Kjj = K[:, j][:, :, j]
@@ -478,23 +478,23 @@ class ThermalSystem:
             Ksj = K[:, s_][:, :, j]
             K = K[:, s_][:, :, s_] + Ksj @ R
             B = B[:, s_] - Ksj @ S
-        sym = np.all(np.abs(K - K.transpose(0, 2, 1)) <= 1e-12 * np.abs(K.transpose(0, 2, 1)),
-                     axis=(1, 2))
+        KT = K.transpose(0, 2, 1)
+        sym = np.all(np.abs(K - KT) <= 1e-12 * np.abs(KT), axis=(1, 2))
         sc = 1.0 / np.sqrt(self.C)
+        eig = {}
+        if sym.any():
+            lam, V = np.linalg.eigh(sc[None, :, None] * K[sym] * sc[None, None, :])
+            eig = {speeds[k]: (lam[i], V[i], B[k]) for i, k in enumerate(np.flatnonzero(sym))}
         if len(self._cache) > 256:
             self._cache.clear()
-        for k in np.flatnonzero(~sym):
-            self._cache[("modes", dt_key, todo[k])] = None
-        if not sym.any():
-            return
-        lam, V = np.linalg.eigh(sc[None, :, None] * K[sym] * sc[None, None, :])
-        g = -np.expm1(-lam * dt_s) / lam
-        Vt = V.transpose(0, 2, 1)
-        Bm = (Vt * sc[None, None, :]) @ B[sym] * g[:, :, None]
-        a = np.exp(-lam * dt_s)
-        for i, k in enumerate(np.flatnonzero(sym)):
-            self._cache[("modes", dt_key, todo[k])] = (
-                a[i], Bm[i], Vt[i] * (1.0 / sc)[None, :], sc[:, None] * V[i])
+        for key, dt in todo.items():  # the rest as modes() writes it, per step
+            if key[2] not in eig:
+                self._cache[key] = None
+                continue
+            lam_i, V_i, B_i = eig[key[2]]
+            g_i = -np.expm1(-lam_i * dt) / lam_i
+            self._cache[key] = (np.exp(-lam_i * dt), (V_i.T * sc[None, :]) @ B_i * g_i[:, None],
+                                V_i.T * (1.0 / sc)[None, :], sc[:, None] * V_i)
 
     def discretize(self, dt_s: float, speed_rpm: float, q: np.ndarray | None = None,
                    integrals: bool = False) -> tuple[np.ndarray, ...]:

@@ -211,18 +211,20 @@ def test_the_stamps_of_a_fine_network_hold_four_entries_per_varying_conductance(
 
 @pytest.mark.parametrize("nodes, symmetric", [(5, True), (11, True), (11, False)])
 def test_modes_prepared_for_many_speeds_are_those_of_one_speed(nodes, symmetric):
-    """A fit's simulation asks for the modes at every speed level of a run at once
-    (prepare_modes: stacked matrices, one batched eigenproblem); they must be the modes the
-    one-speed path gives, bit for bit, since a fit's result must not depend on which path
-    filled the cache. A K that is not symmetric (made so here by one entry) has no modes:
-    None on both paths."""
+    """A fit's simulation asks for the modes along a run's steps and speed levels at once
+    (prepare_modes: stacked matrices, one batched eigenproblem); they must be the modes
+    that modes() gives along the same sequence, bit for bit, since a fit's result must not
+    depend on which path filled the cache. Steps that differ below the cache key's 1e-9 s
+    (a grid on a time-of-day clock) share an entry made with the step first asked for. A K
+    that is not symmetric (made so here by one entry) has no modes: None on both paths."""
     from dataclasses import replace
 
     from lumped.build import build_network
     from spindle.spec_reader import load_spec
 
     spec = load_spec("spl2782")
-    speeds = [0.0, 120.0, 1234.5, 3000.0, 4300.0, 9000.0]
+    speeds = [3000.0, 0.0, 120.0, 1234.5, 3000.0, 4300.0, 9000.0, 120.0, 4300.0]
+    dts = [60.0 + 1e-11, 60.0, 60.0, 0.75, 60.0 - 1e-11, 60.0, 59.25, 60.0 + 2e-11, 60.0]
     systems = [build_network(spec, nodes).network.assemble() for _ in range(2)]
     for sys_ in systems:
         if not symmetric:
@@ -231,10 +233,15 @@ def test_modes_prepared_for_many_speeds_are_those_of_one_speed(nodes, symmetric)
             K0[0, 1] *= 1.5
             sys_._stamp = replace(st, K0=K0)
     batched, single = systems
-    batched.prepare_modes(np.full(len(speeds), 60.0), np.array(speeds))
-    for n in speeds:
-        got = batched._cache[("modes", 60.0, n)]
-        want = single.modes(60.0, n)
+    batched.prepare_modes(np.array(dts), np.array(speeds))
+    for dt, n in zip(dts, speeds, strict=True):
+        got = batched._cache[("modes", round(dt, 9), n)]
+        want = single.modes(dt, n)
         assert (got is None) == (want is None) == (not symmetric)
         for g, w in zip(got or (), want or (), strict=True):
             np.testing.assert_array_equal(g, w)
+    # the entry of 3000 rpm at 60 s was made with the step asked first, 60 + 1e-11 s
+    first = build_network(spec, nodes).network.assemble()
+    if symmetric:
+        np.testing.assert_array_equal(batched._cache[("modes", 60.0, 3000.0)][0],
+                                      first.modes(60.0 + 1e-11, 3000.0)[0])
