@@ -437,10 +437,16 @@ class ThermalSystem:
             else:
                 s = 1.0 / np.sqrt(self.C)
                 lam, V = np.linalg.eigh(s[:, None] * K * s[None, :])
-                g = -np.expm1(-lam * dt_s) / lam
-                self._cache[key] = (np.exp(-lam * dt_s), (V.T * s[None, :]) @ B * g[:, None],
-                                    V.T * (1.0 / s)[None, :], s[:, None] * V)
+                self._cache[key] = self._modal_form(lam, V, B, dt_s)
         return self._cache[key]
+
+    def _modal_form(self, lam: np.ndarray, V: np.ndarray, B: np.ndarray, dt_s: float) -> tuple:
+        """(a, Bm, to_modal, from_modal) of :meth:`modes` from the eigenpairs (lam, V) of
+        C^-1/2 K C^-1/2, the condensed B and the step dt_s [s]."""
+        s = 1.0 / np.sqrt(self.C)
+        g = -np.expm1(-lam * dt_s) / lam
+        return (np.exp(-lam * dt_s), (V.T * s[None, :]) @ B * g[:, None],
+                V.T * (1.0 / s)[None, :], s[:, None] * V)
 
     def prepare_modes(self, dts_s: np.ndarray, speeds_rpm: np.ndarray) -> None:
         """:meth:`modes` for a sequence of steps [s] and speeds [rpm] at once, into the same
@@ -461,15 +467,8 @@ class ThermalSystem:
         if len(todo) < 2:
             return
         speeds = list(dict.fromkeys(key[2] for key in todo))
-        st = self._stamps()
-        nf = st.K0.shape[0]
-        K = np.repeat(st.K0[None], len(speeds), axis=0)
-        B = np.repeat(st.B0[None], len(speeds), axis=0)
-        if st.varying:
-            for k, n in enumerate(speeds):  # as _full: one sparse product per speed
-                g = np.array([conductance_at(G, n) for G in st.varying])
-                K[k] += (st.Kv @ g).reshape(nf, nf)
-                B[k] += (st.Bv @ g).reshape(B.shape[1:])
+        full = [self._full(n, None) for n in speeds]
+        K, B = np.array([f[0] for f in full]), np.array([f[1] for f in full])
         s_, j = self.state, self.junction
         if len(j):
             Kjj = K[:, j][:, :, j]
@@ -488,13 +487,8 @@ class ThermalSystem:
         if len(self._cache) > 256:
             self._cache.clear()
         for key, dt in todo.items():  # the rest as modes() writes it, per step
-            if key[2] not in eig:
-                self._cache[key] = None
-                continue
-            lam_i, V_i, B_i = eig[key[2]]
-            g_i = -np.expm1(-lam_i * dt) / lam_i
-            self._cache[key] = (np.exp(-lam_i * dt), (V_i.T * sc[None, :]) @ B_i * g_i[:, None],
-                                V_i.T * (1.0 / sc)[None, :], sc[:, None] * V_i)
+            self._cache[key] = (self._modal_form(*eig[key[2]], dt) if key[2] in eig
+                                else None)
 
     def discretize(self, dt_s: float, speed_rpm: float, q: np.ndarray | None = None,
                    integrals: bool = False) -> tuple[np.ndarray, ...]:

@@ -356,7 +356,10 @@ class GreyBox:
         Y[0] = readout @ x
         dts = np.diff(inp.grid_s)
         n_K = self.conductance_speeds()
-        sys.prepare_modes(dts, n_K)
+        # the modes the loop below asks for, at the start of each run of equal (dt, speed)
+        first = np.flatnonzero(np.r_[True, (dts[1:] != dts[:-1]) | (n_K[1:] != n_K[:-1])]
+                               )[:len(dts)]
+        sys.prepare_modes(dts[first], n_K[first])
         k = 0
         while k < n_int:  # runs of equal (dt, speed): one modal recursion each
             j = k + 1
