@@ -2,14 +2,15 @@
 
     python benchmarks/bench_fit.py [--effect fixture_expansion] [--seed 1] [--keep DIR]
     python benchmarks/bench_fit.py --run tests/data/peer-runs/bench-runs/dev-06.csv
-    python benchmarks/bench_fit.py --run ../shared/bench-runs-2/dev2-01.csv --serial-too
+    python benchmarks/bench_fit.py --run ../shared/bench-runs-2/dev2-01.csv --workers 2 --serial-too
 
 Makes a synthetic run with ``spindle-verify synth`` (FEM level 1, not timed), or takes
 ``--run``, a bench export such as a peer's development run; then times reading it, one
 grey-box simulation, and the whole ``fit`` (calibration, forward selection over the library,
 cross-validation, diagnostics, report.json and report.html), with ``--workers`` processes as
-``spindle-verify fit`` runs (default min(2, CPUs)); ``--serial-too`` times it again with one
-process and prints the ratio (the two reports must be the same: compare/forked.py). Target
+``spindle-verify fit`` runs (default 1); with ``--workers 2 --serial-too`` it times the fit
+again with one process, prints the ratio and says whether the two reports agree (not on
+every run: docs/fit.md "Options"). Target
 (issues 6, 13, 32): <= 60 s on 2 cores for a 16 h run.
 """
 
@@ -31,15 +32,14 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--keep", help="keep the run and the report in this folder")
     ap.add_argument("--run", type=Path, help="time this bench export instead of a synthetic run")
-    ap.add_argument("--workers", type=int, default=None,
-                    help="processes per fit (default min(2, CPUs), as spindle-verify fit)")
+    ap.add_argument("--workers", type=int, default=1,
+                    help="processes per fit (default 1, as spindle-verify fit)")
     ap.add_argument("--serial-too", action="store_true",
                     help="time the fit with one process too and print the ratio")
     args = ap.parse_args(argv)
     if args.run is not None:
         require_files([args.run], "--run")
 
-    from compare.executor import default_workers
     from compare.fit.greybox import GreyBox
     from compare.fit.report import save_report
     from compare.fit.run import greybox_inputs, run_fit
@@ -64,7 +64,7 @@ def main(argv: list[str] | None = None) -> None:
     for _ in range(10):
         gb.simulate({"h_air": 1.01})
     t_sim = (time.perf_counter() - t) / 10
-    workers = args.workers or default_workers()
+    workers = args.workers
     t = time.perf_counter()
     rep = run_fit(run, spec, workers=workers)
     save_report(rep, folder / "fit")

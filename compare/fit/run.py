@@ -292,7 +292,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     ``fit_fraction``). ``alpha``, ``min_gain`` (the cross-validated gain asked, a share) and
     ``cv_blocks`` set the criteria of those names (compare.fit.criteria); ``candidates``:
     the effects to try (default: the library). ``workers``: processes that share each
-    calibration's Jacobian columns (compare.forked; the result does not depend on it)."""
+    calibration's Jacobian columns (compare.forked; default 1: on some runs more
+    processes move the parameters' late digits, docs/fit.md "Options")."""
     from compare.fit.adequacy import base_adequacy, extrapolation_warnings
     from compare.residuals import diagnose
 
