@@ -70,10 +70,10 @@ def main(argv: list[str] | None = None) -> None:
 
     from compare.fit.greybox import GreyBox
     from compare.fit.params import default_theta
-    from compare.fit.run import greybox_inputs
     from compare.synth.bench import reference_run, synth
     from compare.synth.mismatch import Mismatch
     from spindle.bench import read_bench
+    from spindle.bench_inputs import interval_inputs
     from spindle.cycles import drawn_cycle
     from spindle.drive import cycle_load_case, drive_for
     from spindle.spec_reader import load_spec
@@ -100,7 +100,7 @@ def main(argv: list[str] | None = None) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         run = Path(tmp) / "clean.csv"
         synth(spec, "random", "clean", args.seed, run, level=0)
-        inputs = greybox_inputs(read_bench(run), 60.0)
+        inputs = interval_inputs(read_bench(run), 60.0)
     gb = GreyBox(spec, drive, inputs, 11)
     theta = default_theta(gb.parameters())
     cool_gb = gb.variant(("coolant_dynamics",))

@@ -42,9 +42,10 @@ def main(argv: list[str] | None = None) -> None:
 
     from compare.fit.greybox import GreyBox
     from compare.fit.report import save_report
-    from compare.fit.run import greybox_inputs, run_fit
+    from compare.fit.run import run_fit
     from compare.synth.bench import synth
     from spindle.bench import read_bench
+    from spindle.bench_inputs import interval_inputs
     from spindle.drive import drive_for
     from spindle.spec_reader import load_spec
 
@@ -58,7 +59,7 @@ def main(argv: list[str] | None = None) -> None:
     t = time.perf_counter()
     bench = read_bench(run)
     t_read = time.perf_counter() - t
-    gb = GreyBox(spec, drive_for(spec), greybox_inputs(bench))
+    gb = GreyBox(spec, drive_for(spec), interval_inputs(bench))
     gb.simulate({})
     t = time.perf_counter()
     for _ in range(10):

@@ -145,6 +145,29 @@ def acf(r: Any, nlags: int) -> np.ndarray:
     return rho
 
 
+def effective_samples(res: dict[str, np.ndarray]) -> float:
+    """Sum over channels of n / tau_int, tau_int = 1 + 2 sum_k rho_k the integrated
+    autocorrelation time of the residual (Sokal's self-consistent window M >= 5 tau), so that
+    serially correlated residuals count as the independent samples they are worth."""
+    total = 0.0
+    for r in res.values():
+        n = len(r)
+        if n < 4:
+            total += n
+            continue
+        rc = r - r.mean()
+        f = np.fft.rfft(rc, 2 * n)
+        ac = np.fft.irfft(f * np.conj(f))[:n]
+        rho = ac / ac[0] if ac[0] > 0 else np.zeros(n)
+        tau = 1.0
+        for m in range(1, n // 2):
+            tau += 2 * rho[m]
+            if m >= 5 * tau:
+                break
+        total += n / max(tau, 1.0)
+    return total
+
+
 def acf_band(n: int, alpha: float = 0.05) -> float:
     """Half-width of the pointwise white-noise band of the ACF (and CCF), z_(1-alpha/2)/sqrt(n):
     1.96/sqrt(n) at alpha = 5 %. ``n``: number of valid samples. Dimensionless."""

@@ -1,11 +1,11 @@
 """Grey-box inputs of a shipped cycle, for the tests that drive the grey box without a bench
-run (a bench run's inputs come from compare.fit.run.greybox_inputs)."""
+run (a bench run's inputs come from spindle.bench_inputs.interval_inputs)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from compare.fit.greybox import Inputs
+from spindle.bench_inputs import Inputs
 
 
 def inputs_from_cycle(cycle, grid_s: np.ndarray) -> Inputs:

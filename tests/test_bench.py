@@ -314,9 +314,9 @@ def test_a_run_whose_clock_starts_late_gets_the_grid_of_the_shifted_run(tmp_path
     late_run = read_bench(write(tmp_path, late, "late.csv"))
     np.testing.assert_allclose(bench_grid(late_run), bench_grid(early_run) + shift, rtol=0,
                                atol=1e-9)
-    from compare.fit.run import greybox_inputs
+    from spindle.bench_inputs import interval_inputs
 
-    a, b = greybox_inputs(early_run), greybox_inputs(late_run)
+    a, b = interval_inputs(early_run), interval_inputs(late_run)
     for name in ("speed_rpm", "power_kW", "load_torque_Nm", "T_env_K", "T_coolant_K"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
 

@@ -137,13 +137,14 @@ def _write(tmp_path_factory, name: str, content: str | bytes) -> Path:
 def _ingest_bench(path: Path) -> None:
     """What ``fit`` does with a bench file before calibrating."""
     from compare.fit.criteria import Criteria
-    from compare.fit.run import _measured, greybox_inputs
+    from compare.fit.run import _measured
     from spindle.bench import check_against_spec, read_bench
+    from spindle.bench_inputs import interval_inputs
     from spindle.spec_reader import load_spec
 
     run = read_bench(path)
     channels = check_against_spec(run, load_spec("spl2782"))
-    inputs = greybox_inputs(run, 60.0)
+    inputs = interval_inputs(run, 60.0)
     _measured(run, channels, inputs.grid_s, 0.6, 1, Criteria())
     assert np.all(np.isfinite(inputs.speed_rpm)) and np.all(np.isfinite(inputs.T_env_K))
 

@@ -93,8 +93,9 @@ def test_the_calibrated_model_places_the_switch_where_the_spec_model_cannot():
     on this project's mismatched FEM runs the second placement cut the error from 206-495 s
     to 26-123 s (docs/fit-history.md, *Input timing*)."""
     from compare.fit.criteria import Criteria
-    from compare.fit.run import _measured, _place_gap_switches, greybox_inputs
+    from compare.fit.run import _measured, _place_gap_switches
     from spindle.bench import BenchRun
+    from spindle.bench_inputs import interval_inputs
     from spindle.units import ZERO_C_K
 
     spec, drive = load_spec("spl2782"), DRIVES["spl2782"]
@@ -116,7 +117,7 @@ def test_the_calibrated_model_places_the_switch_where_the_spec_model_cannot():
             **{f"{c}_C": y[c][rows] - ZERO_C_K for c in ("T1", "T2", "T_stator")},
             "P1_um": (y["P1"][rows] - y["P1"][0]) * 1e6}
     run = BenchRun(None, {}, t, cols, {}, [], ["T1", "T2", "T_stator", "P1"], float(t[-1]))
-    inputs = greybox_inputs(run)
+    inputs = interval_inputs(run)
     channels = ["T1", "T2", "T_stator", "P1"]
     measured = _measured(run, channels, inputs.grid_s, 0.6, 1, Criteria())
 

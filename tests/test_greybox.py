@@ -8,12 +8,13 @@ import numpy as np
 import pytest
 
 from compare.cli import main
-from compare.fit.calibrate import Calibrator, Measured, resample
+from compare.fit.calibrate import Calibrator, Measured
 from compare.fit.criteria import Criteria
 from compare.fit.effects import LIBRARY, label
 from compare.fit.greybox import GreyBox
 from lumped import build
 from spindle.bench import read_bench
+from spindle.bench_inputs import resample
 from spindle.cycle_files import load_cycle
 from spindle.drive import DRIVES, cycle_load_case
 from spindle.spec_reader import load_spec

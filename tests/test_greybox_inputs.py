@@ -1,4 +1,4 @@
-"""The grey box's per-interval inputs from a bench run (compare.fit.run.greybox_inputs): the
+"""The grey box's per-interval inputs from a bench run (spindle.bench_inputs.interval_inputs): the
 losses an interval takes from the power balance are the mean over its samples of
 P_el - M omega, also where the speed ramps inside the interval (issue 32)."""
 
@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from compare.fit.run import greybox_inputs
 from spindle.bench import BenchRun
+from spindle.bench_inputs import interval_inputs
 
 
 def _ramp_run(losses_W: float = 900.0, torque_Nm: float = 42.0) -> BenchRun:
@@ -30,7 +30,7 @@ def _ramp_run(losses_W: float = 900.0, torque_Nm: float = 42.0) -> BenchRun:
 
 
 def test_losses_are_the_samples_mean_through_a_ramp_inside_a_cell():
-    inp = greybox_inputs(_ramp_run(), 60.0)
+    inp = interval_inputs(_ramp_run(), 60.0)
     omega = 2.0 * math.pi * inp.speed_rpm / 60.0  # rad/s of each interval's held speed
     losses = inp.power_kW * 1e3 - inp.load_torque_Nm * omega
     # every interval, the ramp's included, gives the samples' 900 W to round-off
@@ -48,7 +48,7 @@ def test_a_run_without_torque_has_none():
     run = _ramp_run()
     run = replace(run, columns={**run.columns, "load_torque_Nm": np.zeros_like(run.time_s)},
                   load_torque_measured=False)
-    assert np.all(greybox_inputs(run, 60.0).load_torque_Nm == 0.0)
+    assert np.all(interval_inputs(run, 60.0).load_torque_Nm == 0.0)
 
 
 def test_an_on_change_log_averages_over_time_not_over_samples():

@@ -86,8 +86,15 @@ def test_fit_report_renders(tmp_path):
     assert main(["synth", "--effect", "fixture_expansion", "--seed", "2", "--level", "0",
                  "--out", str(run)]) == 0
     out = tmp_path / "fit"
-    assert main(["fit", str(run), "--out", str(out), "--quiet", "--cv-blocks", "0",
-                 "--candidates", "fixture_expansion", "centrifugal_shortening"]) == 0
+    own = tmp_path / "mine.toml"  # criteria of one's own reach the report; options go over them
+    own.write_text("cv_blocks = 0\nalpha = 0.05\nmaterial_peak = 0.6\n")
+    assert main(["fit", str(run), "--out", str(out), "--quiet", "--criteria", str(own),
+                 "--alpha", "0.02", "--candidates", "fixture_expansion",
+                 "centrifugal_shortening"]) == 0
+    doc = json.loads((out / "report.json").read_text())
+    used = {c["name"]: c["value"] for c in doc["criteria"]}
+    assert (used["cv_blocks"], used["alpha"], used["material_peak"]) == (0, 0.02, 0.6)
+    assert doc["alpha"] == 0.02 and doc["cross_validation"] == {}
     # the fit report's two pictures: channels and residuals (compare.fit.report._pictures)
     text = _check(out / "report.html", tmp_path, min_images=2)
     assert "Signature tests" in text and "Candidates and criteria" in text

@@ -9,7 +9,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from scipy import stats
+from scipy import signal, stats
 
 from compare.residuals import (
     Diagnostics,
@@ -20,6 +20,7 @@ from compare.residuals import (
     cross_correlation,
     cumulated_periodogram,
     diagnose,
+    effective_samples,
     ks_constant,
     ljung_box,
     peak_lag,
@@ -304,3 +305,18 @@ def test_plot_helpers_draw_and_return_the_axes():
     assert all(len(ax.lines) >= 3 for ax in axes)
     assert axes[1].get_xlabel() == "frequency [Hz]"
     plt.close(fig)
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.5, 0.9])
+def test_effective_samples_of_ar1_is_n_over_its_integrated_time(phi):
+    """An AR(1) series x_t = phi x_(t-1) + e_t has rho_k = phi^k, so tau_int = 1 + 2 sum_k
+    phi^k = (1 + phi) / (1 - phi) (Sokal's definition; Madsen 2008 ch. 5): n_eff = n / tau.
+    The tolerance is the estimator's scatter at n = 200,000: the sd of tau's estimate is about
+    tau sqrt(2 (2M + 1) / n) with the window M ~ 5 tau (Sokal), 4 % at phi = 0.9; 4 sd."""
+    rng = np.random.default_rng(7)
+    n = 200_000
+    x = signal.lfilter([1.0], [1.0, -phi], rng.standard_normal(n))
+    tau = (1 + phi) / (1 - phi)
+    sd_rel = math.sqrt(2 * (2 * 5 * tau + 1) / n)
+    got = effective_samples({"a": x, "b": x[: n // 2]})  # channels add
+    assert got == pytest.approx(1.5 * n / tau, rel=4 * sd_rel)

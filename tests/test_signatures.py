@@ -398,8 +398,8 @@ def test_power_signatures_on_the_peer_runs():
     calibrated: a second each)."""
     from compare.fit.greybox import GreyBox
     from compare.fit.params import DEFAULT_BASE_EXTRA, default_theta
-    from compare.fit.run import greybox_inputs
     from spindle.bench import read_bench
+    from spindle.bench_inputs import interval_inputs
     from spindle.drive import drive_for
     from spindle.spec_reader import load_spec
 
@@ -408,7 +408,7 @@ def test_power_signatures_on_the_peer_runs():
 
     def tests_of(label: str) -> dict:
         run = read_bench(PEER_RUNS / f"{label}.csv")
-        gb = GreyBox(spec, drive, greybox_inputs(run), base_extra=DEFAULT_BASE_EXTRA)
+        gb = GreyBox(spec, drive, interval_inputs(run), base_extra=DEFAULT_BASE_EXTRA)
         return _power_tests(run, gb, default_theta(gb.parameters()))
 
     truth = json.loads((PEER_RUNS / "truth.json").read_text(encoding="utf-8"))
@@ -430,7 +430,7 @@ def test_power_signatures_on_the_peer_runs():
 # ------------------------------------------------------------- heat bookkeeping in the grey box
 @pytest.fixture(scope="module")
 def box():
-    from compare.fit.greybox import Inputs
+    from spindle.bench_inputs import Inputs
     from spindle.drive import DRIVES
     from spindle.spec_reader import load_spec
 

@@ -46,6 +46,7 @@ def _base_extra(names: list[str] | None) -> tuple[str, ...] | None:
 
 @with_progress("fit")
 def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
+    from compare.fit.criteria import Criteria
     from compare.fit.report import save_report, summary_text
     from compare.fit.run import run_fit
     from spindle.outputs import output_dir, safe_name
@@ -53,15 +54,18 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
 
     base_extra = _base_extra(args.base_extra)
     spec = load_spec(args.spec)
+    criteria = Criteria().with_file(args.criteria) if args.criteria else None
+    inputs = [spec.path, args.run, *([args.criteria] if args.criteria else [])]
     default = f"results/{safe_name(spec.name)}/fit-{safe_name(Path(args.run).stem)}"
-    out = out_folder(args.out, default, [spec.path, args.run], force=args.force)
+    out = out_folder(args.out, default, inputs, force=args.force)
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
-                  candidates=args.candidates, min_gain=args.min_gain / 100.0,
+                  candidates=args.candidates,
+                  min_gain=None if args.min_gain is None else args.min_gain / 100.0,
                   progress=progress.say,
                   fem_level=None if args.lumped_only else args.fem_level,
                   base_extra=base_extra, blocks=args.blocks,
-                  cv_blocks=args.cv_blocks, workers=args.workers)
-    with output_dir(out, inputs=[spec.path, args.run], force=args.force) as tmp, progress.pictures():
+                  cv_blocks=args.cv_blocks, criteria=criteria, workers=args.workers)
+    with output_dir(out, inputs=inputs, force=args.force) as tmp, progress.pictures():
         save_report(rep, tmp, pictures=not args.no_pictures)
     progress.done()
     print(summary_text(rep))
@@ -70,10 +74,12 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the command's sub-parser."""
+    from compare.fit.criteria import Criteria
     from compare.fit.effects import LIBRARY
     from compare.fit.params import DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS
 
-    """Add the command's sub-parser."""
+    table = Criteria()
     fp = subparsers.add_parser("fit", help="fit a bench run: calibrate, diagnose the residual, add the "
                         "effects it supports, report the error before and after")
     fp.add_argument("run", metavar="RUN.csv", help="bench export (format: docs/bench.md)")
@@ -85,18 +91,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="windows for selecting effects: cut the run into this many blocks, "
                     "of which about 1 - fit-fraction, spread over the run, validate (default "
                     "1: the fit window is the run's start; docs/fit.md says why)")
-    fp.add_argument("--cv-blocks", type=cv_blocks, default=5,
+    fp.add_argument("--cv-blocks", type=cv_blocks,
                     help="blocked cross-validation of the base and the final model: each of "
                     "this many blocks held out in turn, the model refitted without it and "
-                    "simulated over it (default 5; 0: none)")
-    fp.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
+                    f"simulated over it (default {table.cv_blocks}; 0: none)")
+    fp.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True),
                     help="the level of every test: an effect's likelihood-ratio test, the "
                     "signature tests, the competitor's scan (against the same scan on noise) and the "
-                    "plausible range of the base parameters (default 0.01)")
-    fp.add_argument("--min-gain", type=number(0.0, 100.0), default=25.0,
+                    f"plausible range of the base parameters (default {table.alpha:g})")
+    fp.add_argument("--min-gain", type=number(0.0, 100.0),
                     help="an effect judged by the open-loop fit must remove at least this "
                     "share [%%] of the blocked cross-validated error above the noise floor on "
-                    "its channels (default 25)")
+                    f"its channels (default {100 * table.cv_gain:g})")
+    fp.add_argument("--criteria", metavar="FILE.toml",
+                    help="criteria of your own: a TOML file of name = value lines, with the "
+                    "names, units and types of the table compare/fit/criteria.toml (the report "
+                    "lists the table it ran with); --alpha, --min-gain and --cv-blocks "
+                    "override it")
     fp.add_argument("--fem-level", type=number(0, 4, integer=True), default=0,
                     help="FEM reference level that anchors the model on the run's inputs "
                     "(default 0; docs/fit.md)")

@@ -9,11 +9,11 @@
   tolerance. Parameters are fitted on a log scale (factors) or scaled to their bounds.
 - **Confidence intervals** from the Jacobian: cov = s^2 (J^T J)^-1 with s^2 the residual
   variance, inflated by n / n_eff for the residual's autocorrelation (n_eff = n / tau_int with
-  tau_int the integrated autocorrelation time, see :func:`effective_samples`), 95 % intervals;
-  correlations; a parameter is
-  reported not identifiable when its interval spans more than its bounds' range (a direction
-  the information matrix does not determine counts with an eigenvalue of 1e-12 of the largest:
-  it takes the parameters that share it out of their bounds, and leaves the others alone).
+  tau_int the integrated autocorrelation time: compare.residuals.effective_samples), 95 %
+  intervals; correlations; a parameter is reported not identifiable when its interval spans
+  more than its bounds' range (a direction the information matrix does not determine counts
+  with an eigenvalue of 1e-12 of the largest: it takes the parameters that share it out of
+  their bounds, and leaves the others alone).
 - **Priors** (when :meth:`Calibrator.set_prior` is called, as ``fit`` does): each base
   parameter is Gaussian around the spec's value on its fitted scale, with the width
   ``Param.prior_sd``; the data term is weighted by n_eff / n against them.
@@ -38,6 +38,7 @@ from compare.fit.effects import LIBRARY, effect_of
 from compare.fit.greybox import GreyBox
 from compare.fit.params import BASE_PARAMS, EXTRA_BASE_PARAMS, Param
 from compare.forked import ForkedColumns
+from compare.residuals import effective_samples
 from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
 
 #: the paper's tolerance per bench channel [K; m for P1] (spindle.tolerances)
@@ -115,24 +116,6 @@ class Measured:
         if window == "validation":
             return ok & ~self._fit_points
         return ok
-
-
-def resample(t_s: np.ndarray, y: np.ndarray, grid_s: np.ndarray, gap_steps: float
-             ) -> np.ndarray:
-    """Values at the grid points: linear between valid samples; NaN outside the samples and
-    inside gaps longer than ``gap_steps`` grid steps (Criteria.gap_min_steps)."""
-    ok = ~np.isnan(y)
-    t, v = t_s[ok], y[ok]
-    out = np.full(len(grid_s), np.nan)
-    if len(t) < 2:
-        return out
-    inside = (grid_s >= t[0]) & (grid_s <= t[-1])
-    out[inside] = np.interp(grid_s[inside], t, v)
-    step = np.median(np.diff(grid_s))
-    k = np.clip(np.searchsorted(t, grid_s), 1, len(t) - 1)
-    gap = (t[k] - t[k - 1]) > gap_steps * step
-    out[gap & inside] = np.nan
-    return out
 
 
 # ---------------------------------------------------------------------- scaling of parameters
@@ -358,29 +341,6 @@ def over_tolerance(window_errors: Mapping[str, Mapping[str, float]]) -> dict[str
     selection and the report's verdict read."""
     return {c: float(e["rmse_w"]) for c, e in window_errors.items()
             if e.get("n") and e["rmse_w"] > 1.0}
-
-
-def effective_samples(res: dict[str, np.ndarray]) -> float:
-    """Sum over channels of n / tau_int, tau_int = 1 + 2 sum_k rho_k the integrated
-    autocorrelation time of the residual (Sokal's self-consistent window M >= 5 tau), so that
-    serially correlated residuals count as the independent samples they are worth."""
-    total = 0.0
-    for r in res.values():
-        n = len(r)
-        if n < 4:
-            total += n
-            continue
-        rc = r - r.mean()
-        f = np.fft.rfft(rc, 2 * n)
-        ac = np.fft.irfft(f * np.conj(f))[:n]
-        rho = ac / ac[0] if ac[0] > 0 else np.zeros(n)
-        tau = 1.0
-        for m in range(1, n // 2):
-            tau += 2 * rho[m]
-            if m >= 5 * tau:
-                break
-        total += n / max(tau, 1.0)
-    return total
 
 
 def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[str],

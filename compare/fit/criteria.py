@@ -1,260 +1,138 @@
 """Every threshold, window and level the fit's rules use, in one table: :class:`Criteria`.
 
-Each entry has its value, its unit and its reason: a statistical argument, a physical bound,
-a sensor's resolution or a computing budget. ``fit``'s options (``--alpha``, ``--min-gain``,
-``--cv-blocks``) set the entries of the same names, and every rule that reads them reads them
-here; the report lists the table it ran with (:meth:`Criteria.table`) and, for each
-candidate, which named criteria it passed.
+The table is data, compare/fit/criteria.toml: each entry has its value, its unit and its
+reason (a statistical argument, a physical bound, a sensor's resolution or a computing
+budget). ``fit``'s options (``--alpha``, ``--min-gain``, ``--cv-blocks``) set the entries of
+the same names, ``fit --criteria FILE`` any of them (:meth:`Criteria.with_file`), and every
+rule that reads them reads them here; the report lists the table it ran with
+(:meth:`Criteria.table`) and, for each candidate, which named criteria it passed.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+import tomllib
+import typing
+from dataclasses import dataclass, field, fields, is_dataclass, replace
+from importlib.resources import files
+from pathlib import Path
 
 from compare.fit.signatures import OnsetScale
 from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
+from spindle.errors import InputError
+
+TABLE_FILE = "criteria.toml"
 
 
-def _c(value, unit: str, reason: str):
-    return field(default=value, metadata={"unit": unit, "reason": reason})
+def _conform(value, hint, where: tuple[str, str]):
+    """``value`` as read from TOML, checked against the type ``hint`` and converted to it
+    (arrays to tuples, tables to the dataclass, an integer to a float where a float is
+    asked); ``where``: (file, entry) of the error message."""
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if origin is tuple:
+        kinds = [args[0]] * len(value) if Ellipsis in args and isinstance(value, list) else args
+        if not isinstance(value, list) or len(value) != len(kinds):
+            raise InputError(*where, f"is {value!r}, not an array of {len(args)} values"
+                             if Ellipsis not in args else f"is {value!r}, not an array",
+                             "give it as the table in compare/fit/criteria.toml does")
+        return tuple(_conform(v, kind, where) for v, kind in zip(value, kinds, strict=True))
+    if is_dataclass(hint):
+        hints = typing.get_type_hints(hint)
+        if not isinstance(value, dict) or set(value) != set(hints):
+            raise InputError(*where, f"is {value!r}", f"give each of {', '.join(hints)}")
+        return hint(**{k: _conform(value[k], hints[k], where) for k in hints})
+    ok = (isinstance(value, bool) if hint is bool else
+          isinstance(value, int | float) and not isinstance(value, bool)
+          and math.isfinite(value) and (hint is float or isinstance(value, int))
+          if hint in (int, float) else isinstance(value, hint))
+    if not ok:
+        raise InputError(*where, f"is {value!r}, not {'an' if hint is int else 'a'} "
+                         f"{hint.__name__}", "give it as the table in "
+                         "compare/fit/criteria.toml does")
+    return float(value) if hint is float else value
+
+
+def _from_table(cls):
+    """Each annotated entry of ``cls`` becomes a field whose default, unit and reason are the
+    table's; an entry with a value in the code (one shared with another module) keeps it."""
+    table = tomllib.loads(files("compare.fit").joinpath(TABLE_FILE).read_text("utf-8"))
+    hints = typing.get_type_hints(cls)
+    for name, hint in hints.items():
+        entry = table.pop(name)
+        value = getattr(cls, name) if "value" not in entry else _conform(
+            entry["value"], hint, (TABLE_FILE, name))
+        setattr(cls, name, field(default=value, metadata={"unit": entry["unit"],
+                                                           "reason": entry["reason"]}))
+    assert not table, f"{TABLE_FILE}: entries without a field: {sorted(table)}"
+    return cls
 
 
 @dataclass(frozen=True)
+@_from_table
 class Criteria:
-    """The criteria of one fit (module docstring). Frozen: derive another with
-    :meth:`with_options`."""
+    """The criteria of one fit (module docstring; compare/fit/criteria.toml holds each
+    entry's value, unit and reason). Frozen: derive another with :meth:`with_options` or
+    :meth:`with_file`."""
 
-    # ---------------------------------------------------------------- statistics
-    alpha: float = _c(
-        0.01, "-", "the level of every test: an effect's likelihood-ratio test, each "
-        "signature test, the competitor's scan (against its Monte Carlo critical value: "
-        "scan_null_tail) and the plausible range of a base parameter (two-sided). At 1 % per "
-        "test, the about ten candidates of a run give a false one in under 10 % of clean runs "
-        "before the other criteria")
-    material_peak: float = _c(
-        0.5, "tolerances", "an effect (or the competitor) is named only if at its estimate it "
-        "moves one of its channels by half a tolerance at its peak: a smaller term cannot take "
-        "a compensation that meets the tolerances out of them, so naming it helps no user")
-    open_loop_material_change: bool = _c(
-        True, "-", "an effect named by the open loop must also change the fitted model's "
-        "prediction (the effect and the base's re-adjustment together) by material_peak on "
-        "one of its channels: the open loop's only evidence is that prediction, and an effect "
-        "the base re-adjusts around to within half a tolerance changes no compensation built "
-        "on the model. The signature route keeps its own evidence")
-    plausible_base_route: bool = _c(
-        True, "-", "an open-loop effect that does not change the prediction by material_peak "
-        "still changes the model where, without it, the calibrated base needs an implausible "
-        "value (some |prior z| above implausible_z) and, with it, none: the priors say the "
-        "spindle is like its spec within the declared widths, so a base that can imitate the "
-        "effect only outside them does not (the adequacy verdict would otherwise blame the spec "
-        "for it: 'needs implausible values to fit the run')")
-    cv_blocks: int = _c(
-        5, "blocks", "blocked cross-validation: each fifth of the run held out in turn; five "
-        "blocks of a 16 h run are about 3 h, longer than the slowest time constant (the "
-        "housing's, 1-2 h), so a held-out block is not predicted from its neighbours' state")
-    cv_gain: float = _c(
-        0.25, "-", "an effect judged by the open-loop fit (no signature test applies) must "
-        "remove this share of the blocked cross-validated error above the noise floor on its "
-        "channels: a law of the inputs predicts the blocks it was not fitted on. A quarter is "
-        "five times the scatter of the folds' own refits (a few % on a run with nothing to "
-        "find)")
-    held_out_misfit_unexplained: bool = _c(
-        True, "-", "where the final model misses a channel's tolerance on the held-out "
-        "validation window (open-loop RMS above one tolerance), the run is 'unexplained' (with "
-        "nothing named) or says 'something else remains' (beside what was named) even if no "
-        "localized form of the competitor is significant: with sensor noise a tenth of the "
-        "tolerance, an RMS of one tolerance on held-out data is not noise (the test's "
-        "false-alarm rate is nil under a correct model), whatever the library took up. 'Base "
-        "inadequate' said the same and pointed at the spec alone; the report still gives the "
-        "adequacy verdict on the spec. False: such runs end 'nothing named, base inadequate' "
-        "or name their effects alone")
-    distinct_among_alternatives: bool = _c(
-        True, "-", "the distinct criterion weighs a candidate against the other candidates "
-        "on its channels that are alternatives to it, not against complements: two candidates "
-        "each of which, as the amplitude of its fitted shift, adds a significant gain (at "
-        "alpha, one degree of freedom) to the other's (jointly with the base's step) explain "
-        "different parts of the run, so naming the larger is no guess between them; forward "
-        "selection then judges the other against the model that holds it. False: every other "
-        "candidate on a shared channel is a rival")
-    open_loop_adequate_model: bool = _c(
-        True, "-", "an effect named by the open loop is withdrawn where the final model, with "
-        "it, still misses the tolerance of one of the effect's own channels on the held-out "
-        "validation window (as for held_out_misfit_unexplained): the open loop's evidence is "
-        "the model's likelihood, and the likelihood-ratio test holds only under a model that "
-        "explains the data; where it does not, any candidate that moves the channel gains "
-        "from what is missing, so the cause is a guess. A misfit on a channel the effect does "
-        "not act on leaves its test as it was. A step judged on a model holding a withdrawn "
-        "one goes with it; a signature's evidence is the raw samples' and stays")
-    competitor_step_s: float = _c(
-        1800.0, "s", "the time grid of the competitor's windows: half an hour resolves an "
-        "event of a few hours, and a 16 h run gives 32 blocks, 528 windows")
-    scan_null_tail: int = _c(
-        10, "draws", "the verdict's scan is significant above the critical value of the same "
-        "scan on white noise (a Monte Carlo test of its largest statistic, which, unlike a "
-        "Bonferroni bound over its thousands of overlapping windows, knows they are nearly "
-        "the same test): the 10th largest maximum of 10 / alpha - 1 draws (999 at 1 %), so "
-        "the test's level is alpha exactly (its Monte Carlo scatter over seeds and its value "
-        "against the Bonferroni bound: docs/figures/scan-null.json)")
-    competitor_masses: tuple[str, ...] = _c(
-        ("stator", "rotor", "front_bearing", "rear_bearing", "housing", "cooling_sleeve"),
-        "part roles", "where the competitor may put an unexplained heat: one mass of each "
-        "role a motor spindle's heat passes through (the first of the role found)")
-
-    speed_bin_rel: float = _c(
-        0.05, "-", "the grey box evaluates its speed-dependent conductances (films, bearings) "
-        "at the interval's speed rounded to a geometric grid of 5 % steps: the films follow "
-        "n^0.5-0.8, so they move by at most 4 %, a tenth of their prior sd; a ramp logged on "
-        "change then needs a few dozen sets of modes, not one per interval. The heat sources "
-        "take the exact speed; a feedback whose heat enters the matrices (a preload's) takes "
-        "its heat on the same grid, which moves its term by at most 2.5 %")
-
-    # ---------------------------------------------------------------- base model
-    at_bound_rel: float = _c(
-        1e-3, "of the range", "a calibrated value within this share of its range from a "
-        "bound is reported as on the bound")
-    missing_path_W_K: float = _c(
-        1.0, "W/K", "a conductance the spec lacks (G_seat_W_K) is reported as needed above "
-        "1 W/K: that moves a bearing ring carrying 30-60 W of friction by several kelvin, far "
-        "above the sensors' resolution")
-    optimizer_tol: float = _c(
-        1e-6, "-", "least_squares' ftol and xtol (the relative change of the cost and of the "
-        "scaled parameters at which a calibration stops): a computing budget. 1e-8 was "
-        "measured on the main and held-out sets: 9 % more time, no verdict better, and the "
-        "validation RMS as sensitive to round-off as at 1e-6, since it moves along directions "
-        "the run does not determine (docs/fit-history.md, 2026-11-28)")
-    refit_nfev: int = _c(
-        20, "evaluations", "computing budget of the refit of the candidate that joins the "
-        "model, which starts from its Gauss-Newton fit and converges in a few iterations")
-
-    # ---------------------------------------------------------------- input timing
-    gap_min_steps: float = _c(
-        2.0, "grid steps", "a stretch without any logged row longer than two grid steps is a "
-        "logging gap (a bench logging on change writes at least a heartbeat per step)")
-    gap_judge_s: float = _c(
-        3600.0, "s", "an operating change inside a logging gap is placed where the model fits "
-        "the hour after the gap best: long against the rings' settling, short against the run. "
-        "Until that hour is over the inputs are not known (what ran inside the gap is a "
-        "guess), so something else is not looked for in the gap nor in that hour. That holds "
-        "for every gap, not only one with an operating change: the room's and the coolant's "
-        "temperatures inside it are interpolated, and a chiller's on-off cycle (tenths of a "
-        "kelvin to a kelvin, in minutes to tens of minutes) is shorter than a gap")
-    gap_level_s: float = _c(
-        300.0, "s", "the speed, power and load levels either side of a gap are read over five "
-        "minutes of samples")
-
-    # ---------------------------------------------------------------- signatures: steps
-    step_rpm: float = _c(
-        200.0, "rpm", "a speed change between two samples larger than this is a step: ten "
-        "times a drive's speed scatter (20 rpm) and a tenth of the smallest step of a test "
-        "cycle")
-    moving_rpm: float = _c(
-        300.0, "rpm", "below this a spindle stands: its bearing and motor heat is nil")
-    no_load_Nm: float = _c(
-        0.5, "N m", "a segment turns without load up to this process torque (a load cell's "
-        "zero drift); two load levels either side of a logging gap that differ by more are an "
-        "operating change inside it (compare.fit.gaps), as a speed change beyond the drive's "
-        "scatter is")
-    speed_band_rpm: float = _c(
-        SPEED_BAND_RPM, "rpm", "a logged speed within max(20 rpm, 1 %) of the current step "
-        "belongs to it: a drive's scatter around its set speed (spindle.bench_inputs)")
-    speed_band_rel: float = _c(SPEED_BAND_REL, "-", "as speed_band_rpm")
-    step_ramp_s: float = _c(
-        30.0, "s", "speed changes beyond step_rpm less than 30 s apart are one step: a "
-        "drive's ramp (about 10 s) logged over several samples, with room for an on-change "
-        "log's spacing; short against the onset windows (2 min and longer)")
-    line_min_samples: int = _c(
-        4, "samples", "a straight line before or after a step is read from at least four "
-        "samples: two for the line, two degrees of freedom for its standard errors")
-    line_min_span: float = _c(
-        0.5, "of the window", "and its samples must span half its window: a line through a "
-        "burst of samples at one end of the window is extrapolated over the rest")
-    onset_min_late_z: float = _c(
-        2.0, "se", "a step enters the onset ratio only where its late slope change is two "
-        "standard errors from nothing: the ratio is regressed on it, and a regressor with a "
-        "relative error above one half biases the slope towards zero and gives it heavy tails "
-        "(errors in variables)")
-    jump_min_dn2_krpm2: float = _c(
-        1.0, "krpm^2", "a step enters P1's jump regression where n^2 changes by 1 krpm^2 "
-        "(1000 rpm from standstill, 100 rpm at 5000): a smaller step's jump is under P1's "
-        "0.1 um resolution for any shortening below 0.1 um/krpm^2, seven times the FEM's own "
-        "for spl2782, so it adds nothing but a thermal transient to the regression")
-    jump_before_s: tuple[float, float] = _c(
-        (-180.0, -10.0), "s from a step", "the line before a speed step for P1's jump: three "
-        "minutes, short against the thermal response, the ramp's last 10 s left out")
-    jump_after_s: tuple[float, float] = _c(
-        (10.0, 80.0), "s from a step", "the line after it: the drive's ramp (10 s) left out, "
-        "70 s before the heat arrives at the nose")
-    jump_se_floor_um: float = _c(
-        0.02, "um", "the least standard error of a jump: a line through quantised samples "
-        "can fit them exactly, and a fifth of P1's 0.1 um resolution is what it resolves")
-    onset_scales: tuple[OnsetScale, ...] = _c(
-        (OnsetScale("2 min / 4 min", (-300.0, -10.0), (10.0, 120.0), (120.0, 360.0)),
-         OnsetScale("6.5 min / 13 min", (-600.0, -10.0), (10.0, 400.0), (400.0, 1200.0))),
-        "s from a step", "the onset is read at two time scales: minutes (a lag of a few "
-        "minutes; the temperatures' noise is small) and a quarter of an hour (a lag of ten to "
-        "twenty minutes, and a channel as coarsely logged as P1)")
-    concave_ratio: float = _c(
-        1.15, "-", "the model's onset ratio above which a channel is expected to respond at "
-        "once (a concave onset): the ratio of a first-order response's slope change over "
-        "the two windows is 1.3 and falls to 1 for a ramp; 1.15 is half-way. The model's "
-        "ratio must clear it by its own one-sided interval at alpha")
-    lag_grid_s: tuple[float, ...] = _c(
-        (0.0, 15.0, 30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1800.0, 3600.0), "s",
-        "the lag time constants the onset ratio is mapped over, doubling up to the library's "
-        "bound")
-
-    # ---------------------------------------------------------------- signatures: power
-    drift_min_segment_s: float = _c(
-        1800.0, "s", "a no-load segment is read for a drift when it lasts half an hour: the "
-        "ring difference settles in 10-20 min")
-    drift_min_segments: int = _c(
-        3, "segments", "the preload coefficient is regressed through the origin on the "
-        "segments' drifts: three give its standard error two degrees of freedom")
-    drift_early_s: tuple[float, float] = _c(
-        (120.0, 360.0), "s from the start", "the early power of a segment: after the drive's "
-        "ramp and its first averaging, before the rings have warmed")
-    drift_late_s: float = _c(
-        900.0, "s", "the late power: the segment's last quarter of an hour")
-    window_min_samples: int = _c(
-        3, "samples", "a window's mean (of the power, of a block of residual) carries the "
-        "standard error of its own samples' scatter: three samples give it two degrees of "
-        "freedom (an on-change log holds a few samples in minutes)")
-    power_resolution_W: float = _c(
-        0.05, "W", "the least standard error of a mean power: a drive's power reading resolves "
-        "about 0.1 W")
-    level_min_s: float = _c(
-        600.0, "s", "a no-load segment gives a power level when it lasts ten minutes (its "
-        "second half settled)")
-    level_rpm: float = _c(50.0, "rpm", "no-load segments within 50 rpm are one speed level")
-    min_levels: int = _c(
-        5, "levels", "the n^3 term is read from at least five speed levels: four terms are "
-        "fitted (n, n^(5/3), n^2, n^3), so one degree of freedom is left for the scatter")
-    min_speed_span: float = _c(
-        3.0, "-", "the levels must span a factor 3 in speed, or n^2 and n^3 cannot be told "
-        "apart")
-
-    # ---------------------------------------------------------------- signatures: load
-    load_plateau_min_s: float = _c(
-        1800.0, "s", "a loaded constant-speed plateau is read when it lasts half an hour")
-    load_settle_s: float = _c(
-        900.0, "s", "after a speed change the rings settle to the new bearing heat for a "
-        "quarter of an hour (their time constant, 5-10 min, three times over)")
-    load_block_s: float = _c(
-        300.0, "s", "the residual is averaged over five-minute blocks: short against the "
-        "motor's thermal response, long against the logging")
-    load_span_Nm: float = _c(
-        5.0, "N m", "the process torque must vary by 5 N m within a plateau: 100-500 W of "
-        "motor loss, a response of tenths of a kelvin at the rings")
-    load_min_plateaus: int = _c(
-        4, "plateaus", "the jackknife over the plateaus needs four for its standard error")
-    load_probe_R_K_W: float = _c(
-        0.002, "K/W", "the probe coolant resistance of the sensitivity (the model is linear in "
-        "it to first order; a tenth of the library range's upper end)")
-    max_path_correlation: float = _c(
-        0.8, "-", "the coolant's and the rotor's paths to the rings are told apart only where "
-        "their regressors correlate at most 0.8: a variance inflation 1 / (1 - r^2) of 2.8, "
-        "beyond which the two estimates trade")
+    # statistics
+    alpha: float
+    material_peak: float
+    open_loop_material_change: bool
+    plausible_base_route: bool
+    cv_blocks: int
+    cv_gain: float
+    held_out_misfit_unexplained: bool
+    distinct_among_alternatives: bool
+    open_loop_adequate_model: bool
+    competitor_step_s: float
+    scan_null_tail: int
+    competitor_masses: tuple[str, ...]
+    speed_bin_rel: float
+    # base model
+    at_bound_rel: float
+    missing_path_W_K: float
+    optimizer_tol: float
+    refit_nfev: int
+    # input timing
+    gap_min_steps: float
+    gap_judge_s: float
+    gap_level_s: float
+    # signatures: steps
+    step_rpm: float
+    moving_rpm: float
+    no_load_Nm: float
+    speed_band_rpm: float = SPEED_BAND_RPM
+    speed_band_rel: float = SPEED_BAND_REL
+    step_ramp_s: float
+    line_min_samples: int
+    line_min_span: float
+    onset_min_late_z: float
+    jump_min_dn2_krpm2: float
+    jump_before_s: tuple[float, float]
+    jump_after_s: tuple[float, float]
+    jump_se_floor_um: float
+    onset_scales: tuple[OnsetScale, ...]
+    concave_ratio: float
+    lag_grid_s: tuple[float, ...]
+    # signatures: power
+    drift_min_segment_s: float
+    drift_min_segments: int
+    drift_early_s: tuple[float, float]
+    drift_late_s: float
+    window_min_samples: int
+    power_resolution_W: float
+    level_min_s: float
+    level_rpm: float
+    min_levels: int
+    min_speed_span: float
+    # signatures: load
+    load_plateau_min_s: float
+    load_settle_s: float
+    load_block_s: float
+    load_span_Nm: float
+    load_min_plateaus: int
+    load_probe_R_K_W: float
+    max_path_correlation: float
 
     # ---------------------------------------------------------------- derived
     def implausible_z(self) -> float:
@@ -271,6 +149,25 @@ class Criteria:
     def with_options(self, **values) -> Criteria:
         """These criteria with some entries set (None leaves an entry as it is)."""
         return replace(self, **{k: v for k, v in values.items() if v is not None})
+
+    def with_file(self, path: str | Path) -> Criteria:
+        """These criteria with the entries a TOML file sets, one ``name = value`` line each
+        (the names and values of compare/fit/criteria.toml); an unknown name, a value of
+        another type or a file that is not TOML is an InputError naming the file and the
+        entry."""
+        try:
+            given = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
+            raise InputError(str(path), "-", f"cannot be read as TOML ({err})",
+                             "give a TOML file of name = value lines") from None
+        hints = typing.get_type_hints(Criteria)
+        for name in given:
+            if name not in hints:
+                raise InputError(str(path), name, "is no criterion",
+                                 f"use the names of compare/fit/criteria.toml, e.g. "
+                                 f"{', '.join(list(hints)[:3])}")
+        return replace(self, **{k: _conform(v, hints[k], (str(path), k))
+                                for k, v in given.items()})
 
     def table(self) -> list[dict]:
         """Every entry: name, value, unit, reason (the report's criteria table)."""

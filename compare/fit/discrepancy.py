@@ -29,8 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from compare.fit.greybox import GreyBox, Inputs
+from compare.fit.greybox import GreyBox
 from compare.fit.params import base_params, default_theta
+from spindle.bench_inputs import Inputs
 from spindle.loads import LoadCase, TimeSeries
 from spindle.spec import Spec
 

@@ -28,8 +28,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from compare.fit.criteria import Criteria
-from compare.fit.greybox import Inputs
-from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
+from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM, Inputs
 
 #: the criteria of the gaps (gap_min_steps, gap_judge_s, gap_level_s) when none are given
 _DEFAULT = Criteria()

@@ -19,7 +19,7 @@ from compare.fit.params import EXTRA_BASE_PARAMS, Param, base_params
 from lumped.blocks import Convection, FixedTemperature, varies_with_speed
 from lumped.build import build_network
 from lumped.simulation import LumpedModel
-from spindle.bench_inputs import interval_heat_W
+from spindle.bench_inputs import Inputs, interval_heat_W
 from spindle.drive import Drive
 from spindle.spec import Spec
 from spindle.streaming import modal_recursion
@@ -29,20 +29,6 @@ ROTATING = ("shaft", "tool", "rotor")
 _K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact", "heat_capacity",
              "axial_scale", "G_seat_W_K")
 CHANNELS = ("T1", "T2", "T_stator", "P1")
-
-
-@dataclass
-class Inputs:
-    """Model inputs on a time grid (interval k runs from grid[k] to grid[k + 1]): speed
-    [rpm], electrical power [kW], load torque [N m], ambient and coolant [K], per interval."""
-
-    grid_s: np.ndarray
-    speed_rpm: np.ndarray
-    power_kW: np.ndarray
-    load_torque_Nm: np.ndarray
-    T_env_K: np.ndarray
-    T_coolant_K: np.ndarray
-    T_start_K: float | None = None  # uniform initial temperature [K] (default: T_env_K[0])
 
 
 def _geometric(x: np.ndarray, floor: float, rel: float) -> np.ndarray:

@@ -1,8 +1,8 @@
 """``spindle-verify fit RUN.csv --spec SPEC --out DIR``: confront the model with a bench run.
 
 1. Ingest the run (spindle.bench), map its channels to the spec's sensors, build the grey
-   box's per-interval inputs (:func:`greybox_inputs`) and place an operating change inside a
-   logging gap (compare.fit.gaps).
+   box's per-interval inputs (spindle.bench_inputs.interval_inputs) and place an operating
+   change inside a logging gap (compare.fit.gaps).
 2. Anchor the grey box to the FEM reference on the run's inputs (compare.fit.discrepancy) and
    calibrate the base parameters with priors around the spec's values on the fit window
    (compare.fit.calibrate).
@@ -22,71 +22,21 @@ from pathlib import Path
 
 import numpy as np
 
-from compare.fit.calibrate import TOLERANCE, Calibrator, Fit, Measured, resample
+from compare.fit.calibrate import TOLERANCE, Calibrator, Fit, Measured
 from compare.fit.criteria import Criteria
 from compare.fit.effects import LIBRARY
 from compare.fit.effects import candidates as candidate_labels
 from compare.fit.gaps import unknown_input_spans
-from compare.fit.greybox import GreyBox, Inputs
+from compare.fit.greybox import GreyBox
 from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, default_theta
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
 from spindle.bench import BenchRun, check_against_spec, read_bench
-from spindle.bench_inputs import (
-    STANDSTILL_RPM,
-    bench_grid,
-    cell_means,
-    held,
-    held_product,
-    settled_speed,
-)
+from spindle.bench_inputs import Inputs, interval_inputs, resample, valid_samples
 from spindle.drive import drive_for
 from spindle.errors import InputError, SolverError
 from spindle.results import check_plausible
 from spindle.spec import Spec
-from spindle.units import ZERO_C_K
-
-
-def _valid_samples(run: BenchRun, col: str) -> tuple[np.ndarray, np.ndarray]:
-    """(times [s], values) of column ``col``'s non-empty cells."""
-    y = run.columns[col]
-    ok = ~np.isnan(y)
-    return run.time_s[ok], y[ok]
-
-
-def greybox_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = 2.0) -> Inputs:
-    """Per-interval inputs of the grey box on the run's grid (spindle.bench_inputs):
-
-    - speed [rpm]: the one logged at the interval's middle (held), settled to the drive's
-      scatter band (a step inside an interval is at most half an interval off);
-    - power [kW], ambient and coolant [K]: the time mean over the interval of the signal as
-      logged, each sample held until the next one, for ``hold_steps`` grid steps at most (a
-      bench that logs on change writes at least a heartbeat that often: Criteria.gap_min_steps);
-    - load torque [N m]: the torque that at the middle's speed does the interval's mean
-      mechanical work, mean(M n) / n_mid (torque and speed each held). The losses the power
-      balance takes from the interval are then mean(P_el - M omega), as the samples give
-      them; mean(P_el) - mean(M) omega_mid is not: a 5000 -> 1000 rpm ramp at 42 N m inside
-      one interval gives 5271 W of heat where the samples give about 900 W.
-    """
-    grid = bench_grid(run, grid_s)
-    mids = 0.5 * (grid[:-1] + grid[1:])
-    hold = hold_steps * grid_s
-    t_n, n = _valid_samples(run, "speed_rpm")
-    speed = settled_speed(held(t_n, n, mids))
-    power = cell_means(*_valid_samples(run, "power_kW"), grid, mids, hold)
-    if run.load_torque_measured:
-        t_m, m = _valid_samples(run, "load_torque_Nm")
-        # mean M n [N m rpm], each held
-        work = cell_means(*held_product(t_m, m, t_n, n), grid, mids, hold)
-        moving = speed >= STANDSTILL_RPM
-        torque = np.where(moving, work / np.where(moving, speed, 1.0),
-                          cell_means(t_m, m, grid, mids, hold))
-    else:
-        torque = np.zeros(len(mids))
-    t_env, y_env = _valid_samples(run, "T_env_C")
-    T_env = cell_means(t_env, y_env, grid, mids, hold) + ZERO_C_K
-    T_cool = cell_means(*_valid_samples(run, "T_coolant_C"), grid, mids, hold) + ZERO_C_K
-    return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + ZERO_C_K)
 
 
 def _check_base_extra(base_extra: tuple[str, ...]) -> None:
@@ -141,7 +91,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     if drive is None:
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
                          "add [power_balance] preset to the spec")
-    raw = greybox_inputs(run, grid_s, criteria.gap_min_steps)
+    raw = interval_inputs(run, grid_s, criteria.gap_min_steps)
     measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks, criteria)
     inputs, switches = _place_gap_switches(run, spec, drive, raw, measured, channels, nodes,
                                            base_extra, say, criteria)
@@ -202,8 +152,8 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
     runs) with the FEM anchor's ``discrepancy`` if given."""
     from compare.fit.gaps import gaps_with_change, place_switches
 
-    t_n, n = _valid_samples(run, "speed_rpm")
-    torque = _valid_samples(run, "load_torque_Nm") if run.load_torque_measured else None
+    t_n, n = valid_samples(run, "speed_rpm")
+    torque = valid_samples(run, "load_torque_Nm") if run.load_torque_measured else None
     if not gaps_with_change(run.time_s, t_n, n, inputs.grid_s, criteria=criteria,
                             torque=torque):
         return inputs, []
@@ -223,7 +173,7 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
             total += float(np.nansum(r * r))
         return total
 
-    return place_switches(inputs, run.time_s, t_n, n, *_valid_samples(run, "power_kW"),
+    return place_switches(inputs, run.time_s, t_n, n, *valid_samples(run, "power_kW"),
                           misfit, criteria, torque)
 
 
@@ -278,11 +228,12 @@ class FitReport:
         return save_report(self, Path(out), pictures)
 
 
-def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: float = 0.01,
-            nodes: int = 11, grid_s: float = 60.0, candidates: list[str] | None = None,
-            min_gain: float | None = None, progress: Callable[[str], None] | None = None,
-            fem_level: int | None = 0, base_extra: tuple[str, ...] | None = None,
-            blocks: int = 1, cv_blocks: int = 5, criteria: Criteria | None = None,
+def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
+            alpha: float | None = None, nodes: int = 11, grid_s: float = 60.0,
+            candidates: list[str] | None = None, min_gain: float | None = None,
+            progress: Callable[[str], None] | None = None, fem_level: int | None = 0,
+            base_extra: tuple[str, ...] | None = None, blocks: int = 1,
+            cv_blocks: int | None = None, criteria: Criteria | None = None,
             workers: int = 1) -> FitReport:
     """The whole loop (module docstring): the base parameters are calibrated on the lumped
     grey box anchored to the FEM (level ``fem_level``; None: the lumped model alone, no
@@ -290,7 +241,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6, alpha: floa
     the base. ``blocks``: the run is cut into that many blocks, of which about 1 -
     ``fit_fraction`` validate, spread over the run (1: the fit window is the first
     ``fit_fraction``). ``alpha``, ``min_gain`` (the cross-validated gain asked, a share) and
-    ``cv_blocks`` set the criteria of those names (compare.fit.criteria); ``candidates``:
+    ``cv_blocks`` set the criteria of those names over ``criteria`` (default: the table,
+    compare.fit.criteria; None leaves an entry as it is there); ``candidates``:
     the effects to try (default: the library). ``workers``: processes that share each
     calibration's Jacobian columns (compare.forked; default 1: on some runs more
     processes move the parameters' late digits, docs/fit.md "Options")."""

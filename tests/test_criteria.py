@@ -1,0 +1,141 @@
+"""The criteria table (compare/fit/criteria.toml) as ``Criteria`` reads it, and a user's own
+criteria file (``fit --criteria FILE``): values typed as the fields declare them, every
+entry with its unit and reason, and bad files refused with the file and the entry named."""
+
+from __future__ import annotations
+
+import fnmatch
+import tomllib
+import typing
+from dataclasses import fields
+from pathlib import Path
+
+import pytest
+
+from compare.fit.criteria import Criteria
+from compare.fit.signatures import OnsetScale
+from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
+from spindle.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE = tomllib.loads((ROOT / "compare" / "fit" / "criteria.toml").read_text("utf-8"))
+
+
+def _is(value, hint) -> bool:
+    """Whether ``value`` is of the type ``hint`` (tuples element by element)."""
+    if typing.get_origin(hint) is tuple:
+        args = typing.get_args(hint)
+        kinds = [args[0]] * len(value) if Ellipsis in args else args
+        return isinstance(value, tuple) and len(value) == len(kinds) and all(
+            _is(v, k) for v, k in zip(value, kinds, strict=True))
+    return type(value) is hint
+
+
+def test_every_entry_of_the_table_is_a_typed_field_with_unit_and_reason():
+    crit = Criteria()
+    hints = typing.get_type_hints(Criteria)
+    assert [f.name for f in fields(crit)] == list(TABLE)  # the table's order is the report's
+    for f in fields(crit):
+        assert _is(getattr(crit, f.name), hints[f.name]), f.name
+        assert f.metadata["unit"] and f.metadata["reason"].strip(), f.name
+        assert "\n" not in f.metadata["reason"] and "  " not in f.metadata["reason"], f.name
+
+
+def test_entries_shared_with_another_module_take_its_value():
+    """The table holds no copy of a value another module owns (it would go stale there)."""
+    crit = Criteria()
+    assert crit.speed_band_rpm == SPEED_BAND_RPM and crit.speed_band_rel == SPEED_BAND_REL
+    assert "value" not in TABLE["speed_band_rpm"] and "value" not in TABLE["speed_band_rel"]
+    assert all("value" in e for k, e in TABLE.items() if not k.startswith("speed_band"))
+
+
+def _toml(value) -> str:
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, OnsetScale):
+        return "{" + ", ".join(f"{f.name} = {_toml(getattr(value, f.name))}"
+                               for f in fields(value)) + "}"
+    if isinstance(value, tuple):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    return repr(value)
+
+
+def test_a_file_of_every_entry_reads_back_as_the_table(tmp_path):
+    crit = Criteria()
+    own = tmp_path / "all.toml"
+    own.write_text("".join(f"{f.name} = {_toml(getattr(crit, f.name))}\n"
+                           for f in fields(crit)))
+    assert crit.with_file(own) == crit
+
+
+def test_a_users_file_sets_its_entries_and_leaves_the_rest(tmp_path):
+    own = tmp_path / "mine.toml"
+    own.write_text("alpha = 0.05\nmaterial_peak = 1  # an integer where a float is asked\n"
+                   "cv_blocks = 3\nheld_out_misfit_unexplained = false\n"
+                   "lag_grid_s = [0, 60, 600]\njump_before_s = [-120.0, -10.0]\n"
+                   'onset_scales = [{name = "5 min", before_s = [-300.0, -10.0], '
+                   "early_s = [10.0, 150.0], late_s = [150.0, 300.0]}]\n")
+    crit = Criteria().with_file(own)
+    assert crit.alpha == 0.05 and crit.material_peak == 1.0
+    assert type(crit.material_peak) is float and crit.cv_blocks == 3
+    assert crit.held_out_misfit_unexplained is False
+    assert crit.lag_grid_s == (0.0, 60.0, 600.0) and type(crit.lag_grid_s[1]) is float
+    assert crit.jump_before_s == (-120.0, -10.0)
+    assert crit.onset_scales == (OnsetScale("5 min", (-300.0, -10.0), (10.0, 150.0),
+                                            (150.0, 300.0)),)
+    assert crit.cv_gain == Criteria().cv_gain  # not in the file
+    # the options of the command line apply over the file
+    assert crit.with_options(alpha=0.02, cv_blocks=None).alpha == 0.02
+    assert {r["name"]: r["value"] for r in crit.table()}["alpha"] == 0.05
+
+
+@pytest.mark.parametrize("text, entry, words", [
+    ("alfa = 0.05\n", "alfa", "is no criterion"),
+    ('alpha = "0.05"\n', "alpha", "not a float"),
+    ("alpha = nan\n", "alpha", "not a float"),
+    ("cv_blocks = 2.5\n", "cv_blocks", "not an int"),
+    ("material_peak = true\n", "material_peak", "not a float"),
+    ("held_out_misfit_unexplained = 1\n", "held_out_misfit_unexplained", "not a bool"),
+    ("jump_before_s = [-120.0]\n", "jump_before_s", "not an array of 2 values"),
+    ("lag_grid_s = 60.0\n", "lag_grid_s", "not an array"),
+    ("competitor_masses = [1, 2]\n", "competitor_masses", "not a str"),
+    ('onset_scales = [{name = "x", before_s = [-1.0, 0.0]}]\n', "onset_scales",
+     "give each of name, before_s, early_s, late_s"),
+    ("alpha = \n", "-", "cannot be read as TOML"),
+])
+def test_a_bad_file_names_the_file_and_the_entry(tmp_path, text, entry, words):
+    own = tmp_path / "mine.toml"
+    own.write_text(text)
+    with pytest.raises(InputError) as err:
+        Criteria().with_file(own)
+    assert err.value.problem.file == str(own) and err.value.problem.field == entry
+    assert words in str(err.value)
+
+
+def test_fit_refuses_a_bad_criteria_file_with_exit_2_and_no_output(tmp_path):
+    from compare.cli import main
+
+    own = tmp_path / "mine.toml"
+    own.write_text("alfa = 0.05\n")
+    assert main(["fit", str(tmp_path / "run.csv"), "--criteria", str(own), "--out",
+                 str(tmp_path / "o"), "--quiet"]) == 2
+    assert not (tmp_path / "o").exists()
+
+
+def test_the_table_is_installed_with_the_package():
+    """pip install . copies only the data files pyproject.toml names: each tracked data file
+    below a package folder must be named there (tests run from the checkout, where a missing
+    one is still found)."""
+    import subprocess
+
+    cfg = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))
+    data = cfg["tool"]["setuptools"]["package-data"]
+    tracked = subprocess.run(["git", "ls-files", "spindle", "meshes", "reference", "lumped",
+                              "compare", "spindle_verify"], cwd=ROOT, capture_output=True,
+                             text=True, check=True).stdout.split()
+    for path in (p for p in tracked if not p.endswith(".py")):
+        top, rest = path.split("/", 1)
+        assert any(fnmatch.fnmatch(rest, g) for g in data.get(top, [])), path
+    assert "fit/criteria.toml" in data["compare"]
