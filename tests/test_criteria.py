@@ -70,6 +70,19 @@ def test_a_file_of_every_entry_reads_back_as_the_table(tmp_path):
     assert crit.with_file(own) == crit
 
 
+def test_a_copy_of_the_table_edited_sets_the_entries_it_changes(tmp_path):
+    shipped = (ROOT / "compare" / "fit" / "criteria.toml").read_text("utf-8")
+    own = tmp_path / "copy.toml"
+    own.write_text(shipped)
+    assert Criteria().with_file(own) == Criteria()
+    own.write_text(shipped.replace("[alpha]\nvalue = 0.01", "[alpha]\nvalue = 0.05"))
+    assert Criteria().with_file(own) == Criteria().with_options(alpha=0.05)
+    own.write_text(shipped.replace('[gap_judge_s]\nvalue = 3600.0\nunit = "s"',
+                                   '[gap_judge_s]\nvalue = 60.0\nunit = "min"'))
+    with pytest.raises(InputError, match="gap_judge_s.unit: is 'min'"):
+        Criteria().with_file(own)
+
+
 def test_a_users_file_sets_its_entries_and_leaves_the_rest(tmp_path):
     own = tmp_path / "mine.toml"
     own.write_text("alpha = 0.05\nmaterial_peak = 1  # an integer where a float is asked\n"

@@ -104,10 +104,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "share [%%] of the blocked cross-validated error above the noise floor on "
                     f"its channels (default {100 * table.cv_gain:g})")
     fp.add_argument("--criteria", metavar="FILE.toml",
-                    help="criteria of your own: a TOML file of name = value lines, with the "
-                    "names, units and types of the table compare/fit/criteria.toml (the report "
-                    "lists the table it ran with); --alpha, --min-gain and --cv-blocks "
-                    "override it")
+                    help="criteria of your own: a TOML file of name = value lines, or an "
+                    "edited copy of the table compare/fit/criteria.toml, with its names, units "
+                    "and types (the report lists the table it ran with); --alpha, --min-gain "
+                    "and --cv-blocks override it")
     fp.add_argument("--fem-level", type=number(0, 4, integer=True), default=0,
                     help="FEM reference level that anchors the model on the run's inputs "
                     "(default 0; docs/fit.md)")

@@ -57,13 +57,15 @@ def _from_table(cls):
     table's; an entry with a value in the code (one shared with another module) keeps it."""
     table = tomllib.loads(files("compare.fit").joinpath(TABLE_FILE).read_text("utf-8"))
     hints = typing.get_type_hints(cls)
+    if set(hints) != set(table):
+        raise RuntimeError(f"compare/fit/{TABLE_FILE} and Criteria differ in "
+                           f"{sorted(set(hints) ^ set(table))}")
     for name, hint in hints.items():
-        entry = table.pop(name)
+        entry = table[name]
         value = getattr(cls, name) if "value" not in entry else _conform(
             entry["value"], hint, (TABLE_FILE, name))
         setattr(cls, name, field(default=value, metadata={"unit": entry["unit"],
                                                            "reason": entry["reason"]}))
-    assert not table, f"{TABLE_FILE}: entries without a field: {sorted(table)}"
     return cls
 
 
@@ -151,23 +153,33 @@ class Criteria:
         return replace(self, **{k: v for k, v in values.items() if v is not None})
 
     def with_file(self, path: str | Path) -> Criteria:
-        """These criteria with the entries a TOML file sets, one ``name = value`` line each
-        (the names and values of compare/fit/criteria.toml); an unknown name, a value of
-        another type or a file that is not TOML is an InputError naming the file and the
-        entry."""
+        """These criteria with the entries a TOML file sets: ``name = value`` lines, or
+        entries as compare/fit/criteria.toml writes them (a copy of it, edited; an entry
+        without a value sets nothing). An unknown name, a value of another type, a unit
+        other than the table's or a file that is not TOML is an InputError naming the file
+        and the entry."""
         try:
             given = tomllib.loads(Path(path).read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
             raise InputError(str(path), "-", f"cannot be read as TOML ({err})",
                              "give a TOML file of name = value lines") from None
         hints = typing.get_type_hints(Criteria)
-        for name in given:
+        units = {f.name: f.metadata["unit"] for f in fields(self)}
+        values = {}
+        for name, v in given.items():
             if name not in hints:
                 raise InputError(str(path), name, "is no criterion",
                                  f"use the names of compare/fit/criteria.toml, e.g. "
                                  f"{', '.join(list(hints)[:3])}")
-        return replace(self, **{k: _conform(v, hints[k], (str(path), k))
-                                for k, v in given.items()})
+            if isinstance(v, dict) and {"value", "unit", "reason"} >= set(v):  # the table's form
+                if v.get("unit", units[name]) != units[name]:
+                    raise InputError(str(path), f"{name}.unit", f"is {v['unit']!r}",
+                                     f"give the value in {units[name]!r}, the table's unit")
+                if "value" not in v:
+                    continue
+                v = v["value"]
+            values[name] = _conform(v, hints[name], (str(path), name))
+        return replace(self, **values)
 
     def table(self) -> list[dict]:
         """Every entry: name, value, unit, reason (the report's criteria table)."""
