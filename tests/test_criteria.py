@@ -117,6 +117,10 @@ def test_a_users_file_sets_its_entries_and_leaves_the_rest(tmp_path):
     ('onset_scales = [{name = "x", before_s = [-1.0, 0.0]}]\n', "onset_scales",
      "give each of name, before_s, early_s, late_s"),
     ("alpha = \n", "-", "cannot be read as TOML"),
+    ("alpha = 0.0\n", "alpha", "outside 0.001..0.5"),  # the table's range, --alpha's bound
+    ("cv_gain = 1.5\n", "cv_gain", "outside 0.0..1.0"),
+    ("material_peak = -0.5\n", "material_peak", "outside 0..inf"),  # no number is negative
+    ("[alpha]\nvalue = 0.7\n", "alpha", "outside 0.001..0.5"),  # in the table's form too
 ])
 def test_a_bad_file_names_the_file_and_the_entry(tmp_path, text, entry, words):
     own = tmp_path / "mine.toml"
@@ -152,3 +156,12 @@ def test_the_table_is_installed_with_the_package():
         top, rest = path.split("/", 1)
         assert any(fnmatch.fnmatch(rest, g) for g in data.get(top, [])), path
     assert "fit/criteria.toml" in data["compare"]
+
+
+def test_one_cross_validation_block_is_refused_before_any_work(tmp_path):
+    from compare.fit.run import run_fit
+    from spindle.spec_reader import load_spec
+
+    with pytest.raises(InputError, match="cv_blocks: 1 block leaves nothing to fit on"):
+        run_fit(tmp_path / "never-read.csv", load_spec("spl2782"),
+                criteria=Criteria().with_options(cv_blocks=1))

@@ -22,6 +22,7 @@ from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
 from spindle.errors import InputError
 
 TABLE_FILE = "criteria.toml"
+_FIX = "give it as the table compare/fit/criteria.toml does"
 
 
 def _conform(value, hint, where: tuple[str, str]):
@@ -32,9 +33,8 @@ def _conform(value, hint, where: tuple[str, str]):
     if origin is tuple:
         kinds = [args[0]] * len(value) if Ellipsis in args and isinstance(value, list) else args
         if not isinstance(value, list) or len(value) != len(kinds):
-            raise InputError(*where, f"is {value!r}, not an array of {len(args)} values"
-                             if Ellipsis not in args else f"is {value!r}, not an array",
-                             "give it as the table in compare/fit/criteria.toml does")
+            raise InputError(*where, f"is {value!r}, not an array" + (
+                "" if Ellipsis in args else f" of {len(args)} values"), _FIX)
         return tuple(_conform(v, kind, where) for v, kind in zip(value, kinds, strict=True))
     if is_dataclass(hint):
         hints = typing.get_type_hints(hint)
@@ -46,10 +46,19 @@ def _conform(value, hint, where: tuple[str, str]):
           and math.isfinite(value) and (hint is float or isinstance(value, int))
           if hint in (int, float) else isinstance(value, hint))
     if not ok:
-        raise InputError(*where, f"is {value!r}, not {'an' if hint is int else 'a'} "
-                         f"{hint.__name__}", "give it as the table in "
-                         "compare/fit/criteria.toml does")
+        raise InputError(*where, f"is {value!r}, not a{'n' if hint is int else ''} "
+                         f"{hint.__name__}", _FIX)
     return float(value) if hint is float else value
+
+
+def _in_range(value, bounds: list | None, where: tuple[str, str]):
+    """``value`` unless it is a number outside ``bounds`` (the entry's ``range``; default: not
+    negative, as each number of the table is a count, duration, level or share): InputError."""
+    lo, hi = bounds or (0, math.inf)
+    if isinstance(value, int | float) and not isinstance(value, bool) and not lo <= value <= hi:
+        raise InputError(*where, f"is {value}, outside {lo}..{hi}",
+                         "give a value in that range (compare/fit/criteria.toml)")
+    return value
 
 
 def _from_table(cls):
@@ -62,10 +71,10 @@ def _from_table(cls):
                            f"{sorted(set(hints) ^ set(table))}")
     for name, hint in hints.items():
         entry = table[name]
-        value = getattr(cls, name) if "value" not in entry else _conform(
-            entry["value"], hint, (TABLE_FILE, name))
-        setattr(cls, name, field(default=value, metadata={"unit": entry["unit"],
-                                                           "reason": entry["reason"]}))
+        value = getattr(cls, name) if "value" not in entry else _in_range(_conform(
+            entry["value"], hint, (TABLE_FILE, name)), entry.get("range"), (TABLE_FILE, name))
+        setattr(cls, name, field(default=value, metadata={
+            "unit": entry["unit"], "reason": entry["reason"], "range": entry.get("range")}))
     return cls
 
 
@@ -165,20 +174,22 @@ class Criteria:
                              "give a TOML file of name = value lines") from None
         hints = typing.get_type_hints(Criteria)
         units = {f.name: f.metadata["unit"] for f in fields(self)}
+        ranges = {f.name: f.metadata["range"] for f in fields(self)}
         values = {}
         for name, v in given.items():
             if name not in hints:
                 raise InputError(str(path), name, "is no criterion",
                                  f"use the names of compare/fit/criteria.toml, e.g. "
                                  f"{', '.join(list(hints)[:3])}")
-            if isinstance(v, dict) and {"value", "unit", "reason"} >= set(v):  # the table's form
+            if isinstance(v, dict) and {"value", "unit", "reason", "range"} >= set(v):  # table's form
                 if v.get("unit", units[name]) != units[name]:
                     raise InputError(str(path), f"{name}.unit", f"is {v['unit']!r}",
                                      f"give the value in {units[name]!r}, the table's unit")
                 if "value" not in v:
                     continue
                 v = v["value"]
-            values[name] = _conform(v, hints[name], (str(path), name))
+            values[name] = _in_range(_conform(v, hints[name], (str(path), name)),
+                                     ranges[name], (str(path), name))
         return replace(self, **values)
 
     def table(self) -> list[dict]:
