@@ -342,15 +342,12 @@ class GreyBox:
         Y[0] = readout @ x
         dts = np.diff(inp.grid_s)
         n_K = self.conductance_speeds()
-        # the modes the loop below asks for, at the start of each run of equal (dt, speed)
+        # runs of equal (dt, speed): one set of modes and one modal recursion each
         first = np.flatnonzero(np.r_[True, (dts[1:] != dts[:-1]) | (n_K[1:] != n_K[:-1])]
-                               )[:len(dts)]
+                               )[:n_int]
         sys.prepare_modes(dts[first], n_K[first])
-        k = 0
-        while k < n_int:  # runs of equal (dt, speed): one modal recursion each
-            j = k + 1
-            while j < n_int and dts[j] == dts[k] and n_K[j] == n_K[k]:
-                j += 1
+        bounds = [*first.tolist(), n_int]
+        for k, j in zip(bounds[:-1], bounds[1:], strict=True):
             modal = None if sys.temperature_dependent else sys.modes(float(dts[k]),
                                                                       float(n_K[k]))
             if modal is not None:
@@ -364,7 +361,6 @@ class GreyBox:
                                               self._binned(U[i, :m]))
                     x = Phi @ x + Gam @ U[i]
                     Y[i + 1] = readout @ x
-            k = j
         out: dict[str, np.ndarray] = {n: Y[:, i] for i, n in enumerate(names)}
         if extra:
             out.update({n: Y[:, len(rows) - len(extra) + i] for i, n in enumerate(extra)})
