@@ -59,8 +59,8 @@ def held(t_samples: np.ndarray, y_samples: np.ndarray, t: np.ndarray) -> np.ndar
 
 
 #: a logged value holds for at most this many grid steps: a bench that logs on change writes
-#: at least a heartbeat that often, so a longer silence is a gap (compare.fit.criteria's
-#: gap_min_steps says the same)
+#: at least a heartbeat that often, so a longer silence is a gap (the fit's criterion
+#: gap_min_steps takes this value)
 HOLD_STEPS = 2.0
 
 #: speed scatter a drive shows around its set speed: a logged speed within this band of the

@@ -14,7 +14,7 @@ import pytest
 
 from compare.fit.criteria import Criteria
 from compare.fit.signatures import OnsetScale
-from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
+from spindle.bench_inputs import HOLD_STEPS, SPEED_BAND_REL, SPEED_BAND_RPM
 from spindle.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -44,9 +44,10 @@ def test_every_entry_of_the_table_is_a_typed_field_with_unit_and_reason():
 def test_entries_shared_with_another_module_take_its_value():
     """The table holds no copy of a value another module owns (it would go stale there)."""
     crit = Criteria()
-    assert crit.speed_band_rpm == SPEED_BAND_RPM and crit.speed_band_rel == SPEED_BAND_REL
-    assert "value" not in TABLE["speed_band_rpm"] and "value" not in TABLE["speed_band_rel"]
-    assert all("value" in e for k, e in TABLE.items() if not k.startswith("speed_band"))
+    owned = {"speed_band_rpm": SPEED_BAND_RPM, "speed_band_rel": SPEED_BAND_REL,
+             "gap_min_steps": HOLD_STEPS}
+    assert {k: getattr(crit, k) for k in owned} == owned
+    assert all(("value" in e) == (k not in owned) for k, e in TABLE.items())
 
 
 def _toml(value) -> str:

@@ -18,7 +18,7 @@ from importlib.resources import files
 from pathlib import Path
 
 from compare.fit.signatures import OnsetScale
-from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM
+from spindle.bench_inputs import HOLD_STEPS, SPEED_BAND_REL, SPEED_BAND_RPM
 from spindle.errors import InputError
 
 TABLE_FILE = "criteria.toml"
@@ -105,7 +105,7 @@ class Criteria:
     optimizer_tol: float
     refit_nfev: int
     # input timing
-    gap_min_steps: float
+    gap_min_steps: float = HOLD_STEPS
     gap_judge_s: float
     gap_level_s: float
     # signatures: steps
@@ -164,9 +164,9 @@ class Criteria:
     def with_file(self, path: str | Path) -> Criteria:
         """These criteria with the entries a TOML file sets: ``name = value`` lines, or
         entries as compare/fit/criteria.toml writes them (a copy of it, edited; an entry
-        without a value sets nothing). An unknown name, a value of another type, a unit
-        other than the table's or a file that is not TOML is an InputError naming the file
-        and the entry."""
+        without a value sets nothing). An unknown name, a value of another type or outside
+        the entry's range, a unit other than the table's or a file that is not TOML is an
+        InputError naming the file and the entry."""
         try:
             given = tomllib.loads(Path(path).read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
