@@ -262,7 +262,9 @@ class ThermalSystem:
         only: the others change B u, not the matrices)."""
         if not self.temperature_dependent or q is None:
             return None
-        return tuple(np.round(np.asarray(q)[self._tc_columns], 12))
+        # exact: a key rounded to 12 decimals handed out the matrices of an earlier, nearly
+        # equal q, so a result depended on what was evaluated before it (compare.fit.greybox)
+        return tuple(np.asarray(q, dtype=float)[self._tc_columns].tolist())
 
     @property
     def n_states(self) -> int:

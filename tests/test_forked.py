@@ -59,9 +59,9 @@ def test_a_column_that_fails_in_a_child_raises_here_as_in_one_process():
 def test_a_calibration_is_the_same_with_one_process_or_two(monkeypatch):
     """The base calibration of a 16 h cycle (six parameters, three of them in the network's
     matrices) with its Jacobian columns shared by two processes gives the parameters, the
-    Jacobian-based intervals and the model to the last bit of one process here. (Not on
-    every run: clean-7 of the drawn families moves in its parameters' late digits, cause
-    not confirmed, so --workers defaults to 1; docs/fit.md "Options".)"""
+    Jacobian-based intervals and the model to the last bit of one process here. (That holds
+    on every run only if an evaluation does not depend on what the process evaluated before:
+    tests/test_greybox.py test_a_simulation_does_not_depend_on_the_parameter_sets_simulated_before.)"""
     from compare.fit.calibrate import Calibrator, Measured
     from compare.fit.greybox import GreyBox
     from spindle.cycle_files import load_cycle

@@ -120,7 +120,10 @@ class GreyBox:
         """Heat per source [W] and interval: the power balance with friction factor ``f0``
         times (n / FRICTION_REF_RPM)^``friction_exponent`` (Drive.with_friction_exponent) and
         the rotor share of the motor losses."""
-        key = ("src", round(f0, 12), round(rotor_share, 12), round(friction_exponent, 12))
+        # exact keys: a key rounded to 12 decimals returned the sources of an earlier,
+        # nearly equal f0, so a result depended on what was evaluated before it (and a
+        # Jacobian's columns in a forked child differed from the same columns in one process)
+        key = ("src", float(f0), float(rotor_share), float(friction_exponent))
         if key not in self._cache:
             # the motor loss does not depend on its split, so the power balances are made
             # once per friction law, at a rotor share of 0 (stator = the whole loss), and
@@ -140,7 +143,7 @@ class GreyBox:
     def _balances(self, f0: float, friction_exponent: float) -> dict[str, np.ndarray]:
         """Heat per source [W] and interval at a rotor share of 0 (sources; under a key
         ("src", ...), as everything that depends on the inputs)."""
-        key = ("src", "balances", round(f0, 12), round(friction_exponent, 12))
+        key = ("src", "balances", float(f0), float(friction_exponent))
         if key not in self._cache:
             d = self.drive.with_f0(f0).with_rotor_share(0.0).with_friction_exponent(
                 friction_exponent)
@@ -267,7 +270,7 @@ class GreyBox:
         # effects' flows, shared by the systems, were configured for these values above)
         k_names = self.matrix_params()
         kkey = ("system", self.nodes, self.effects, self._seats,
-                *(round(float(theta.get(k, 0.0)), 12) for k in k_names))
+                *(float(theta.get(k, 0.0)) for k in k_names))  # exact, as in sources
         system = self._cache.get(kkey)
         if system is None:
             systems = [k for k in self._cache if isinstance(k, tuple) and k[:1] == ("system",)]
