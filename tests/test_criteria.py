@@ -166,3 +166,37 @@ def test_one_cross_validation_block_is_refused_before_any_work(tmp_path):
     with pytest.raises(InputError, match="cv_blocks: 1 block leaves nothing to fit on"):
         run_fit(tmp_path / "never-read.csv", load_spec("spl2782"),
                 criteria=Criteria().with_options(cv_blocks=1))
+
+
+@pytest.mark.parametrize("entry, value", [("alpha", 0.0005), ("alpha", 0.6), ("cv_gain", -0.1),
+                                          ("cv_blocks", 21), ("material_peak", -1.0)])
+def test_options_outside_the_range_are_refused_as_in_a_file(entry, value):
+    """with_options (run_fit's alpha, min_gain, cv_blocks) checks the table's range as
+    with_file does: a level of 0.0005 would cost 10 / alpha - 1 = 19,999 scan draws a test."""
+    with pytest.raises(InputError) as err:
+        Criteria().with_options(**{entry: value})
+    assert err.value.problem.field == entry and "outside" in str(err.value)
+
+
+@pytest.mark.parametrize("option, entry, percent", [("--alpha", "alpha", False),
+                                                     ("--min-gain", "cv_gain", True),
+                                                     ("--cv-blocks", "cv_blocks", False)])
+def test_the_options_take_the_range_of_the_table(tmp_path, capsys, option, entry, percent):
+    """fit's --alpha, --min-gain (a share in %) and --cv-blocks accept the ends of their
+    entry's range and refuse what lies beyond, with exit 2 before any work."""
+    from compare.cli import main
+
+    lo, hi = Criteria.range_of(entry)
+    k = 100.0 if percent else 1.0
+    out = tmp_path / "o"
+    for v in (lo * k - (1 if entry == "cv_blocks" else 1e-4 * k), hi * k + 1):
+        assert main(["fit", str(tmp_path / "run.csv"), option, f"{v:g}", "--out",
+                     str(out)]) == 2
+        assert option in capsys.readouterr().err
+    assert not out.exists()
+    for v in (lo * k, hi * k):
+        text = f"{int(v)}" if entry == "cv_blocks" else f"{v:g}"
+        # accepted by the option; the missing run then stops the fit (exit 2, named)
+        assert main(["fit", str(tmp_path / "run.csv"), option, text, "--out", str(out),
+                     "--quiet"]) == 2
+        assert "run.csv" in capsys.readouterr().err

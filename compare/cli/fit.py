@@ -22,15 +22,22 @@ from spindle.errors import InputError
 if TYPE_CHECKING:
     from compare.progress import Progress
 
-_CV_RANGE = number(0, 20, integer=True)
+def _criterion(name: str, *, integer: bool = False, percent: bool = False):
+    """An argparse ``type`` for the criterion ``name``: the range of compare/fit/criteria.toml
+    (``percent``: a share given in %)."""
+    from compare.fit.criteria import Criteria
+
+    lo, hi = Criteria.range_of(name)
+    k = 100.0 if percent else 1.0
+    return number(lo * k, hi * k, integer=integer)
 
 
 def cv_blocks(text: str) -> int:
-    """``--cv-blocks``: 0 (none) or 2..20."""
-    value = _CV_RANGE(text)
+    """``--cv-blocks``: 0 (none) or 2 up to the table's bound."""
+    value = _criterion("cv_blocks", integer=True)(text)
     if value == 1:
         raise argparse.ArgumentTypeError("1 block leaves nothing to fit on: give 0 (none) or "
-                                         "2..20")
+                                         "2 or more")
     return value
 
 
@@ -95,11 +102,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="blocked cross-validation of the base and the final model: each of "
                     "this many blocks held out in turn, the model refitted without it and "
                     f"simulated over it (default {table.cv_blocks}; 0: none)")
-    fp.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True),
+    fp.add_argument("--alpha", type=_criterion("alpha"),
                     help="the level of every test: an effect's likelihood-ratio test, the "
                     "signature tests, the competitor's scan (against the same scan on noise) and the "
-                    f"plausible range of the base parameters (default {table.alpha:g})")
-    fp.add_argument("--min-gain", type=number(0.0, 100.0),
+                    "plausible range of the base parameters (default "
+                    f"{table.alpha:g}; {' to '.join(f'{v:g}' for v in table.range_of('alpha'))}, "
+                    "the table's range)")
+    fp.add_argument("--min-gain", type=_criterion("cv_gain", percent=True),
                     help="an effect judged by the open-loop fit must remove at least this "
                     "share [%%] of the blocked cross-validated error above the noise floor on "
                     f"its channels (default {100 * table.cv_gain:g})")

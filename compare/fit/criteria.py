@@ -157,9 +157,20 @@ class Criteria:
         half the chi-square quantile of one degree of freedom at alpha (3.3 at 1 %)."""
         return 0.5 * chi2_threshold(self.alpha, 1)
 
+    @classmethod
+    def range_of(cls, name: str) -> tuple[float, float]:
+        """The range (lo, hi) an entry's value must lie in (the table's ``range``; default:
+        not negative), as a file, :meth:`with_options` and the command line's options check."""
+        lo, hi = next(f for f in fields(cls) if f.name == name).metadata["range"] or (0, math.inf)
+        return lo, hi
+
     def with_options(self, **values) -> Criteria:
-        """These criteria with some entries set (None leaves an entry as it is)."""
-        return replace(self, **{k: v for k, v in values.items() if v is not None})
+        """These criteria with some entries set (None leaves an entry as it is); a number
+        outside the entry's range is an InputError, as in a file."""
+        given = {k: v for k, v in values.items() if v is not None}
+        for k, v in given.items():
+            _in_range(v, list(self.range_of(k)), ("criteria", k))
+        return replace(self, **given)
 
     def with_file(self, path: str | Path) -> Criteria:
         """These criteria with the entries a TOML file sets: ``name = value`` lines, or
