@@ -8,9 +8,9 @@ Makes a synthetic run with ``spindle-verify synth`` (FEM level 1, not timed), or
 ``--run``, a bench export such as a peer's development run; then times reading it, one
 grey-box simulation, and the whole ``fit`` (calibration, forward selection over the library,
 cross-validation, diagnostics, report.json and report.html), with ``--workers`` processes as
-``spindle-verify fit`` runs (default 1); with ``--workers 2 --serial-too`` it times the fit
-again with one process, prints the ratio and says whether the two reports agree (not on
-every run: docs/fit.md "Options"). Target
+``spindle-verify fit`` runs (default min(2, CPUs), as fit's); with ``--serial-too`` it times
+the fit again with one process, prints the ratio and says whether the two reports agree
+(they must, to the last bit: docs/fit.md "Options"). Target
 (issues 6, 13, 32): <= 60 s on 2 cores for a 16 h run.
 """
 
@@ -24,6 +24,7 @@ from pathlib import Path
 from verdicts import require_files
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
+from compare.executor import default_workers
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -32,8 +33,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--keep", help="keep the run and the report in this folder")
     ap.add_argument("--run", type=Path, help="time this bench export instead of a synthetic run")
-    ap.add_argument("--workers", type=int, default=1,
-                    help="processes per fit (default 1, as spindle-verify fit)")
+    ap.add_argument("--workers", type=int, default=default_workers(),
+                    help=f"processes per fit (default {default_workers()} here, as "
+                    "spindle-verify fit)")
     ap.add_argument("--serial-too", action="store_true",
                     help="time the fit with one process too and print the ratio")
     args = ap.parse_args(argv)

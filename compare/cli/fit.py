@@ -133,11 +133,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     f"(default: {' '.join(DEFAULT_BASE_EXTRA)}; "
                     "docs/fit.md)")
     fp.add_argument("--nodes", type=NODE_COUNT, default=11, help="lumped model nodes (default 11)")
-    fp.add_argument("--workers", type=WORKERS, default=1,
+    fp.add_argument("--workers", type=WORKERS, default=default_workers(),
                     help="processes that share each calibration's finite-difference columns "
-                    "(forked copies of this one, on Linux; faster on runs logged on change, "
-                    f"e.g. {default_workers()} here; on some runs the late digits of the "
-                    "parameters differ from one process's, docs/fit.md; default 1)")
+                    "(forked copies of this one, on Linux; the report is the same to the "
+                    "last bit with any number; 1: this process alone; default "
+                    f"{default_workers()} here, min(2, CPUs))")
     fp.add_argument("--candidates", nargs="+", choices=list(LIBRARY), metavar="EFFECT",
                     help="candidate effects (default: the whole library: "
                     f"{', '.join(LIBRARY)})")
