@@ -117,7 +117,8 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-complements-held-out": "fit-trade-complements-held-out.json",
           "trade-complements-fresh": "fit-trade-complements-fresh.json",
           "trade-optimizer-tol": "fit-trade-optimizer-tol.json",
-          "trade-optimizer-tol-held-out": "fit-trade-optimizer-tol-held-out.json"}
+          "trade-optimizer-tol-held-out": "fit-trade-optimizer-tol-held-out.json",
+          "trade-exact-keys": "fit-trade-exact-keys.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
@@ -156,6 +157,29 @@ def optimizer_tol_text() -> str:
         "1e-8 (docs/figures/fit-roundoff-1e-6.json and -1e-8.json: the rows before the "
         "stamps, at 1e-6 and with 1e-8 written into that tree, against those after).",
         width=92)
+
+
+def exact_keys_text() -> str:
+    """docs/fit.md's figures of the exact cache keys, from the file compare_reports.py wrote
+    from rows (validation RMS moves and fit times)."""
+    import json
+    import textwrap
+
+    d = json.loads((ROOT / "docs" / "figures" / "fit-trade-exact-keys.json")
+                   .read_text(encoding="utf-8"))
+    m, t = d["rms_moved"], d["fit_s"]
+    return textwrap.fill(
+        f"The validation RMS after moved by more than 0.001 (K or µm) on {m['over_0.001']} of "
+        f"{m['runs']} runs, by more than 0.01 on {m['over_0.01']}, at most {m['largest']}, "
+        f"in either direction. The fits took {t['after']['total']} s in all against "
+        f"{t['before']['total']} s (median {t['before']['median']} → {t['after']['median']} s "
+        "a run, one process a fit, two at a time).", width=92)
+
+
+def test_the_exact_keys_figures_are_their_file():
+    from tests.docs_blocks import assert_block
+
+    assert_block("docs/fit.md", "exact-keys-figures", exact_keys_text())
 
 
 def test_the_optimizer_tolerance_figures_are_their_files():
