@@ -159,14 +159,11 @@ class Criteria:
 
     @classmethod
     def range_of(cls, name: str) -> tuple[float, float]:
-        """The range (lo, hi) an entry's value must lie in (the table's ``range``; default:
-        not negative), as a file, :meth:`with_options` and the command line's options check."""
-        lo, hi = next(f for f in fields(cls) if f.name == name).metadata["range"] or (0, math.inf)
-        return lo, hi
+        """An entry's range (lo, hi): the table's ``range``, else not negative."""
+        return tuple({f.name: f for f in fields(cls)}[name].metadata["range"] or (0, math.inf))
 
     def with_options(self, **values) -> Criteria:
-        """These criteria with some entries set (None leaves an entry as it is); a number
-        outside the entry's range is an InputError, as in a file."""
+        """These criteria with some entries set (None leaves one as it is), range-checked."""
         given = {k: v for k, v in values.items() if v is not None}
         for k, v in given.items():
             _in_range(v, list(self.range_of(k)), ("criteria", k))

@@ -21,6 +21,7 @@ from lumped.build import build_network
 from lumped.simulation import LumpedModel
 from spindle.bench_inputs import Inputs, interval_heat_W
 from spindle.drive import Drive
+from spindle.errors import InputError
 from spindle.spec import Spec
 from spindle.streaming import modal_recursion
 
@@ -120,9 +121,7 @@ class GreyBox:
         """Heat per source [W] and interval: the power balance with friction factor ``f0``
         times (n / FRICTION_REF_RPM)^``friction_exponent`` (Drive.with_friction_exponent) and
         the rotor share of the motor losses."""
-        # exact keys: a key rounded to 12 decimals returned the sources of an earlier,
-        # nearly equal f0, so a result depended on what was evaluated before it (and a
-        # Jacobian's columns in a forked child differed from the same columns in one process)
+        # exact keys: rounded ones handed out a nearly equal set's entry (fit-history (12))
         key = ("src", float(f0), float(rotor_share), float(friction_exponent))
         if key not in self._cache:
             # the motor loss does not depend on its split, so the power balances are made
@@ -324,12 +323,9 @@ class GreyBox:
         effects = self._effects()
         for e, _ in effects:
             src = e.heat(src, th, inp)
-        cols = []
-        for name in sys.source_names:
-            cols.append(src[name] if name in src else np.zeros(n_int))
-        for f in sys.fixed_sources:
-            cols.append(inp.T_env_K if f == "ambient" else inp.T_coolant_K)
-        U = np.column_stack(cols)
+        U = np.column_stack([src[n] if n in src else np.zeros(n_int) for n in sys.source_names]
+                            + [inp.T_env_K if f == "ambient" else inp.T_coolant_K
+                               for f in sys.fixed_sources])
         m = len(sys.source_names)
         start = inp.T_start_K if inp.T_start_K is not None else inp.T_env_K[0]
         x = np.full(sys.n_states, start if x0_K is None else x0_K)
@@ -406,8 +402,6 @@ def _stretch_exponents(spec: Spec, nodes: int
         b = plain(stretch_axially(spec, factor))
         eb = b.system.edges
         if names != [e[3] for e in eb] or len(set(names)) != len(names):
-            from spindle.errors import InputError
-
             raise InputError(str(spec.path), "axial_scale", "the lumped network's layout "
                              f"changes when the spindle is stretched axially by {factor:g}, "
                              "so its lengths cannot be scaled as one parameter",
