@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import tomllib
 import typing
+from collections.abc import Sequence
 from dataclasses import dataclass, field, fields, is_dataclass, replace
 from importlib.resources import files
 from pathlib import Path
@@ -51,7 +52,7 @@ def _conform(value, hint, where: tuple[str, str]):
     return float(value) if hint is float else value
 
 
-def _in_range(value, bounds: list | None, where: tuple[str, str]):
+def _in_range(value, bounds: Sequence[float] | None, where: tuple[str, str]):
     """``value`` unless it is a number outside ``bounds`` (the entry's ``range``; default: not
     negative, as each number of the table is a count, duration, level or share): InputError."""
     lo, hi = bounds or (0, math.inf)
@@ -166,7 +167,7 @@ class Criteria:
         """These criteria with some entries set (None leaves one as it is), range-checked."""
         given = {k: v for k, v in values.items() if v is not None}
         for k, v in given.items():
-            _in_range(v, list(self.range_of(k)), ("criteria", k))
+            _in_range(v, self.range_of(k), ("criteria", k))
         return replace(self, **given)
 
     def with_file(self, path: str | Path) -> Criteria:
@@ -182,7 +183,6 @@ class Criteria:
                              "give a TOML file of name = value lines") from None
         hints = typing.get_type_hints(Criteria)
         units = {f.name: f.metadata["unit"] for f in fields(self)}
-        ranges = {f.name: f.metadata["range"] for f in fields(self)}
         values = {}
         for name, v in given.items():
             if name not in hints:
@@ -197,7 +197,7 @@ class Criteria:
                     continue
                 v = v["value"]
             values[name] = _in_range(_conform(v, hints[name], (str(path), name)),
-                                     ranges[name], (str(path), name))
+                                     self.range_of(name), (str(path), name))
         return replace(self, **values)
 
     def table(self) -> list[dict]:
