@@ -159,13 +159,25 @@ def test_the_table_is_installed_with_the_package():
     assert "fit/criteria.toml" in data["compare"]
 
 
-def test_one_cross_validation_block_is_refused_before_any_work(tmp_path):
-    from compare.fit.run import run_fit
-    from spindle.spec_reader import load_spec
+def test_one_cross_validation_block_is_refused_wherever_it_is_given(tmp_path, capsys):
+    """The table's cv_blocks entry excludes 1 (nothing would be left to fit on): refused by
+    the options, by a user's file (naming the file) and by --cv-blocks, with exit 2 before
+    any work; 0 and 2 pass."""
+    from compare.cli import main
 
-    with pytest.raises(InputError, match="cv_blocks: 1 block leaves nothing to fit on"):
-        run_fit(tmp_path / "never-read.csv", load_spec("spl2782"),
-                criteria=Criteria().with_options(cv_blocks=1))
+    with pytest.raises(InputError, match="cv_blocks: is 1: one block leaves nothing to fit on"):
+        Criteria().with_options(cv_blocks=1)
+    own = tmp_path / "mine.toml"
+    own.write_text("cv_blocks = 1\n")
+    with pytest.raises(InputError) as err:
+        Criteria().with_file(own)
+    assert (err.value.problem.file, err.value.problem.field) == (str(own), "cv_blocks")
+    assert [Criteria().with_options(cv_blocks=n).cv_blocks for n in (0, 2)] == [0, 2]
+    out = tmp_path / "o"
+    for args in (["--cv-blocks", "1"], ["--criteria", str(own)]):
+        assert main(["fit", str(tmp_path / "run.csv"), *args, "--out", str(out)]) == 2
+        assert "one block leaves nothing to fit on" in capsys.readouterr().err
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("entry, value", [("alpha", 0.0005), ("alpha", 0.6), ("cv_gain", -0.1),

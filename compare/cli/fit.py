@@ -23,22 +23,23 @@ if TYPE_CHECKING:
     from compare.progress import Progress
 
 def _criterion(name: str, *, integer: bool = False, percent: bool = False):
-    """An argparse ``type`` for the criterion ``name``: the range of compare/fit/criteria.toml
-    (``percent``: a share given in %)."""
+    """An argparse ``type`` for the criterion ``name``: what compare/fit/criteria.toml's entry
+    allows (its range, less the values it excludes; ``percent``: a share given in %)."""
     from compare.fit.criteria import Criteria
 
     lo, hi = Criteria.range_of(name)
     k = 100.0 if percent else 1.0
-    return number(lo * k, hi * k, integer=integer)
+    parse = number(lo * k, hi * k, integer=integer)
 
+    def checked(text: str):
+        value = parse(text)
+        try:
+            Criteria.checked(name, value / k if percent else value)
+        except InputError as err:
+            raise argparse.ArgumentTypeError(f"{err.problem.message}; {err.problem.fix}") from None
+        return value
 
-def cv_blocks(text: str) -> int:
-    """``--cv-blocks``: 0 (none) or 2 up to the table's bound."""
-    value = _criterion("cv_blocks", integer=True)(text)
-    if value == 1:
-        raise argparse.ArgumentTypeError("1 block leaves nothing to fit on: give 0 (none) or "
-                                         "2 or more")
-    return value
+    return checked
 
 
 def _base_extra(names: list[str] | None) -> tuple[str, ...] | None:
@@ -98,7 +99,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="windows for selecting effects: cut the run into this many blocks, "
                     "of which about 1 - fit-fraction, spread over the run, validate (default "
                     "1: the fit window is the run's start; docs/fit.md says why)")
-    fp.add_argument("--cv-blocks", type=cv_blocks,
+    fp.add_argument("--cv-blocks", type=_criterion("cv_blocks", integer=True),
                     help="blocked cross-validation of the base and the final model: each of "
                     "this many blocks held out in turn, the model refitted without it and "
                     f"simulated over it (default {table.cv_blocks}; 0: none)")

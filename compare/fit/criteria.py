@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import tomllib
 import typing
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, is_dataclass, replace
 from importlib.resources import files
 from pathlib import Path
@@ -24,6 +24,8 @@ from spindle.errors import InputError
 
 TABLE_FILE = "criteria.toml"
 _FIX = "give it as the table compare/fit/criteria.toml does"
+#: the keys of an entry in the table's form
+_ENTRY_KEYS = {"value", "unit", "reason", "range", "excluded"}
 
 
 def _conform(value, hint, where: tuple[str, str]):
@@ -52,13 +54,21 @@ def _conform(value, hint, where: tuple[str, str]):
     return float(value) if hint is float else value
 
 
-def _in_range(value, bounds: Sequence[float] | None, where: tuple[str, str]):
+def _in_range(value, bounds: Sequence[float] | None, where: tuple[str, str],
+              excluded: Mapping[str, str] | None = None):
     """``value`` unless it is a number outside ``bounds`` (the entry's ``range``; default: not
-    negative, as each number of the table is a count, duration, level or share): InputError."""
+    negative, as each number of the table is a count, duration, level or share) or one the
+    entry's ``excluded`` names (value as text: why): InputError."""
     lo, hi = bounds or (0, math.inf)
-    if isinstance(value, int | float) and not isinstance(value, bool) and not lo <= value <= hi:
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        return value
+    if not lo <= value <= hi:
         raise InputError(*where, f"is {value}, outside {lo}..{hi}",
                          "give a value in that range (compare/fit/criteria.toml)")
+    why = (excluded or {}).get(f"{value:g}")
+    if why:
+        raise InputError(*where, f"is {value}: {why}", f"give a value in {lo}..{hi} other "
+                         f"than {', '.join(excluded)} (compare/fit/criteria.toml)")
     return value
 
 
@@ -73,9 +83,11 @@ def _from_table(cls):
     for name, hint in hints.items():
         entry = table[name]
         value = getattr(cls, name) if "value" not in entry else _in_range(_conform(
-            entry["value"], hint, (TABLE_FILE, name)), entry.get("range"), (TABLE_FILE, name))
+            entry["value"], hint, (TABLE_FILE, name)), entry.get("range"), (TABLE_FILE, name),
+            entry.get("excluded"))
         setattr(cls, name, field(default=value, metadata={
-            "unit": entry["unit"], "reason": entry["reason"], "range": entry.get("range")}))
+            "unit": entry["unit"], "reason": entry["reason"], "range": entry.get("range"),
+            "excluded": entry.get("excluded")}))
     return cls
 
 
@@ -163,11 +175,17 @@ class Criteria:
         """An entry's range (lo, hi): the table's ``range``, else not negative."""
         return tuple({f.name: f for f in fields(cls)}[name].metadata["range"] or (0, math.inf))
 
+    @classmethod
+    def checked(cls, name: str, value, where: tuple[str, str] | None = None):
+        """``value`` for the entry ``name`` if the table's range allows it and does not
+        exclude it, else InputError at ``where`` (file, field; default criteria, name)."""
+        meta = {f.name: f for f in fields(cls)}[name].metadata
+        return _in_range(value, cls.range_of(name), where or ("criteria", name),
+                         meta["excluded"])
+
     def with_options(self, **values) -> Criteria:
         """These criteria with some entries set (None leaves one as it is), range-checked."""
-        given = {k: v for k, v in values.items() if v is not None}
-        for k, v in given.items():
-            _in_range(v, self.range_of(k), ("criteria", k))
+        given = {k: self.checked(k, v) for k, v in values.items() if v is not None}
         return replace(self, **given)
 
     def with_file(self, path: str | Path) -> Criteria:
@@ -189,15 +207,15 @@ class Criteria:
                 raise InputError(str(path), name, "is no criterion",
                                  f"use the names of compare/fit/criteria.toml, e.g. "
                                  f"{', '.join(list(hints)[:3])}")
-            if isinstance(v, dict) and {"value", "unit", "reason", "range"} >= set(v):  # table's form
+            if isinstance(v, dict) and _ENTRY_KEYS >= set(v):  # the table's form
                 if v.get("unit", units[name]) != units[name]:
                     raise InputError(str(path), f"{name}.unit", f"is {v['unit']!r}",
                                      f"give the value in {units[name]!r}, the table's unit")
                 if "value" not in v:
                     continue
                 v = v["value"]
-            values[name] = _in_range(_conform(v, hints[name], (str(path), name)),
-                                     self.range_of(name), (str(path), name))
+            values[name] = self.checked(name, _conform(v, hints[name], (str(path), name)),
+                                        (str(path), name))
         return replace(self, **values)
 
     def table(self) -> list[dict]:

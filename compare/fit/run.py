@@ -252,9 +252,6 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
     t0 = time.perf_counter()
     criteria = (criteria or Criteria()).with_options(alpha=alpha, cv_gain=min_gain,
                                                      cv_blocks=cv_blocks)
-    if criteria.cv_blocks == 1:
-        raise InputError("criteria", "cv_blocks", "1 block leaves nothing to fit on",
-                         "give 0 (none) or 2..20")
     unknown = [c for c in (candidates or []) if c not in LIBRARY]
     if unknown:  # before any work
         raise InputError("command line", "--candidates", f"unknown effect {unknown[0]}",
