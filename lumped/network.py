@@ -36,6 +36,13 @@ from spindle.errors import SpindleVerifyError
 from spindle.loads import SpeedTable
 
 
+def _step(dt_s: float) -> float:
+    """A time step [s] to 1 ns: steps that differ by less (a grid on a time-of-day clock,
+    58.7 against 58.69999999999709 s) are one step, computed with the rounded value, so a
+    cached step's matrices do not depend on which of them was asked for first."""
+    return round(float(dt_s), 9)
+
+
 class NetworkError(SpindleVerifyError):
     """A network that cannot be assembled: each line names the block and the fix."""
 
@@ -429,7 +436,8 @@ class ThermalSystem:
         """Modal form of the exact zero-order-hold step for a symmetric network (None
         otherwise): (a, Bm, to_modal, from_modal) with z = to_modal x, z+ = a z + Bm u and
         x = from_modal z (eigenvectors of C^-1/2 K C^-1/2)."""
-        key = ("modes", round(float(dt_s), 9), float(speed_rpm))
+        dt_s = _step(dt_s)
+        key = ("modes", dt_s, float(speed_rpm))
         if key not in self._cache:
             K, B, _, _ = self.matrices(speed_rpm, None)
             # np.allclose(K, K.T, rtol=1e-12, atol=0) for a finite K, without its checks for
@@ -456,16 +464,15 @@ class ThermalSystem:
         matrices, their condensation and the eigenproblems of all new speeds go to numpy as
         stacks, so a new set of conductances costs a few calls, not a few per speed. The
         numbers are those of :meth:`modes` called along the sequence: each stacked slice
-        runs the same LAPACK and BLAS routine on the same values, and each cache entry gets
-        the step it is first asked with (tests/test_lumped_network.py)."""
+        runs the same LAPACK and BLAS routine on the same values (tests/test_lumped_network.py)."""
         if self.temperature_dependent:
             return
         todo: dict[tuple, float] = {}  # cache key -> the step it is first asked with
         for dt, n in zip(np.asarray(dts_s, dtype=float).tolist(),
                          np.asarray(speeds_rpm, dtype=float).tolist(), strict=True):
-            key = ("modes", round(dt, 9), n)
+            key = ("modes", _step(dt), n)
             if key not in todo and key not in self._cache:
-                todo[key] = dt
+                todo[key] = key[1]
         if len(todo) < 2:
             return
         speeds = list(dict.fromkeys(key[2] for key in todo))
@@ -499,8 +506,8 @@ class ThermalSystem:
         augmented system, scipy.linalg.expm). With ``integrals``
         also (Psi, Lambda) with integral_0^dt x dt = Psi x + Lambda u, for exact energy
         bookkeeping."""
-        key = ("zoh", round(float(dt_s), 9), float(speed_rpm), integrals,
-               self._q_key(q))
+        dt_s = _step(dt_s)
+        key = ("zoh", dt_s, float(speed_rpm), integrals, self._q_key(q))
         if key in self._cache:
             return self._cache[key]
         K, B, _, _ = self.matrices(speed_rpm, q)

@@ -214,8 +214,8 @@ def test_modes_prepared_for_many_speeds_are_those_of_one_speed(nodes, symmetric)
     """A fit's simulation asks for the modes along a run's steps and speed levels at once
     (prepare_modes: stacked matrices, one batched eigenproblem); they must be the modes
     that modes() gives along the same sequence, bit for bit, since a fit's result must not
-    depend on which path filled the cache. Steps that differ below the cache key's 1e-9 s
-    (a grid on a time-of-day clock) share an entry made with the step first asked for. A K
+    depend on which path filled the cache. Steps that differ below 1 ns
+    (a grid on a time-of-day clock) are one step, the rounded one, whichever came first. A K
     that is not symmetric (made so here by one entry) has no modes: None on both paths."""
     from dataclasses import replace
 
@@ -240,8 +240,15 @@ def test_modes_prepared_for_many_speeds_are_those_of_one_speed(nodes, symmetric)
         assert (got is None) == (want is None) == (not symmetric)
         for g, w in zip(got or (), want or (), strict=True):
             np.testing.assert_array_equal(g, w)
-    # the entry of 3000 rpm at 60 s was made with the step asked first, 60 + 1e-11 s
-    first = build_network(spec, nodes).network.assemble()
+    # the entry of 3000 rpm at 60 s is the 60 s step's, whichever near step came first
     if symmetric:
-        np.testing.assert_array_equal(batched._cache[("modes", 60.0, 3000.0)][0],
-                                      first.modes(60.0 + 1e-11, 3000.0)[0])
+        for first in (60.0 + 1e-11, 60.0, 60.0 - 1e-11):
+            other = build_network(spec, nodes).network.assemble()
+            other.modes(first, 3000.0)
+            np.testing.assert_array_equal(other.modes(60.0 + 2e-11, 3000.0)[0],
+                                          batched._cache[("modes", 60.0, 3000.0)][0])
+        exact = build_network(spec, nodes).network.assemble()._modal_form(
+            *np.linalg.eigh((1 / np.sqrt(single.C))[:, None] * single.matrices(3000.0, None)[0]
+                            * (1 / np.sqrt(single.C))[None, :]), single.matrices(3000.0, None)[1],
+            60.0)
+        np.testing.assert_array_equal(batched._cache[("modes", 60.0, 3000.0)][0], exact[0])
