@@ -15,11 +15,14 @@ here one after another.
 from __future__ import annotations
 
 import multiprocessing
+import signal
 import sys
 from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
+#: the signals a forked child leaves to its parent
+_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 #: the function a forked child evaluates (set just before the fork, so the child inherits it)
 _CHILD_FUN: Callable[[np.ndarray], np.ndarray] | None = None
 
@@ -29,6 +32,20 @@ def _in_child(x: np.ndarray) -> tuple[bool, np.ndarray | None]:
         return True, np.atleast_1d(_CHILD_FUN(x))
     except Exception:  # noqa: BLE001 (evaluated again in the parent, which raises as in serial)
         return False, None
+
+
+def _leave_signals_to_the_parent() -> None:
+    """A child's start: out of the terminal's process group, so that a Ctrl-C or
+    ``timeout``'s signal to the group reaches the parent alone, which ends its children
+    (:meth:`ForkedColumns.__exit__`); SIGINT ignored and SIGTERM the default, not the
+    parent's handler (compare.cli), which would print a traceback from the child and could
+    leave the pool hung on a child that died mid-task."""
+    import os
+
+    os.setpgrp()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent's fork
 
 
 def can_fork() -> bool:
@@ -92,10 +109,16 @@ class ForkedColumns:
     def _start(self) -> bool:
         global _CHILD_FUN
         _CHILD_FUN = self.fun  # forked now, so the children also hold today's caches
+        # the signals wait until a child has its own handlers (they stay blocked in the
+        # pool's threads, as Python handles them in the main thread)
+        held = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
         try:
-            self.pool = multiprocessing.get_context("fork").Pool(self.workers - 1)
+            self.pool = multiprocessing.get_context("fork").Pool(
+                self.workers - 1, initializer=_leave_signals_to_the_parent)
         except (OSError, AssertionError, ValueError):  # no children to be had: serial
             self.workers = 1
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)
         return self.pool is not None
 
     def __call__(self, fun: Callable, points: Iterable[np.ndarray]) -> list[np.ndarray]:

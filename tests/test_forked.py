@@ -99,3 +99,63 @@ def test_a_calibration_is_the_same_with_one_process_or_two(monkeypatch):
     # problem whose films and contacts are strongly correlated)
     for k, v in truth.items():
         assert one.theta[k] == pytest.approx(v, rel=1e-3)
+
+
+_INTERRUPTED = """
+import os, signal, sys, time
+import numpy as np
+from compare.cli import _terminate
+from compare.forked import ForkedColumns
+
+signal.signal(signal.SIGTERM, _terminate)  # as the command line has it
+pids = sys.argv[1]
+
+def slow(x):
+    open(os.path.join(pids, str(os.getpid())), "w").close()
+    time.sleep(0.3)
+    return x
+
+try:
+    with ForkedColumns(slow, [True, True, False, False], workers=2) as cols:
+        while True:
+            cols(slow, [np.full(1, float(i)) for i in range(4)])
+except KeyboardInterrupt:
+    print("interrupted", file=sys.stderr)
+    sys.exit(130)
+"""
+
+
+@needs_fork
+@pytest.mark.parametrize("signum", ["SIGINT", "SIGTERM"])
+def test_a_signal_to_the_process_group_ends_the_fit_and_its_children_quietly(tmp_path,
+                                                                              signum):
+    """Ctrl-C (SIGINT) or ``timeout`` (SIGTERM) signals the whole process group while the
+    children evaluate columns. The parent alone handles it and ends its children: no
+    traceback from a child (it once raised the parent's KeyboardInterrupt; a pool can hang
+    on a child that died mid-task), exit 130, no child left."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    pids = tmp_path / "pids"
+    pids.mkdir()
+    proc = subprocess.Popen([sys.executable, "-c", _INTERRUPTED, str(pids)],
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 30
+    while len(list(pids.iterdir())) < 2 and time.monotonic() < deadline:  # a child is busy
+        time.sleep(0.05)
+    time.sleep(0.15)  # inside a column, on both sides
+    os.killpg(proc.pid, getattr(signal, signum))
+    try:
+        err = proc.communicate(timeout=20)[1]
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        pytest.fail("the interrupted process hung")
+    assert proc.returncode == 130 and "Traceback" not in err and "interrupted" in err, err
+    children = {int(p.name) for p in pids.iterdir()} - {proc.pid}
+    assert children
+    time.sleep(0.5)
+    for pid in children:
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
