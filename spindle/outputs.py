@@ -156,23 +156,7 @@ def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
         if q == target or target in q.parents:
             raise InputError(str(path), "--out", f"holds the input {p}, which an output could "
                              "overwrite", "choose an output folder apart from the inputs")
-    # nothing is created here (a run refused later must leave nothing behind): the nearest
-    # existing folder on the way must be one we can write into
-    base = target
-    while not base.exists() and base != base.parent:
-        base = base.parent
-    if not base.is_dir():
-        raise InputError(str(path), "--out", f"cannot be created: {base} is a file",
-                         "give a folder in a place you can write to")
-    if not os.access(base, os.W_OK | os.X_OK):
-        raise InputError(str(path), "--out", f"cannot be written ({base} is not writable)",
-                         "give a folder in a place you can write to")
-    try:  # the permission bits may allow what the place refuses (/proc, a read-only mount)
-        os.rmdir(tempfile.mkdtemp(prefix=".spindle-verify-probe-", dir=base))
-    except OSError as exc:
-        raise InputError(str(path), "--out", f"cannot be created in {base} "
-                         f"({exc.strerror or exc})",
-                         "give a folder in a place you can write to") from None
+    _check_writable(path, target)
     if path.is_dir():
         nested = next((q.parent for q in path.glob(f"*/**/{MARKER}")), None)
         if nested is not None and not force:
@@ -183,6 +167,27 @@ def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
         if found and not force:
             raise _refuse_foreign(path, found)
     return path
+
+
+def _check_writable(path: Path, target: Path, option: str = "--out") -> None:
+    """``path`` (resolved: ``target``) can be created and written: nothing is created here
+    (a run refused later must leave nothing behind), so the nearest existing folder on the
+    way must be one we can write into."""
+    base = target
+    while not base.exists() and base != base.parent:
+        base = base.parent
+    if not base.is_dir():
+        raise InputError(str(path), option, f"cannot be created: {base} is a file",
+                         "give a folder in a place you can write to")
+    if not os.access(base, os.W_OK | os.X_OK):
+        raise InputError(str(path), option, f"cannot be written ({base} is not writable)",
+                         "give a folder in a place you can write to")
+    try:  # the permission bits may allow what the place refuses (/proc, a read-only mount)
+        os.rmdir(tempfile.mkdtemp(prefix=".spindle-verify-probe-", dir=base))
+    except OSError as exc:
+        raise InputError(str(path), option, f"cannot be created in {base} "
+                         f"({exc.strerror or exc})",
+                         "give a folder in a place you can write to") from None
 
 
 def _clean_leftovers(parent: Path, name: str) -> None:
@@ -203,6 +208,81 @@ def _clean_leftovers(parent: Path, name: str) -> None:
                 shutil.rmtree(old, ignore_errors=True)
         except (PermissionError, OverflowError):
             pass
+
+
+#: file beside single output files (synth's run and truth, a baseline): their names and
+#: SHA-256, so that a later run replaces those and refuses a file of the user's
+FILE_MARKER = ".spindle-verify-files"
+
+
+def _files_written(folder: Path) -> dict[str, str]:
+    try:
+        data = json.loads((folder / FILE_MARKER).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return {}
+    files = data.get("files") if isinstance(data, dict) else None
+    return {str(k): str(v) for k, v in files.items()} if isinstance(files, dict) else {}
+
+
+def _foreign_file(path: Path) -> bool:
+    """``path`` exists and is not a file spindle-verify wrote (or it was edited since)."""
+    if not (path.exists() or path.is_symlink()):
+        return False
+    return (path.is_symlink() or not path.is_file()
+            or _files_written(path.parent).get(path.name) != _sha256(path))
+
+
+def _refuse_file(path: Path, option: str) -> InputError:
+    return InputError(str(path), option, "exists and spindle-verify did not write it (or it "
+                      "was edited since)", "give a new file name, move the file away, or add "
+                      f"--force to have it moved aside to '{path.stem}.kept-<time>"
+                      f"{path.suffix}' (nothing is deleted)")
+
+
+def check_output_file(path: str | Path, inputs: Sequence[str | Path] = (),
+                      force: bool = False, option: str = "--out") -> Path:
+    """Refuse, before any work is done, an output file that cannot be one: a folder, one of
+    the run's ``inputs``, a place that cannot be written, or (unless ``force``) an existing
+    file spindle-verify did not write there (its folder's :data:`FILE_MARKER`)."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(str(path), option, "is a folder", "give a file name")
+    for p in inputs:
+        if Path(p).resolve() == path.resolve():
+            raise InputError(str(path), option, f"is the input {p}", "give another file name: "
+                             "an output never replaces an input")
+    _check_writable(path, path.parent.resolve(), option)
+    if _foreign_file(path) and not force:
+        raise _refuse_file(path, option)
+    return path
+
+
+def write_output_file(path: str | Path, write: Callable[[Path], Any], force: bool = False,
+                      option: str = "--out") -> None:
+    """:func:`atomic_write` into ``path``, which :func:`check_output_file` allows (asked
+    again here: the file may have appeared during the run); a file of the user's there is
+    first moved aside to ``<stem>.kept-<time><suffix>`` with ``force``. The file is recorded
+    in its folder's :data:`FILE_MARKER`."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if _foreign_file(path):
+        if not force:
+            raise _refuse_file(path, option)
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        kept = path.with_name(f"{path.stem}.kept-{stamp}{path.suffix}")
+        n = 1
+        while kept.exists() or kept.is_symlink():
+            n += 1
+            kept = path.with_name(f"{path.stem}.kept-{stamp}-{n}{path.suffix}")
+        os.rename(path, kept)
+        print(f"spindle-verify: moved {path} aside to {kept} (--force)", file=sys.stderr)
+    atomic_write(path, write)
+    files = {**_files_written(path.parent), path.name: _sha256(path)}
+    text = json.dumps({"format": MANIFEST_FORMAT, "written_by": "spindle-verify",
+                       "note": "single files spindle-verify wrote into this folder; a later run "
+                               "replaces these and refuses (or with --force moves aside) any "
+                               "other file", "files": files}, indent=1) + "\n"
+    atomic_write(path.parent / FILE_MARKER, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
 @contextmanager

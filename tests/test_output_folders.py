@@ -253,3 +253,64 @@ def test_sigterm_during_a_cli_run_exits_130_and_writes_nothing(tmp_path):
     assert _hidden(tmp_path) == []
     if code == 130:
         assert not out.exists()
+
+
+def test_a_single_output_file_replaces_its_own_and_refuses_the_users(tmp_path):
+    """synth's run and a baseline are single files, often written into a folder of the
+    user's: an existing file there is replaced only if spindle-verify wrote it (its folder's
+    record of names and SHA-256), never an input; with force a file of the user's is moved
+    aside, not deleted."""
+    from spindle.outputs import FILE_MARKER, check_output_file, write_output_file
+
+    mine = tmp_path / "run.csv"
+    mine.write_text("user data\n")
+    with pytest.raises(InputError) as err:
+        check_output_file(mine)
+    assert err.value.problem.field == "--out" and "--force" in str(err.value)
+    with pytest.raises(InputError):
+        write_output_file(mine, lambda p: p.write_text("new\n"))
+    assert mine.read_text() == "user data\n"
+    with pytest.raises(InputError, match="is the input"):
+        check_output_file(mine, inputs=[mine], force=True)
+    write_output_file(mine, lambda p: p.write_text("new\n"), force=True)
+    (kept,) = tmp_path.glob("run.kept-*.csv")
+    assert kept.read_text() == "user data\n" and mine.read_text() == "new\n"
+    assert (tmp_path / FILE_MARKER).is_file()
+    check_output_file(mine)  # its own now: replaced without force
+    write_output_file(mine, lambda p: p.write_text("newer\n"))
+    assert mine.read_text() == "newer\n" and len(list(tmp_path.glob("run.kept-*"))) == 1
+    mine.write_text("edited by the user\n")
+    with pytest.raises(InputError, match="edited since"):
+        check_output_file(mine)
+    with pytest.raises(InputError, match="is a folder"):
+        check_output_file(tmp_path)
+
+
+def test_synth_and_baseline_never_write_over_a_users_file(tmp_path, capsys):
+    """synth once replaced its own --cycle file with the run it made from it, and synth and
+    baseline replaced any file at --out (a read-only bench export included)."""
+    from compare.cli import main
+
+    cycle = tmp_path / "steps.csv"
+    cycle.write_text("speed_rpm,duration_s,load_torque_Nm\n1000,3600,0\n4300,3600,10\n")
+    export = tmp_path / "export.csv"
+    export.write_text("time_s,T1_C\n0,20\n")
+    export.chmod(0o444)
+    quick = ["--level", "0", "--quiet"]
+    assert main(["synth", "--cycle", str(cycle), "--out", str(cycle), *quick]) == 2
+    assert main(["synth", "--cycle", str(cycle), "--out", str(export), *quick]) == 2
+    assert "did not write it" in capsys.readouterr().err
+    assert cycle.read_text().startswith("speed_rpm,duration_s") and export.stat().st_size == 17
+    assert main(["synth", "--cycle", str(cycle), "--out", str(export), "--force", *quick]) == 0
+    (kept,) = tmp_path.glob("export.kept-*.csv")
+    assert kept.read_text() == "time_s,T1_C\n0,20\n"
+    assert export.read_text().startswith("# spindle: spl2782")
+    assert main(["synth", "--cycle", str(cycle), "--out", str(export), "--seed", "1",
+                 *quick]) == 0  # its own run: replaced
+    base = tmp_path / "base.json"
+    base.write_text("{}\n")
+    args = ["baseline", "fin-shaft", "--steady-only", "--nodes", "5", "--out", str(base),
+            "--quiet"]
+    assert main(args) == 2 and base.read_text() == "{}\n"
+    assert main([*args, "--force"]) == 0 and main(args) == 0
+    assert len(list(tmp_path.glob("base.kept-*.json"))) == 1

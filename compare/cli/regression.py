@@ -17,7 +17,6 @@ from compare.cli.common import (
     add_spec,
     with_progress,
 )
-from spindle.errors import InputError
 
 if TYPE_CHECKING:
     from compare.progress import Progress
@@ -26,21 +25,18 @@ if TYPE_CHECKING:
 @with_progress("baseline")
 def _cmd_baseline(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.regression import make_baseline
-    from spindle.outputs import atomic_write
+    from spindle.outputs import check_output_file, write_output_file
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)  # validates before the long run
-    out = Path(args.out)
-    if out.exists() and out.is_dir():
-        raise InputError(str(out), "--out", "is a folder", "give a file name, e.g. baseline.json")
-    if out.resolve() == Path(spec.path).resolve():
-        raise InputError(str(out), "--out", "would overwrite the spec", "choose another file")
+    out = check_output_file(args.out, [spec.path] if Path(spec.path).is_file() else [],
+                            args.force)
     settings = {"levels": sorted(set(args.levels)), "nodes": sorted(set(args.nodes)),
                 "dt_s": args.dt, "transient": not args.steady_only}
     tolerances = {"temperature_K": args.tol_temp, "growth_um": args.tol_growth}
     doc = make_baseline(args.spec, settings, tolerances, progress.say)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write(out, lambda tmp: tmp.write_text(json.dumps(doc, indent=1) + "\n", "utf-8"))
+    write_output_file(out, lambda tmp: tmp.write_text(json.dumps(doc, indent=1) + "\n", "utf-8"),
+                      force=args.force)
     progress.done()
     print(f"{spec.name}: {len(doc['figures'])} figures in {doc['created_with_runtime_s']:.1f} s; "
           f"wrote {out}")
@@ -70,7 +66,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     bp = subparsers.add_parser("baseline", help="store the figures of a study (values, errors, "
                         "tolerances) as JSON for regression checks")
     add_spec(bp)
-    bp.add_argument("--out", required=True, help="the JSON file to write")
+    bp.add_argument("--out", required=True, help="the JSON file to write; a run replaces what "
+                    "an earlier run wrote there and refuses a file of yours")
+    bp.add_argument("--force", action="store_true", help="write over a file at --out that "
+                    "spindle-verify did not write: it is moved aside to "
+                    "'<name>.kept-<time>.json', never deleted")
     bp.add_argument("--levels", type=MESH_LEVEL, nargs="+", default=[0, 1, 2],
                     help="FEM levels, three or more (default 0 1 2)")
     bp.add_argument("--nodes", type=NODE_COUNT, nargs="+", default=[5, 11],

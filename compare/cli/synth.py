@@ -26,14 +26,21 @@ def _cmd_synth(args: argparse.Namespace, progress: Progress) -> int:
     if bad:
         raise InputError("command line", "--effect", f"unknown effect '{bad[0]}'",
                          f"use one of {', '.join(known)}")
+    from functools import partial
+
+    from spindle.outputs import check_output_file, write_output_file
+
     out = Path(args.out)
     if out.suffix.lower() != ".csv":
         raise InputError(str(out), "--out", "is not a .csv file name", "give e.g. run.csv")
+    inputs = [p for p in (args.cycle, spec.path) if p and Path(p).is_file()]
+    for path in (out, out.with_suffix(".truth.json")):
+        check_output_file(path, inputs, args.force)
     progress.stage(f"FEM level {args.level} run of '{args.cycle}' with "
                    f"{' and '.join(args.effect)}")
     effects = args.effect[0] if len(args.effect) == 1 else args.effect
     truth = synth(spec, args.cycle, effects, args.seed, out, level=args.level,
-                  mismatch=args.mismatch)
+                  mismatch=args.mismatch, write=partial(write_output_file, force=args.force))
     progress.done()
     print(f"wrote {out} and {out.with_suffix('.truth.json')} (effect {truth['effect']}, "
           f"seed {truth['seed']})")
@@ -67,6 +74,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     help="make the data with a spindle that differs from the spec (films, "
                          "contacts, axial length, friction, loss split, FEM level; drawn from "
                          "the seed and recorded in the truth; docs/fit.md)")
-    sy.add_argument("--out", required=True, help="the CSV to write")
+    sy.add_argument("--out", required=True, help="the CSV to write (and RUN.truth.json beside "
+                    "it); a run replaces what an earlier run wrote there and refuses a file of "
+                    "yours")
+    sy.add_argument("--force", action="store_true", help="write over a file at --out that "
+                    "spindle-verify did not write: it is moved aside to "
+                    "'<name>.kept-<time>.csv', never deleted")
     add_quiet(sy)
     sy.set_defaults(func=_cmd_synth)

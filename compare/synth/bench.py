@@ -224,8 +224,10 @@ def bench_rows(t_model: np.ndarray, ch: dict[str, np.ndarray], case: LoadCase, p
 
 def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, out_csv: Path,
           level: int = 1, dt_s: float = 60.0, mismatch: bool = False,
-          truths: dict[str, dict] | None = None) -> dict:
-    """Write the synthetic run and its truth sidecar; returns the truth.
+          truths: dict[str, dict] | None = None, write=None) -> dict:
+    """Write the synthetic run and its truth sidecar; returns the truth. ``write(path,
+    fill)`` writes each (default :func:`spindle.outputs.atomic_write`; the command line's
+    refuses a file of the user's).
 
     ``effect``: ``clean``, an effect of the library, a cause outside it (compare.synth.outside),
     or several of them (a list: injected together). Their sizes are drawn from the seed
@@ -305,9 +307,10 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
                               for h, v in zip(header, row, strict=True)))
     out_csv = Path(out_csv)
     out_csv.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write(out_csv, lambda tmp: tmp.write_text("\n".join(lines) + "\n", "utf-8"))
+    write = write or atomic_write
+    write(out_csv, lambda tmp: tmp.write_text("\n".join(lines) + "\n", "utf-8"))
     sidecar = out_csv.with_suffix(".truth.json")
-    atomic_write(sidecar, lambda tmp: tmp.write_text(json.dumps(truth, indent=2) + "\n", "utf-8"))
+    write(sidecar, lambda tmp: tmp.write_text(json.dumps(truth, indent=2) + "\n", "utf-8"))
     return truth
 
 
