@@ -72,6 +72,23 @@ def _in_range(value, bounds: Sequence[float] | None, where: tuple[str, str],
     return value
 
 
+def _windows_increase(value, hint, where: tuple[str, str]) -> None:
+    """Each window (a pair [from, to] of floats) in ``value`` (of type ``hint``; arrays and
+    tables searched) has from < to: InputError."""
+    args = typing.get_args(hint)
+    if args == (float, float):
+        if not value[0] < value[1]:
+            raise InputError(*where, f"is {list(value)}, a window that does not increase",
+                             "give [from, to] with from < to")
+    elif typing.get_origin(hint) is tuple and Ellipsis in args:
+        for v in value:
+            _windows_increase(v, args[0], where)
+    elif is_dataclass(hint):
+        hints = typing.get_type_hints(hint)
+        for k, h in hints.items():
+            _windows_increase(getattr(value, k), h, where)
+
+
 def _from_table(cls):
     """Each annotated entry of ``cls`` becomes a field whose default, unit and reason are the
     table's; an entry with a value in the code (one shared with another module) keeps it."""
@@ -177,11 +194,31 @@ class Criteria:
 
     @classmethod
     def checked(cls, name: str, value, where: tuple[str, str] | None = None):
-        """``value`` for the entry ``name`` if the table's range allows it and does not
-        exclude it, else InputError at ``where`` (file, field; default criteria, name)."""
+        """``value`` for the entry ``name`` if the table allows it, else InputError at
+        ``where`` (file, field; default criteria, name): a number in the entry's range
+        (each number of an array too) and not one it excludes; an array not empty; a window
+        [from, to] with from < to; a part role one a spec knows."""
         meta = {f.name: f for f in fields(cls)}[name].metadata
-        return _in_range(value, cls.range_of(name), where or ("criteria", name),
-                         meta["excluded"])
+        where = where or ("criteria", name)
+        if isinstance(value, tuple):
+            if not value:
+                raise InputError(*where, "is empty", "give at least one value, as the table "
+                                 "compare/fit/criteria.toml does")
+            if meta["unit"] == "part roles":
+                from spindle.spec import ROLES
+
+                unknown = [v for v in value if v not in ROLES]
+                if unknown:
+                    raise InputError(*where, f"names the unknown role {unknown[0]!r}",
+                                     f"use roles of {', '.join(ROLES)}")
+            hint = typing.get_type_hints(cls)[name]
+            _windows_increase(value, hint, where)
+            if typing.get_args(hint) != (float, float) and all(
+                    isinstance(v, int | float) for v in value):
+                for v in value:
+                    _in_range(v, cls.range_of(name), where, meta["excluded"])
+            return value
+        return _in_range(value, cls.range_of(name), where, meta["excluded"])
 
     def with_options(self, **values) -> Criteria:
         """These criteria with some entries set (None leaves one as it is), range-checked."""
