@@ -357,3 +357,16 @@ def test_the_lumped_model_refuses_two_films_on_one_boundary_as_the_fem_does(tmp_
             make()
         (p,) = exc.value.problems
         assert p.field == "surfaces.draft" and "same boundary as 'housing_outer'" in p.message
+
+
+def test_a_warning_about_the_input_is_one_line_naming_the_input(tmp_path):
+    """A bench column in another unit is kept aside with a warning; it was printed in
+    Python's form, with the path and line of the tool's source that raised it."""
+    bench = tmp_path / "run.csv"
+    bench.write_text("time_s,speed_rpm,power_kW,T_env_C,T_coolant_C,T1_K,T2_C,T_stator_C,P1_um\n"
+                     "0,0,0,20,20,293.15,20,20,0\n60,0,0,20,20,293.15,20,20,0\n")  # too short
+    r = run("fit", str(bench), "--out", str(tmp_path / "o"))
+    assert r.returncode == 2
+    line = next(x for x in r.stderr.splitlines() if "T1_K" in x)
+    assert line.startswith("spindle-verify: warning: ") and str(bench) in line, r.stderr
+    assert ".py:" not in r.stderr and "Traceback" not in r.stderr

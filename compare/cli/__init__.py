@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 from typing import NoReturn
 
 from spindle.errors import InputError, SpindleVerifyError
@@ -102,6 +103,17 @@ def _terminate(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
+_PYTHON_FORMAT = warnings.formatwarning
+
+
+def _format_warning(message, category, filename, lineno, line=None) -> str:
+    """The tool's own warnings (about the user's input) as one line naming the input, not
+    the source line that raised them; any other warning as Python shows it."""
+    if category.__module__.split(".")[0] in ("spindle", "compare", "lumped", "reference"):
+        return f"spindle-verify: warning: {message}\n"
+    return _PYTHON_FORMAT(message, category, filename, lineno, line)
+
+
 def main(argv: list[str] | None = None) -> int:
     try:
         args = build_parser().parse_args(argv)
@@ -112,6 +124,7 @@ def main(argv: list[str] | None = None) -> int:
 
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminate)
+    warnings.formatwarning = _format_warning
     try:
         _check_args(args)
         return args.func(args)
