@@ -44,3 +44,20 @@ class InputError(SpindleVerifyError):
 
 class SolverError(SpindleVerifyError):
     """The numerical problem cannot be solved as posed (for example, it is singular)."""
+
+
+#: set once the user asked the run to stop (the command line's SIGTERM and SIGINT): no output
+#: is put in place after that (spindle.outputs), even where the KeyboardInterrupt the signal
+#: raised was lost (Python ignores an exception raised in a finalizer or a weakref callback)
+STOP = {"requested": False}
+
+
+def request_stop() -> None:
+    """Refuse to put any output in place from now on (:func:`stop_if_requested`)."""
+    STOP["requested"] = True
+
+
+def stop_if_requested() -> None:
+    """KeyboardInterrupt if the user asked the run to stop."""
+    if STOP["requested"]:
+        raise KeyboardInterrupt

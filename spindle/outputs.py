@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from spindle.errors import InputError
+from spindle.errors import InputError, stop_if_requested
 
 _UMASK = os.umask(0)
 os.umask(_UMASK)
@@ -40,13 +40,14 @@ def expect_pictures(n: int) -> None:
 
 def atomic_write(path: Path, write) -> None:
     """Call ``write(tmp_path)`` and move the result into ``path`` in one step (a PNG is
-    reported to :data:`PICTURE_LISTENERS`)."""
+    reported to :data:`PICTURE_LISTENERS`); not after the user asked the run to stop."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:
         write(Path(tmp))
         os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; outputs are ordinary files
+        stop_if_requested()
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
@@ -308,6 +309,7 @@ def output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
         yield tmp  # no input lies inside path (check_output_dir), so none is replaced
         _write_manifest(tmp)
         os.chmod(tmp, 0o777 & ~_UMASK)  # mkdtemp makes 0700; outputs are ordinary folders
+        stop_if_requested()
         _replace_folder(tmp, path, force)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

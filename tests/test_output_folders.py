@@ -314,3 +314,26 @@ def test_synth_and_baseline_never_write_over_a_users_file(tmp_path, capsys):
     assert main(args) == 2 and base.read_text() == "{}\n"
     assert main([*args, "--force"]) == 0 and main(args) == 0
     assert len(list(tmp_path.glob("base.kept-*.json"))) == 1
+
+
+def test_nothing_is_put_in_place_once_the_user_asked_the_run_to_stop(tmp_path, monkeypatch):
+    """A SIGTERM's KeyboardInterrupt raised inside a finalizer is lost (Python prints
+    'Exception ignored' and goes on): a fit told to stop so once wrote its whole output
+    folder. The signal handler also records the request, and no output folder or file is
+    put in place after it."""
+    import signal as signals
+
+    from compare.cli import _terminate
+    from spindle import errors
+    from spindle.outputs import atomic_write
+
+    monkeypatch.setitem(errors.STOP, "requested", False)
+    with pytest.raises(KeyboardInterrupt):
+        _terminate(signals.SIGTERM, None)
+    assert errors.STOP["requested"]
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt), output_dir(out) as tmp:
+        (tmp / "report.json").write_text("{}")
+    with pytest.raises(KeyboardInterrupt):
+        atomic_write(tmp_path / "one.json", lambda p: p.write_text("{}"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == []

@@ -12,7 +12,7 @@ import sys
 import warnings
 from typing import NoReturn
 
-from spindle.errors import InputError, SpindleVerifyError
+from spindle.errors import InputError, SpindleVerifyError, request_stop
 
 
 def package_version() -> str:
@@ -99,7 +99,9 @@ def _check_args(args: argparse.Namespace) -> None:
 
 
 def _terminate(signum: int, frame: object) -> None:
-    """SIGTERM as Ctrl-C: unwind, so that the temporary output folder is removed."""
+    """SIGTERM as Ctrl-C: unwind, so that the temporary output folder is removed; and put
+    no output in place even if this KeyboardInterrupt is lost (spindle.errors.STOP)."""
+    request_stop()
     raise KeyboardInterrupt
 
 
@@ -124,6 +126,8 @@ def main(argv: list[str] | None = None) -> int:
 
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminate)
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            signal.signal(signal.SIGINT, _terminate)
     warnings.formatwarning = _format_warning
     try:
         _check_args(args)
