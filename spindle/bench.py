@@ -62,6 +62,10 @@ T_MIN_C = -60.0
 T_KELVIN_MEDIAN_C = 150.0
 T_KELVIN_MAX_C = 250.0
 POWER_LIMIT_KW = POWER_MAX_KW
+#: |P1| [um] beyond which a reading is not a spindle's thermal growth: tens of um (the
+#: SPL2782's 80 um at its nominal point, the peer's runs below 30 um); 5 mm is a broken
+#: sensor or a value in nm
+P1_LIMIT_UM = 5000.0
 #: What a fit needs: rows with at least one measured channel, and their time span [s].
 MIN_ROWS = 50
 MIN_SPAN_S = 1800.0
@@ -547,7 +551,8 @@ def _is_number(s: str) -> bool:
 
 def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error: _ErrorFor) -> None:
     """Temperatures in °C (not kelvin, >= -60 °C), speed 0..100 000 rpm, power within
-    ±1000 kW, load torque within ±10 000 N m; the first offending line is named."""
+    ±1000 kW, P1 within ±5 mm, load torque within ±10 000 N m; the first offending line is
+    named."""
 
     def first(mask: np.ndarray) -> int:
         return int(line_no[np.flatnonzero(mask)[0]])
@@ -587,6 +592,14 @@ def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error:
         raise error(f"power_kW (line {first(big)})", f"{p[big][0]:g} kW is outside "
                     f"±{POWER_LIMIT_KW:g} kW", "export the electrical power in kW (a value in W is "
                     "1000 times too large)")
+    g = columns.get(CHANNEL_COLUMNS["P1"])
+    if g is not None:
+        big = np.abs(np.nan_to_num(g)) > P1_LIMIT_UM
+        if big.any():
+            raise error(f"{CHANNEL_COLUMNS['P1']} (line {first(big)})", f"{g[big][0]:g} um is "
+                        f"beyond ±{P1_LIMIT_UM:g} um, far more than a spindle grows thermally",
+                        "export the axial growth in um (a value in nm is 1000 times too large); "
+                        "leave the cell empty where the sensor did not measure")
     m = columns.get("load_torque_Nm")
     if m is not None:
         big = np.abs(np.nan_to_num(m)) > TORQUE_MAX_NM

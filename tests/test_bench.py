@@ -203,6 +203,9 @@ ERRORS = [
      "outside ±1000 kW"),
     ("power very negative", HEADER, lambda ls: ls[:7] + [row(420, power="-1500")] + ls[8:],
      "power_kW (line 9)", "outside ±1000 kW"),
+    # a growth of 6500 um is no spindle's: nm exported as um (found by fuzzing: 1e12 passed)
+    ("P1 in nm", HEADER, lambda ls: ls[:7] + [row(420, p1="6500")] + ls[8:], "P1_um (line 9)",
+     "beyond ±5000 um"),
     ("too few rows", HEADER, lambda ls: [row(i * 60.0, speed="1") for i in range(40)], "rows",
      "40 rows with a measured channel"),
     ("too short", HEADER, lambda ls: [row(i * 10.0, speed="1") for i in range(100)], "rows",
