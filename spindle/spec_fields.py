@@ -255,7 +255,8 @@ class FieldReader:
                      f"give only {', '.join(needs[name])} (and factor)")
             return None
         n0 = len(self.problems)
-        args = [self.number(d, k, path, "SI", lo=0.0, lo_open=True) for k in needs[name]]
+        args = [self.number(d, k, path, "l/min" if k == "flow_l_min" else "m", lo=0.0,
+                            lo_open=True) for k in needs[name]]
         factor = self.number(d, "factor", path, "-", required=False, default=1.0, lo=0.0,
                              lo_open=True)
         if len(self.problems) > n0:

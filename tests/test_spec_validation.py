@@ -164,6 +164,11 @@ def test_film_from_a_correlation(tmp_path):
                        'h_W_m2K = { correlation = "rotating_shaft", d_m = 1e300 }')
     assert any(p.field == "surfaces[0].h_W_m2K" and "overflows" in p.message
                for p in problems(tmp_path, bad))
+    # a parameter's unit is its name's (it was "SI")
+    bad = GOOD.replace("h_W_m2K = 10.0", 'h_W_m2K = { correlation = "coolant_channel", '
+                       'flow_l_min = -6.0, width_m = 0.006, height_m = 0.01 }')
+    (p,) = [p for p in problems(tmp_path, bad) if p.field.endswith("flow_l_min")]
+    assert "-6 l/min" in p.message and "l/min" in p.fix and "SI" not in str(p)
 
 
 def test_python_api_takes_a_spec_name_or_path():
