@@ -283,6 +283,11 @@ def _check_steps_header(f: _File, header: list[str], hline: int) -> None:
     if len(header) == 1 and ";" in header[0]:
         raise f.error(f"header (line {hline})", "the columns are separated by ';'",
                       "export comma-separated values with '.' as the decimal separator")
+    if "time_s" in header and "duration_s" not in header:
+        raise f.error(f"time_s (line {hline})", "this is a time series of loads, and a cycle "
+                      "here is a table of steps", "give a step table (header: "
+                      f"{','.join(_CSV_REQUIRED + _CSV_OPTIONAL)}); 'spindle-verify solve "
+                      "--cycle' runs a time series")
     for col in _CSV_REQUIRED:
         if col not in header:
             raise f.error(col, f"required column is missing from the header (line {hline})",

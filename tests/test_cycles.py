@@ -212,6 +212,16 @@ def test_csv_defaults(tmp_path):
     assert c.T_ambient_K == c.T_coolant_K == TimeSeries.constant(20.0 + K0)
 
 
+def test_a_time_series_given_for_a_step_cycle_is_named_as_one(tmp_path):
+    """synth takes a cycle of steps; given a time series (which solve --cycle runs) it asked
+    for a duration_s column."""
+    p = write(tmp_path, "ts.csv", "time_s,speed_rpm,T_env_C\n0,4300,20\n60,4300,20\n")
+    with pytest.raises(InputError) as err:
+        load_cycle(p)
+    assert err.value.problem.field.startswith("time_s") and "time series" in str(err.value)
+    assert "solve --cycle" in err.value.problem.fix
+
+
 def test_toml_table_and_generator_temperatures(tmp_path):
     p = write(tmp_path, "t.toml", """\
         [cycle]
