@@ -190,7 +190,10 @@ def _decode(raw: bytes, name: str) -> str:
 
 def _parse_floats(cells: tuple[str, ...] | list[str]) -> tuple[np.ndarray | None, int]:
     """Cells -> float array with NaN for empty cells (and 'nan'); (None, index) at the first
-    cell that is not a number."""
+    cell that is not a number (:func:`_is_number`)."""
+    sep = next((k for k, c in enumerate(cells) if "_" in c), -1)
+    if sep >= 0:
+        return None, sep
     try:
         return np.array(cells, dtype=float), -1
     except ValueError:
@@ -249,7 +252,8 @@ class _Table:
 
     def _fast(self, text: str, header: list[str]) -> bool:
         """Try the fast path; False leaves the table to the csv module."""
-        if '"' in text or any(ln.count(",") != self.ncol - 1 for ln in self.body):
+        if ('"' in text or "_" in text  # numpy, as Python, reads 1_0 as 10
+                or any(ln.count(",") != self.ncol - 1 for ln in self.body)):
             return False
         first = self.body[0].split(",")
         text_cols = [j for j, c in enumerate(first) if c.strip() and not _is_number(c)]
@@ -542,6 +546,8 @@ def _check_enough_data(t: np.ndarray, columns: dict[str, np.ndarray], channels: 
 
 
 def _is_number(s: str) -> bool:
+    if "_" in s:  # Python's float reads 1_0 as 10; no bench exports digit separators
+        return False
     try:
         float(s)
     except ValueError:

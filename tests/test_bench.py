@@ -203,6 +203,9 @@ ERRORS = [
      "outside ±1000 kW"),
     ("power very negative", HEADER, lambda ls: ls[:7] + [row(420, power="-1500")] + ls[8:],
      "power_kW (line 9)", "outside ±1000 kW"),
+    # Python's float reads 1_0 as 10 (found by fuzzing: it passed as a number)
+    ("cell underscore", HEADER, lambda ls: ls[:20] + [row(1200, t1="2_2")] + ls[21:], "T1_C (line 22)",
+     "'2_2' is not a number"),
     # a growth of 6500 um is no spindle's: nm exported as um (found by fuzzing: 1e12 passed)
     ("P1 in nm", HEADER, lambda ls: ls[:7] + [row(420, p1="6500")] + ls[8:], "P1_um (line 9)",
      "beyond ±5000 um"),
