@@ -79,11 +79,12 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _manifest(folder: Path) -> dict[str, str]:
-    """What the marker of ``folder`` says the tool wrote (relative POSIX path -> SHA-256); empty
-    for a marker of an older version (plain text) or none."""
+def _manifest(folder: Path, marker: str = MARKER) -> dict[str, str]:
+    """What the marker of ``folder`` (:data:`MARKER`, or :data:`FILE_MARKER` for single files)
+    says the tool wrote (relative POSIX path -> SHA-256); empty for a marker of an older
+    version (plain text) or none."""
     try:
-        data = json.loads((folder / MARKER).read_text(encoding="utf-8"))
+        data = json.loads((folder / marker).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError):
         return {}
     files = data.get("files") if isinstance(data, dict) else None
@@ -216,21 +217,12 @@ def _clean_leftovers(parent: Path, name: str) -> None:
 FILE_MARKER = ".spindle-verify-files"
 
 
-def _files_written(folder: Path) -> dict[str, str]:
-    try:
-        data = json.loads((folder / FILE_MARKER).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
-        return {}
-    files = data.get("files") if isinstance(data, dict) else None
-    return {str(k): str(v) for k, v in files.items()} if isinstance(files, dict) else {}
-
-
 def _foreign_file(path: Path) -> bool:
     """``path`` exists and is not a file spindle-verify wrote (or it was edited since)."""
     if not (path.exists() or path.is_symlink()):
         return False
     return (path.is_symlink() or not path.is_file()
-            or _files_written(path.parent).get(path.name) != _sha256(path))
+            or _manifest(path.parent, FILE_MARKER).get(path.name) != _sha256(path))
 
 
 def _refuse_file(path: Path, option: str) -> InputError:
@@ -278,7 +270,7 @@ def write_output_file(path: str | Path, write: Callable[[Path], Any], force: boo
         os.rename(path, kept)
         print(f"spindle-verify: moved {path} aside to {kept} (--force)", file=sys.stderr)
     atomic_write(path, write)
-    files = {**_files_written(path.parent), path.name: _sha256(path)}
+    files = {**_manifest(path.parent, FILE_MARKER), path.name: _sha256(path)}
     text = json.dumps({"format": MANIFEST_FORMAT, "written_by": "spindle-verify",
                        "note": "single files spindle-verify wrote into this folder; a later run "
                                "replaces these and refuses (or with --force moves aside) any "
