@@ -149,6 +149,9 @@ def check_output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
     ``force``) a folder holding anything spindle-verify did not write there
     (:func:`foreign_files`)."""
     path = Path(path)
+    if path.is_symlink():  # replacing it would put a folder where the user's link was
+        raise InputError(str(path), "--out", f"is a link (to {os.readlink(path)})",
+                         "give the folder it points to, or a new folder")
     if path.exists() and not path.is_dir():
         raise InputError(str(path), "--out", "is a file, not a folder",
                          "give a folder for the outputs")

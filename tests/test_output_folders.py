@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from spindle.errors import InputError
-from spindle.outputs import MARKER, output_dir
+from spindle.outputs import MARKER, check_output_dir, output_dir
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -337,3 +337,29 @@ def test_nothing_is_put_in_place_once_the_user_asked_the_run_to_stop(tmp_path, m
     with pytest.raises(KeyboardInterrupt):
         atomic_write(tmp_path / "one.json", lambda p: p.write_text("{}"))
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_a_link_as_the_output_folder_is_refused(tmp_path):
+    """A link given as --out was replaced by a folder (the user's link gone, nothing in its
+    target, a hidden folder left beside it)."""
+    target = tmp_path / "target"
+    target.mkdir()
+    link = tmp_path / "link"
+    link.symlink_to(target)
+    with pytest.raises(InputError, match="is a link"):
+        check_output_dir(link, force=True)
+    assert link.is_symlink() and sorted(p.name for p in tmp_path.iterdir()) == ["link", "target"]
+
+
+@pytest.mark.parametrize("command", [["rom", "fin-shaft", "--level", "0", "--held-out"],
+                                     ["sensors", "fin-shaft", "--level", "0", "--cases"]])
+def test_a_cycle_file_given_is_an_input_even_with_force(tmp_path, capsys, command):
+    """rom's and sensors' cycle files were not counted as inputs: --force moved one out of
+    the --out folder that held it."""
+    from compare.cli import main
+
+    cycle = tmp_path / "c.toml"
+    cycle.write_text('[cycle]\nsteps = [{ speed_rpm = 2000, duration_h = 1 }]\n')
+    assert main([*command, str(cycle), "--out", str(tmp_path), "--force", "--quiet"]) == 2
+    assert "holds the input" in capsys.readouterr().err
+    assert cycle.is_file() and not list(tmp_path.parent.glob(f"{tmp_path.name}.kept-*"))

@@ -81,6 +81,21 @@ def out_folder(out: str | None, default: str, inputs: list, force: bool = False)
     return check_output_dir(Path(out) if out else Path(default), inputs, force)
 
 
+def input_files(*texts: str | None) -> list[str]:
+    """The files among command-line values (a cycle given as ``FILE`` or ``FILE:SEED``): an
+    output folder must not hold them, and ``--force`` must not move them aside."""
+    from pathlib import Path
+
+    out = []
+    for text in texts:
+        if text:
+            for name in (text, text.rpartition(":")[0]):
+                if name and Path(name).is_file():
+                    out.append(name)
+                    break
+    return out
+
+
 def add_no_pictures(parser: argparse.ArgumentParser, what: str = "PNGs") -> None:
     """``--no-pictures``: skip the figures (``what`` names them in the help)."""
     parser.add_argument("--no-pictures", action="store_true", help=f"skip the {what}")

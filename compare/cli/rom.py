@@ -14,6 +14,7 @@ from compare.cli.common import (
     add_out,
     add_quiet,
     add_spec,
+    input_files,
     number,
     out_folder,
     pass_fail,
@@ -51,7 +52,8 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/rom", [spec.path], force=args.force)
+    inputs = [spec.path, *input_files(args.cycle, *args.held_out)]
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/rom", inputs, force=args.force)
     _check_cycles([args.cycle, *args.held_out])
     study = rom_study(spec, args.level, args.cycle, args.held_out, args.dt, args.tol_temp,
                       args.tol_growth, args.safety, progress.say)
@@ -59,7 +61,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     top = max(study.report.speeds_rpm)
     speeds = [k * args.export_speed_step for k in range(int(top // args.export_speed_step) + 1)]
     pred = ROMPredictor(rom, args.sample_time)
-    with output_dir(out, inputs=[spec.path], force=args.force) as tmp, progress.pictures():
+    with output_dir(out, inputs=inputs, force=args.force) as tmp, progress.pictures():
         files = study.save(tmp, pictures=not args.no_pictures)
         files += export(pred, speeds, tmp / "controller", drive=drive_for(spec))
     progress.done()

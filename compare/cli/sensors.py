@@ -11,6 +11,7 @@ from compare.cli.common import (
     POSITIVE,
     TIME_STEP_S,
     add_out,
+    input_files,
     number,
     out_folder,
     with_progress,
@@ -38,7 +39,8 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", [spec.path], force=args.force)
+    inputs = [spec.path, *input_files(*(args.cases or []), args.rank_case)]
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", inputs, force=args.force)
     say = progress.say
     cases = load_cases(spec, args.cases) if args.cases else None
     if args.rank is not None and args.rank < 1:
@@ -53,7 +55,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
             f"(dt {args.rank_dt:g} s)")
         ranking = rank_sensors(spec, rank_case, args.rank, args.candidates, None, args.method,
                                args.rank_level, args.rank_dt, args.tol_temp, args.tol_growth)
-    with output_dir(out, inputs=[spec.path], force=args.force) as tmp, progress.pictures():
+    with output_dir(out, inputs=inputs, force=args.force) as tmp, progress.pictures():
         files = choice.save(tmp, pictures=not args.no_pictures)
         if ranking is not None:
             files += ranking.save(tmp, pictures=not args.no_pictures)
