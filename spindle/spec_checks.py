@@ -148,9 +148,6 @@ def _check_sensors_inside(r: FieldReader, sensors: list[Sensor],
                           secs: list[tuple[Part, int, Section]]) -> None:
     """Every sensor point lies in a part. An array's sensors outside have one cause, its
     radius: one problem per array, not one per sensor."""
-    if not any(s.kind == "temperature" for s in sensors):  # every model is compared there
-        r.add("sensors", "the spec has no temperature sensor", "add [[sensors]] with kind = "
-              '"temperature", or a [[sensor_arrays]] along a part (docs/spec.md)')
     outside_of_array: dict[str, list[Sensor]] = {}
     for s in sensors:
         pts = [(s.z, s.r)] + ([(s.z_ref, s.r_ref)] if s.kind == "axial_displacement" else [])

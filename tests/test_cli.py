@@ -370,3 +370,18 @@ def test_a_warning_about_the_input_is_one_line_naming_the_input(tmp_path):
     line = next(x for x in r.stderr.splitlines() if "T1_K" in x)
     assert line.startswith("spindle-verify: warning: ") and str(bench) in line, r.stderr
     assert ".py:" not in r.stderr and "Traceback" not in r.stderr
+
+
+@pytest.mark.parametrize("command", [["solve", "--model", "lumped"], ["study", "--steady-only"],
+                                     ["sensors"], ["rom"], ["crosscheck"]])
+def test_a_spec_without_temperature_sensors_is_refused_where_models_are_compared(tmp_path,
+                                                                                command):
+    """These commands compare models at the spec's temperature sensors; a spec without any
+    stopped them with an internal error (found by fuzzing). measures and the library still
+    take such a spec (tests/data/uniform_body.toml, the analytic cases)."""
+    from compare.cli import main
+
+    spec = str(Path(__file__).parent / "data" / "uniform_body.toml")
+    out = tmp_path / "o"
+    assert main([command[0], spec, *command[1:], "--out", str(out), "--quiet"]) == 2
+    assert not out.exists()

@@ -81,6 +81,21 @@ def out_folder(out: str | None, default: str, inputs: list, force: bool = False)
     return check_output_dir(Path(out) if out else Path(default), inputs, force)
 
 
+def load_spec_with_sensors(name: str):
+    """The spec ``name`` (spindle.spec_reader.load_spec) for a command that compares models
+    at its temperature sensors: one without them is refused (it stopped such commands with
+    an internal error)."""
+    from spindle.errors import InputError
+    from spindle.spec_reader import load_spec
+
+    spec = load_spec(name)
+    if not spec.temperature_sensors():
+        raise InputError(spec.path, "sensors", "the spec has no temperature sensor, and this "
+                         "command compares the models there", "add [[sensors]] with kind = "
+                         '"temperature", or [[sensor_arrays]] along a part (docs/spec.md)')
+    return spec
+
+
 def input_files(*texts: str | None) -> list[str]:
     """The files among command-line values (a cycle given as ``FILE`` or ``FILE:SEED``): an
     output folder must not hold them, and ``--force`` must not move them aside."""

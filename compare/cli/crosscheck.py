@@ -11,6 +11,7 @@ from compare.cli.common import (
     add_quiet,
     add_spec,
     load_case_input,
+    load_spec_with_sensors,
     out_folder,
     with_progress,
 )
@@ -48,9 +49,8 @@ def _cmd_crosscheck(args: argparse.Namespace, progress: Progress) -> int:
     # imported here so that building the parser stays fast (compare/cli/common.py)
     from compare.crosscheck import crosscheck
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec_reader import load_spec
 
-    spec = load_spec(args.spec)
+    spec = load_spec_with_sensors(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/crosscheck", [spec.path], force=args.force)
     inputs: list[str] = []
     case = (None if args.case is None

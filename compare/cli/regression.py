@@ -15,6 +15,7 @@ from compare.cli.common import (
     TIME_STEP_S,
     add_quiet,
     add_spec,
+    load_spec_with_sensors,
     with_progress,
 )
 
@@ -26,9 +27,8 @@ if TYPE_CHECKING:
 def _cmd_baseline(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.regression import make_baseline
     from spindle.outputs import check_output_file, write_output_file
-    from spindle.spec_reader import load_spec
 
-    spec = load_spec(args.spec)  # validates before the long run
+    spec = load_spec_with_sensors(args.spec)  # validates before the long run
     out = check_output_file(args.out, [spec.path] if Path(spec.path).is_file() else [],
                             args.force)
     settings = {"levels": sorted(set(args.levels)), "nodes": sorted(set(args.nodes)),

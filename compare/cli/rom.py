@@ -15,6 +15,7 @@ from compare.cli.common import (
     add_quiet,
     add_spec,
     input_files,
+    load_spec_with_sensors,
     number,
     out_folder,
     pass_fail,
@@ -49,9 +50,8 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     from reference.rom.realtime import ROMPredictor
     from spindle.drive import drive_for
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec_reader import load_spec
 
-    spec = load_spec(args.spec)
+    spec = load_spec_with_sensors(args.spec)
     inputs = [spec.path, *input_files(args.cycle, *args.held_out)]
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/rom", inputs, force=args.force)
     _check_cycles([args.cycle, *args.held_out])

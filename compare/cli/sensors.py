@@ -12,6 +12,7 @@ from compare.cli.common import (
     TIME_STEP_S,
     add_out,
     input_files,
+    load_spec_with_sensors,
     number,
     out_folder,
     with_progress,
@@ -36,9 +37,8 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     """``spindle-verify sensors``: the node count, and with ``--rank K`` the sensor ranking.
     Returns the exit status (0; bad input raises :class:`spindle.errors.InputError`)."""
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec_reader import load_spec
 
-    spec = load_spec(args.spec)
+    spec = load_spec_with_sensors(args.spec)
     inputs = [spec.path, *input_files(*(args.cases or []), args.rank_case)]
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", inputs, force=args.force)
     say = progress.say

@@ -18,6 +18,7 @@ from compare.cli.common import (
     add_quiet,
     add_spec,
     load_case_input,
+    load_spec_with_sensors,
     number,
     out_folder,
     with_progress,
@@ -41,7 +42,6 @@ def _print_sensor_table(table: dict, title: str) -> None:
 def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.loads import TimeSeries
     from spindle.outputs import output_dir, safe_name
-    from spindle.spec_reader import load_spec
 
     if args.case and args.cycle:
         raise InputError("command line", "--case", "--case (a steady load point) and --cycle (a "
@@ -51,7 +51,7 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
                          "gives the transient its own speeds, so it would be ignored",
                          "drop --speed, or drop --cycle for a steady solve at that speed")
     progress.stage("reading the spec")
-    spec = load_spec(args.spec)
+    spec = load_spec_with_sensors(args.spec)
     inputs = [spec.path, *(x for x in (args.case, args.cycle) if x and Path(x).is_file())]
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/solve", inputs, force=args.force)
     t0 = time.perf_counter()

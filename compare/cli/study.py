@@ -15,6 +15,7 @@ from compare.cli.common import (
     add_out,
     add_quiet,
     add_spec,
+    load_spec_with_sensors,
     out_folder,
     pass_fail,
     with_progress,
@@ -32,9 +33,8 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.study import run_study
     from spindle.outputs import output_dir, safe_name
     from spindle.plots import levels_text
-    from spindle.spec_reader import load_spec
 
-    spec = load_spec(args.spec)
+    spec = load_spec_with_sensors(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/study", [spec.path], force=args.force)
     if args.workers < 1:
         raise InputError("command line", "--workers", f"{args.workers} is below 1",
