@@ -118,7 +118,8 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-complements-fresh": "fit-trade-complements-fresh.json",
           "trade-optimizer-tol": "fit-trade-optimizer-tol.json",
           "trade-optimizer-tol-held-out": "fit-trade-optimizer-tol-held-out.json",
-          "trade-exact-keys": "fit-trade-exact-keys.json"}
+          "trade-exact-keys": "fit-trade-exact-keys.json",
+          "trade-refit-exact-steps": "fit-trade-refit-exact-steps.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
@@ -159,14 +160,13 @@ def optimizer_tol_text() -> str:
         width=92)
 
 
-def exact_keys_text() -> str:
-    """docs/fit.md's figures of the exact cache keys, from the file compare_reports.py wrote
-    from rows (validation RMS moves and fit times)."""
+def exact_keys_text(name: str = "fit-trade-exact-keys.json") -> str:
+    """docs/fit.md's figures of a sample fitted again (the exact cache keys; the exact steps),
+    from the file compare_reports.py wrote from rows (validation RMS moves and fit times)."""
     import json
     import textwrap
 
-    d = json.loads((ROOT / "docs" / "figures" / "fit-trade-exact-keys.json")
-                   .read_text(encoding="utf-8"))
+    d = json.loads((ROOT / "docs" / "figures" / name).read_text(encoding="utf-8"))
     m, t = d["rms_moved"], d["fit_s"]
     return textwrap.fill(
         f"The validation RMS after moved by more than 0.001 (K or µm) on {m['over_0.001']} of "
@@ -180,6 +180,8 @@ def test_the_exact_keys_figures_are_their_file():
     from tests.docs_blocks import assert_block
 
     assert_block("docs/fit.md", "exact-keys-figures", exact_keys_text())
+    assert_block("docs/fit.md", "refit-exact-steps-figures",
+                 exact_keys_text("fit-trade-refit-exact-steps.json"))
 
 
 def test_the_optimizer_tolerance_figures_are_their_files():
