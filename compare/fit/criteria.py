@@ -13,80 +13,19 @@ from __future__ import annotations
 import math
 import tomllib
 import typing
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, fields, is_dataclass, replace
+from dataclasses import dataclass, field, fields, replace
 from importlib.resources import files
 from pathlib import Path
 
 from compare.fit.signatures import OnsetScale
 from spindle.bench_inputs import HOLD_STEPS, SPEED_BAND_REL, SPEED_BAND_RPM
 from spindle.errors import InputError
+from spindle.spec import ROLES
+from spindle.typed_values import conform, in_range
 
 TABLE_FILE = "criteria.toml"
-_FIX = "give it as the table compare/fit/criteria.toml does"
 #: the keys of an entry in the table's form
 _ENTRY_KEYS = {"value", "unit", "reason", "range", "excluded"}
-
-
-def _conform(value, hint, where: tuple[str, str]):
-    """``value`` as read from TOML, checked against the type ``hint`` and converted to it
-    (arrays to tuples, tables to the dataclass, an integer to a float where a float is
-    asked); ``where``: (file, entry) of the error message."""
-    origin, args = typing.get_origin(hint), typing.get_args(hint)
-    if origin is tuple:
-        kinds = [args[0]] * len(value) if Ellipsis in args and isinstance(value, list) else args
-        if not isinstance(value, list) or len(value) != len(kinds):
-            raise InputError(*where, f"is {value!r}, not an array" + (
-                "" if Ellipsis in args else f" of {len(args)} values"), _FIX)
-        return tuple(_conform(v, kind, where) for v, kind in zip(value, kinds, strict=True))
-    if is_dataclass(hint):
-        hints = typing.get_type_hints(hint)
-        if not isinstance(value, dict) or set(value) != set(hints):
-            raise InputError(*where, f"is {value!r}", f"give each of {', '.join(hints)}")
-        return hint(**{k: _conform(value[k], hints[k], where) for k in hints})
-    ok = (isinstance(value, bool) if hint is bool else
-          isinstance(value, int | float) and not isinstance(value, bool)
-          and math.isfinite(value) and (hint is float or isinstance(value, int))
-          if hint in (int, float) else isinstance(value, hint))
-    if not ok:
-        raise InputError(*where, f"is {value!r}, not a{'n' if hint is int else ''} "
-                         f"{hint.__name__}", _FIX)
-    return float(value) if hint is float else value
-
-
-def _in_range(value, bounds: Sequence[float] | None, where: tuple[str, str],
-              excluded: Mapping[str, str] | None = None):
-    """``value`` unless it is a number outside ``bounds`` (the entry's ``range``; default: not
-    negative, as each number of the table is a count, duration, level or share) or one the
-    entry's ``excluded`` names (value as text: why): InputError."""
-    lo, hi = bounds or (0, math.inf)
-    if not isinstance(value, int | float) or isinstance(value, bool):
-        return value
-    if not lo <= value <= hi:
-        raise InputError(*where, f"is {value}, outside {lo}..{hi}",
-                         "give a value in that range (compare/fit/criteria.toml)")
-    why = (excluded or {}).get(f"{value:g}")
-    if why:
-        raise InputError(*where, f"is {value}: {why}", f"give a value in {lo}..{hi} other "
-                         f"than {', '.join(excluded)} (compare/fit/criteria.toml)")
-    return value
-
-
-def _windows_increase(value, hint, where: tuple[str, str]) -> None:
-    """Each window (a pair [from, to] of floats) in ``value`` (of type ``hint``; arrays and
-    tables searched) has from < to: InputError."""
-    args = typing.get_args(hint)
-    if args == (float, float):
-        if not value[0] < value[1]:
-            raise InputError(*where, f"is {list(value)}, a window that does not increase",
-                             "give [from, to] with from < to")
-    elif typing.get_origin(hint) is tuple and Ellipsis in args:
-        for v in value:
-            _windows_increase(v, args[0], where)
-    elif is_dataclass(hint):
-        hints = typing.get_type_hints(hint)
-        for k, h in hints.items():
-            _windows_increase(getattr(value, k), h, where)
 
 
 def _from_table(cls):
@@ -99,12 +38,11 @@ def _from_table(cls):
                            f"{sorted(set(hints) ^ set(table))}")
     for name, hint in hints.items():
         entry = table[name]
-        value = getattr(cls, name) if "value" not in entry else _in_range(_conform(
-            entry["value"], hint, (TABLE_FILE, name)), entry.get("range"), (TABLE_FILE, name),
-            entry.get("excluded"))
-        setattr(cls, name, field(default=value, metadata={
-            "unit": entry["unit"], "reason": entry["reason"], "range": entry.get("range"),
-            "excluded": entry.get("excluded")}))
+        meta = {k: entry.get(k) for k in ("unit", "reason", "range", "excluded")}
+        value = getattr(cls, name) if "value" not in entry else in_range(conform(
+            entry["value"], hint, (TABLE_FILE, name)), meta["range"], (TABLE_FILE, name),
+            meta["excluded"])
+        setattr(cls, name, field(default=value, metadata=meta))
     return cls
 
 
@@ -195,35 +133,20 @@ class Criteria:
     @classmethod
     def checked(cls, name: str, value, where: tuple[str, str] | None = None):
         """``value`` for the entry ``name`` if the table allows it, else InputError at
-        ``where`` (file, field; default criteria, name): a number in the entry's range
-        (each number of an array too) and not one it excludes; an array not empty; a window
-        [from, to] with from < to; a part role one a spec knows."""
+        ``where`` (file, field; default criteria, name): each number (of an array too) in the
+        entry's range and not one it excludes; each part role one a spec knows."""
         meta = {f.name: f for f in fields(cls)}[name].metadata
         where = where or ("criteria", name)
-        if isinstance(value, tuple):
-            if not value:
-                raise InputError(*where, "is empty", "give at least one value, as the table "
-                                 "compare/fit/criteria.toml does")
-            if meta["unit"] == "part roles":
-                from spindle.spec import ROLES
-
-                unknown = [v for v in value if v not in ROLES]
-                if unknown:
-                    raise InputError(*where, f"names the unknown role {unknown[0]!r}",
-                                     f"use roles of {', '.join(ROLES)}")
-            hint = typing.get_type_hints(cls)[name]
-            _windows_increase(value, hint, where)
-            if typing.get_args(hint) != (float, float) and all(
-                    isinstance(v, int | float) for v in value):
-                for v in value:
-                    _in_range(v, cls.range_of(name), where, meta["excluded"])
-            return value
-        return _in_range(value, cls.range_of(name), where, meta["excluded"])
+        if meta["unit"] == "part roles" and (bad := [v for v in value if v not in ROLES]):
+            raise InputError(*where, f"names the unknown role {bad[0]!r}",
+                             f"use roles of {', '.join(ROLES)}")
+        for v in value if isinstance(value, tuple) else (value,):
+            in_range(v, cls.range_of(name), where, meta["excluded"])
+        return value
 
     def with_options(self, **values) -> Criteria:
         """These criteria with some entries set (None leaves one as it is), range-checked."""
-        given = {k: self.checked(k, v) for k, v in values.items() if v is not None}
-        return replace(self, **given)
+        return replace(self, **{k: self.checked(k, v) for k, v in values.items() if v is not None})
 
     def with_file(self, path: str | Path) -> Criteria:
         """These criteria with the entries a TOML file sets: ``name = value`` lines, or
@@ -251,7 +174,7 @@ class Criteria:
                 if "value" not in v:
                     continue
                 v = v["value"]
-            values[name] = self.checked(name, _conform(v, hints[name], (str(path), name)),
+            values[name] = self.checked(name, conform(v, hints[name], (str(path), name)),
                                         (str(path), name))
         return replace(self, **values)
 
