@@ -153,8 +153,17 @@ def start_temperature_K(case: LoadCase, T0: float | None = None) -> float:
 def time_grid(case: LoadCase, dt_s: float) -> np.ndarray:
     """Output times of a transient run [s]: every dt_s, plus every sample time of the
     inputs, so that steps land on the inputs' corners (both models use the same grid). More
-    than MAX_SERIES_POINTS steps is refused (InputError naming --dt) before anything is
+    than MAX_SERIES_POINTS steps is refused (:func:`check_time_step`) before anything is
     allocated."""
+    check_time_step(case, dt_s)
+    grid = np.unique(np.concatenate([np.arange(0.0, case.duration_s, dt_s),
+                                     case.breakpoints(), [case.duration_s]]))
+    return grid[np.concatenate([[True], np.diff(grid) > 1e-9 * dt_s])]
+
+
+def check_time_step(case: LoadCase, dt_s: float) -> None:
+    """InputError naming --dt where dt_s [s] is not positive or gives ``case`` more than
+    MAX_SERIES_POINTS time steps (a command asks this before its work)."""
     if not (math.isfinite(dt_s) and dt_s > 0):
         raise InputError("command line", "--dt", f"{dt_s:g} s is not a positive time step",
                          "give a time step > 0 s, e.g. 60")
@@ -163,9 +172,6 @@ def time_grid(case: LoadCase, dt_s: float) -> np.ndarray:
         raise InputError("command line", "--dt", f"{dt_s:g} s over {case.duration_s / 3600:.4g} h "
                          f"is {steps:.3g} time steps, more than {MAX_SERIES_POINTS:.0e}",
                          f"give --dt >= {case.duration_s / MAX_SERIES_POINTS:.3g} s")
-    grid = np.unique(np.concatenate([np.arange(0.0, case.duration_s, dt_s),
-                                     case.breakpoints(), [case.duration_s]]))
-    return grid[np.concatenate([[True], np.diff(grid) > 1e-9 * dt_s])]
 
 
 _KNOWN_CYCLE_COLUMNS = {"time_s", "speed_rpm", "T_env_C", "T_coolant_C"}

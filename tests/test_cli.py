@@ -385,3 +385,14 @@ def test_a_spec_without_temperature_sensors_is_refused_where_models_are_compared
     out = tmp_path / "o"
     assert main([command[0], spec, *command[1:], "--out", str(out), "--quiet"]) == 2
     assert not out.exists()
+
+
+def test_a_time_step_too_fine_for_the_study_is_refused_before_any_work(tmp_path, capsys):
+    """study --dt 1e-3 ran the steady work, failed the transients one by one and wrote its
+    outputs with exit 1 (found by fuzzing); it is the command line's error, exit 2."""
+    from compare.cli import main
+
+    out = tmp_path / "o"
+    assert main(["study", "fin-shaft", "--nodes", "3", "--dt", "1e-3", "--out", str(out),
+                 "--quiet"]) == 2
+    assert "--dt" in capsys.readouterr().err and not out.exists()
