@@ -467,12 +467,12 @@ class ThermalSystem:
         runs the same LAPACK and BLAS routine on the same values (tests/test_lumped_network.py)."""
         if self.temperature_dependent:
             return
-        todo: dict[tuple, float] = {}  # cache key -> the step it is first asked with
+        todo: dict[tuple, None] = {}  # the new cache keys ("modes", step, speed), in order
         for dt, n in zip(np.asarray(dts_s, dtype=float).tolist(),
                          np.asarray(speeds_rpm, dtype=float).tolist(), strict=True):
             key = ("modes", _step(dt), n)
-            if key not in todo and key not in self._cache:
-                todo[key] = key[1]
+            if key not in self._cache:
+                todo.setdefault(key)
         if len(todo) < 2:
             return
         speeds = list(dict.fromkeys(key[2] for key in todo))
@@ -495,8 +495,8 @@ class ThermalSystem:
             eig = {speeds[k]: (lam[i], V[i], B[k]) for i, k in enumerate(np.flatnonzero(sym))}
         if len(self._cache) > 256:
             self._cache.clear()
-        for key, dt in todo.items():  # the rest as modes() writes it, per step
-            self._cache[key] = (self._modal_form(*eig[key[2]], dt) if key[2] in eig
+        for key in todo:  # the rest as modes() writes it, per step
+            self._cache[key] = (self._modal_form(*eig[key[2]], key[1]) if key[2] in eig
                                 else None)
 
     def discretize(self, dt_s: float, speed_rpm: float, q: np.ndarray | None = None,

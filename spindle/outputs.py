@@ -220,6 +220,17 @@ def _clean_leftovers(parent: Path, name: str) -> None:
 FILE_MARKER = ".spindle-verify-files"
 
 
+def _kept_path(name_for: Callable[[str], Path]) -> Path:
+    """Where a user's entry is moved aside: the first of ``name_for(<time>)``,
+    ``name_for(<time>-2)``, ... that does not exist (nor is a dangling link)."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    kept, n = name_for(stamp), 1
+    while kept.exists() or kept.is_symlink():
+        n += 1
+        kept = name_for(f"{stamp}-{n}")
+    return kept
+
+
 def _foreign_file(path: Path) -> bool:
     """``path`` exists and is not a file spindle-verify wrote (or it was edited since)."""
     if not (path.exists() or path.is_symlink()):
@@ -264,12 +275,7 @@ def write_output_file(path: str | Path, write: Callable[[Path], Any], force: boo
     if _foreign_file(path):
         if not force:
             raise _refuse_file(path, option)
-        stamp = time.strftime("%Y%m%d-%H%M%S")
-        kept = path.with_name(f"{path.stem}.kept-{stamp}{path.suffix}")
-        n = 1
-        while kept.exists() or kept.is_symlink():
-            n += 1
-            kept = path.with_name(f"{path.stem}.kept-{stamp}-{n}{path.suffix}")
+        kept = _kept_path(lambda tag: path.with_name(f"{path.stem}.kept-{tag}{path.suffix}"))
         os.rename(path, kept)
         print(f"spindle-verify: moved {path} aside to {kept} (--force)", file=sys.stderr)
     atomic_write(path, write)
@@ -313,12 +319,7 @@ def output_dir(path: str | Path, inputs: Sequence[str | Path] = (),
 def _keep_aside(path: Path, found: Sequence[str]) -> Path:
     """Move the entries ``found`` of ``path`` into a new sibling ``<name>.kept-<time>``
     folder, keeping their relative paths; say so on stderr."""
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    kept = path.parent / f"{path.name}.kept-{stamp}"
-    n = 1
-    while kept.exists():
-        n += 1
-        kept = path.parent / f"{path.name}.kept-{stamp}-{n}"
+    kept = _kept_path(lambda tag: path.parent / f"{path.name}.kept-{tag}")
     for rel in found:
         src = path / rel.rstrip("/")
         dst = kept / rel.rstrip("/")

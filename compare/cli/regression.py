@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from compare.cli.common import (
@@ -15,6 +14,7 @@ from compare.cli.common import (
     TIME_STEP_S,
     add_quiet,
     add_spec,
+    input_files,
     load_spec_with_sensors,
     with_progress,
 )
@@ -29,8 +29,7 @@ def _cmd_baseline(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.outputs import check_output_file, write_output_file
 
     spec = load_spec_with_sensors(args.spec)  # validates before the long run
-    out = check_output_file(args.out, [spec.path] if Path(spec.path).is_file() else [],
-                            args.force)
+    out = check_output_file(args.out, input_files(spec.path), args.force)
     settings = {"levels": sorted(set(args.levels)), "nodes": sorted(set(args.nodes)),
                 "dt_s": args.dt, "transient": not args.steady_only}
     tolerances = {"temperature_K": args.tol_temp, "growth_um": args.tol_growth}

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import time
 from dataclasses import replace
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from compare.cli.common import (
@@ -17,6 +16,7 @@ from compare.cli.common import (
     add_out,
     add_quiet,
     add_spec,
+    input_files,
     load_case_input,
     load_spec_with_sensors,
     number,
@@ -52,7 +52,7 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
                          "drop --speed, or drop --cycle for a steady solve at that speed")
     progress.stage("reading the spec")
     spec = load_spec_with_sensors(args.spec)
-    inputs = [spec.path, *(x for x in (args.case, args.cycle) if x and Path(x).is_file())]
+    inputs = [spec.path, *input_files(args.case, args.cycle)]
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/solve", inputs, force=args.force)
     t0 = time.perf_counter()
     if args.model == "lumped":

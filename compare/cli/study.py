@@ -40,11 +40,6 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
         raise InputError("command line", "--workers", f"{args.workers} is below 1",
                          "give --workers 1 (serial) or more")
     levels, nodes = sorted(set(args.levels)), sorted(set(args.nodes))
-    if not args.steady_only:  # before the steady work, not as a failed run after it
-        from compare.verify.study import study_cases
-        from spindle.loads import check_time_step
-
-        check_time_step(study_cases(spec)[1], args.dt)
     result = run_study(spec, levels, nodes, transient=not args.steady_only, dt_s=args.dt,
                        threshold=args.threshold / 100.0, progress=progress.say, workers=args.workers,
                        scheduler=args.scheduler, rom=args.rom)

@@ -44,7 +44,7 @@ from compare.verify.accuracy import (
 )
 from compare.verify.convergence import ConvergenceResult, convergence_study
 from spindle.errors import InputError
-from spindle.loads import LoadCase
+from spindle.loads import LoadCase, check_time_step
 from spindle.plots import levels_text
 from spindle.spec import Spec
 
@@ -366,6 +366,8 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     s_case, t_case = study_cases(spec)
     s_case = steady_case or s_case
     t_case = transient_case or t_case
+    if transient:  # a step too fine is the caller's error, before the steady work
+        check_time_step(t_case, dt_s)
     conv = convergence_study(spec, s_case, levels, threshold=threshold, progress=progress,
                              keep_results=True)
     gt = conv.ground_truth_level()
