@@ -396,3 +396,62 @@ def test_a_time_step_too_fine_for_the_study_is_refused_before_any_work(tmp_path,
     assert main(["study", "fin-shaft", "--nodes", "3", "--dt", "1e-3", "--out", str(out),
                  "--quiet"]) == 2
     assert "--dt" in capsys.readouterr().err and not out.exists()
+
+
+def _thin_fin_shaft(tmp_path) -> Path:
+    """The fin-shaft with its radius in a thousandth of its millimetres: its 60 W have
+    nowhere to go, and every model ends far above iron's melting point."""
+    text = (Path(__file__).resolve().parents[1] / "spindle" / "data" / "specs"
+            / "fin-shaft.toml").read_text(encoding="utf-8")
+    assert "r_outer = 0.025" in text
+    spec = tmp_path / "thin.toml"
+    spec.write_text(text.replace("r_outer = 0.025", "r_outer = 1e-6"), encoding="utf-8")
+    return spec
+
+
+@pytest.mark.parametrize("command", [
+    ("study", "--levels", "0", "1", "2", "--nodes", "3", "--steady-only", "--no-pictures"),
+    pytest.param(("crosscheck", "--level", "0"), marks=pytest.mark.skipif(
+        __import__("shutil").which("ccx") is None, reason="CalculiX (ccx) is not installed")),
+])
+def test_every_command_that_solves_refuses_a_result_no_solid_can_have(tmp_path, capsys, command):
+    """solve refused such a result; study wrote errors of 1e305 K with exit 1 and crosscheck
+    wrote T1 = 174 050 °C with exit 0 (found by fuzzing). Both now check the reference's
+    result as solve does (spindle.results.check_plausible): exit 2, nothing written."""
+    out = tmp_path / "o"
+    assert main([command[0], str(_thin_fin_shaft(tmp_path)), *command[1:], "--out", str(out),
+                 "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "not physical" in err and "fix:" in err and not out.exists()
+
+
+def test_measures_refuse_a_baseline_no_solid_can_have(tmp_path, capsys):
+    """measures wrote indicators of a 45.8 MW overload case with exit 0 (found by fuzzing):
+    the uniform body's 0.785 W/K to the room with 1e5 W in it rises by 1.3e5 K."""
+    data = Path(__file__).parent / "data"
+    spec = tmp_path / "hot.toml"
+    text = (data / "uniform_body.toml").read_text(encoding="utf-8")
+    assert "power_W = 100.0" in text
+    spec.write_text(text.replace("power_W = 100.0", "power_W = 1e5"), encoding="utf-8")
+    out = tmp_path / "o"
+    assert main(["measures", str(spec), "--measures", str(data / "uniform_body_measures.toml"),
+                 "--level", "0", "--no-sweeps", "--no-pictures", "--quiet", "--out",
+                 str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "melting point of iron" in err and str(spec) in err and not out.exists()
+
+
+@pytest.mark.skipif(__import__("shutil").which("ccx") is None,
+                    reason="CalculiX (ccx) is not installed")
+def test_crosscheck_takes_a_spec_whose_name_is_no_file_name(tmp_path, capsys):
+    """A spec's name is any text; crosscheck named its decks after it and a 5000-character
+    name stopped it with "File name too long" (found by fuzzing); solve took the name."""
+    text = (Path(__file__).resolve().parents[1] / "spindle" / "data" / "specs"
+            / "fin-shaft.toml").read_text(encoding="utf-8")
+    assert 'name = "fin-shaft"' in text
+    spec = tmp_path / "long.toml"
+    spec.write_text(text.replace('name = "fin-shaft"', f'name = "{"x" * 5000}"', 1),
+                    encoding="utf-8")
+    assert main(["crosscheck", str(spec), "--level", "0", "--quiet", "--out",
+                 str(tmp_path / "o")]) == 0
+    assert (tmp_path / "o" / "crosscheck.json").is_file()

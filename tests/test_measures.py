@@ -514,4 +514,39 @@ alpha_M_W_m2K = {values["alpha_M_W_m2K"]}
     with pytest.raises(MeasureFileError) as exc:
         read_measures(p, body)
     assert [q.field for q in exc.value.problems] == [f"measure[0].{key}"]
-    assert "is outside 0.." in str(exc.value)
+    assert "is not within 0.." in str(exc.value)
+
+
+@pytest.mark.parametrize("entry, field", [
+    ('area = { surfaces = ["lateral"], alpha_M_W_m2K = 10.0, max_m2 = 1e300 }', "area.max_m2"),
+    ('area = { surfaces = ["lateral"], alpha_M_W_m2K = 1e300, max_m2 = 1.0 }',
+     "area.alpha_M_W_m2K"),
+    ('film = { surfaces = ["lateral"], max_W_m2K = 1e300 }', "film.max_W_m2K"),
+    ('heat = { source = "SOURCE", max_W = 2e7 }', "heat.max_W"),
+    ("length = { min_factor = 1e-300, max_factor = 1.5 }", "length.min_factor"),
+    ("length = { min_factor = 0.5, max_factor = 1e6 }", "length.max_factor"),
+])
+def test_a_sweep_far_beyond_any_spindle_is_named(tmp_path, body, entry, field):
+    """Sweeps had no upper bounds (found by fuzzing): 1e300 ran with numpy's overflow warnings
+    and exit 1, a length factor of 1e-300 stopped with "too many indices", 1e6 ran for
+    minutes, and a heat of 2e7 W wrote a rise of about 3e6 K. The bounds are the measures'
+    own (100 m2, 1e5 W/(m2 K)), the spec's largest source (1e6 W: spindle.spec_fields) and
+    a length within 0.1-10 times the spindle's."""
+    source = body.heat_sources[0].name
+    p = _write(tmp_path, f"""
+spec = "uniform-body"
+
+[[measure]]
+name = "fins"
+kind = "added_surface"
+surfaces = ["lateral"]
+A_M_m2 = 0.01
+alpha_M_W_m2K = 10.0
+
+[sweeps]
+{entry.replace("SOURCE", source)}
+""")
+    with pytest.raises(MeasureFileError) as exc:
+        read_measures(p, body)
+    assert [q.field for q in exc.value.problems] == [f"sweeps.{field}"]
+    assert "is not " in str(exc.value) and "fix: give" in str(exc.value)

@@ -68,13 +68,16 @@ def crosscheck(spec: Spec | str | Path, level: int = 1, case: LoadCase | None = 
     t0 = time.perf_counter()
     model = ReferenceModel(spec, int(level), 2)
     res = model.steady(case)
+    res.check_plausible(spec.path)  # before ccx is asked to solve the same impossible case
     times["reference_s"] = time.perf_counter() - t0
     th = model.thermal
     names, pts = th.sensor_points()
     P = th.probe_matrix(pts)
     with ccx_folder() as work:
         t1 = time.perf_counter()
-        name = "".join(c if c.isalnum() or c in "-_" else "_" for c in spec.name)
+        # a file name: a spec's name may be any text (a 5000-character one was "File name
+        # too long"); the decks' names only need to tell the thermal from the elastic one
+        name = "".join(c if c.isalnum() or c in "-_" else "_" for c in spec.name)[:64] or "spec"
         info, cm, data, con = write_thermal_deck(model, case, work / f"{name}.inp")
         times["export_s"] = time.perf_counter() - t1
         t1 = time.perf_counter()

@@ -16,6 +16,7 @@ from compare.design.measure import KINDS, SIZE_FIELDS, SWEEPS, Measure, axial_le
 from compare.design.stiffness import surface_films
 from spindle.errors import Problem, SpindleVerifyError
 from spindle.spec import Spec
+from spindle.spec_fields import MAX_POWER_W
 
 
 class MeasureFileError(SpindleVerifyError):
@@ -64,9 +65,14 @@ class MeasureFile:
     sweeps: tuple[SweepSpec, ...] | None = None  # None: derive defaults from the spec
 
 
-#: the largest added surface [m2] and film coefficient [W/(m2 K)] a measure may name
+#: the largest added surface [m2] and film coefficient [W/(m2 K)] a measure or a sweep may
+#: name: a spindle's housing has about 1 m2; forced water convection reaches 1e4-1e5 W/(m2 K)
 MAX_AREA_M2 = 100.0
 MAX_FILM_W_M2K = 1e5
+#: the range of a length sweep's factors: a design study of the spindle's length within an
+#: order of magnitude either way (a factor of 10 already makes the SPL2782 a 5 m shaft; the
+#: mesh grows with the factor)
+LENGTH_FACTORS = (0.1, 10.0)
 
 _MEASURE_KEYS = ("name", "kind", "description", "surfaces", "A_M_m2", "alpha_M_W_m2K",
                  "alpha_M2_W_m2K")
@@ -120,8 +126,9 @@ class _Reader:
             self.add(fld, f"{v:g} is not > 0", f"give {key} > 0 {unit}")
             return None
         if lo is not None and v < lo or hi is not None and v > hi:
-            self.add(fld, f"{v:g} is outside {lo:g}..{hi:g}", f"give {key} within {lo:g}..{hi:g}"
-                     f" {unit}")
+            span = (f"within {lo:g}..{hi:g}" if lo is not None and hi is not None
+                    else f"at most {hi:g}" if hi is not None else f"at least {lo:g}")
+            self.add(fld, f"{v:g} is not {span}", f"give {key} {span} {unit}")
             return None
         return v
 
@@ -289,15 +296,18 @@ def _read_sweeps(r: _Reader, d: Any, spec: Spec, convective: list[str],
         r.unknown(t, _SWEEP_KEYS[kind], where)
         if kind == "area":
             s = r.surfaces(t, where, convective)
-            a = r.number(t, "alpha_M_W_m2K", where, "W/m2/K", required=True)
-            lo = r.number(t, "min_m2", where, "m2", positive=False, lo=0.0, hi=1e3) or 0.0
-            hi = r.number(t, "max_m2", where, "m2", required=True)
+            a = r.number(t, "alpha_M_W_m2K", where, "W/m2/K", required=True,
+                         hi=MAX_FILM_W_M2K)
+            lo = r.number(t, "min_m2", where, "m2", positive=False, lo=0.0,
+                          hi=MAX_AREA_M2) or 0.0
+            hi = r.number(t, "max_m2", where, "m2", required=True, hi=MAX_AREA_M2)
             if s and a and hi and hi > lo:
                 out.append(SweepSpec(kind, tuple(np.linspace(lo, hi, n)), s, a))
         elif kind == "film":
             s = r.surfaces(t, where, convective)
-            lo = r.number(t, "min_W_m2K", where, "W/m2/K", positive=False, lo=0.0, hi=1e6) or 0.0
-            hi = r.number(t, "max_W_m2K", where, "W/m2/K", required=True)
+            lo = r.number(t, "min_W_m2K", where, "W/m2/K", positive=False, lo=0.0,
+                          hi=MAX_FILM_W_M2K) or 0.0
+            hi = r.number(t, "max_W_m2K", where, "W/m2/K", required=True, hi=MAX_FILM_W_M2K)
             if s and hi and hi > lo:
                 out.append(SweepSpec(kind, tuple(np.linspace(lo, hi, n)), s))
         elif kind == "heat":
@@ -307,13 +317,16 @@ def _read_sweeps(r: _Reader, d: Any, spec: Spec, convective: list[str],
                 r.add(f"{where}.source", f"{src!r} is not a heat source of the spec",
                       f"use one of {names}")
                 continue
-            lo = r.number(t, "min_W", where, "W", positive=False, lo=0.0, hi=1e7) or 0.0
-            hi = r.number(t, "max_W", where, "W", required=True)
+            lo = r.number(t, "min_W", where, "W", positive=False, lo=0.0,
+                          hi=MAX_POWER_W) or 0.0
+            hi = r.number(t, "max_W", where, "W", required=True, hi=MAX_POWER_W)
             if hi and hi > lo:
                 out.append(SweepSpec(kind, tuple(np.linspace(lo, hi, n)), source=src))
         else:
-            lo = r.number(t, "min_factor", where, "-", required=True)
-            hi = r.number(t, "max_factor", where, "-", required=True)
+            lo = r.number(t, "min_factor", where, "-", required=True, lo=LENGTH_FACTORS[0],
+                          hi=LENGTH_FACTORS[1])
+            hi = r.number(t, "max_factor", where, "-", required=True, lo=LENGTH_FACTORS[0],
+                          hi=LENGTH_FACTORS[1])
             if lo and hi and hi > lo:
                 L0 = axial_length_m(spec)
                 out.append(SweepSpec(kind, tuple(L0 * np.linspace(lo, hi, n))))

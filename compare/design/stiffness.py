@@ -270,6 +270,7 @@ def check_solution(result) -> None:
                           f"ill-posed (relative residual {result.residual:.1e}, energy "
                           f"imbalance {imbalance:.1e}); fix: keep a film coefficient > 0 on "
                           "a surface of every group of parts")
+    result.check_plausible(result.model.spec.path)  # temperatures a solid can have
 
 
 def indicators(model, case: LoadCase | None = None, label: str | None = None) -> Indicators:

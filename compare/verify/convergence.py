@@ -326,6 +326,7 @@ def convergence_study(spec: Spec, case: LoadCase | None = None, levels: Sequence
             progress(f"FEM level {lv}: solving {model.thermal.basis.N:,} thermal and "
                      f"{model.elastic.K_red.shape[0]:,} elastic unknowns".replace(",", " "))
         res = model.steady(case, keep_factorisations=False)
+        res.check_plausible(spec.path)  # a film of 1e-300 wrote errors of 1e305 K
         vals, units = quantities(spec, res, case)
         per_level[lv] = (time.perf_counter() - t, model.thermal.smesh.counts(order)["elements"],
                          int(model.thermal.basis.N), vals, res if keep_results else None)
