@@ -220,8 +220,44 @@ def import_dask():
     return distributed
 
 
+#: how long [s] a scheduler's address may take to accept a connection before it is called
+#: unreachable: a scheduler on a network answers in milliseconds, and Dask's own retries
+#: took 30 s to say that nothing listens there
+CONNECT_TIMEOUT_S = 5.0
+
+
+def check_scheduler(scheduler: str | None) -> None:
+    """InputError at once when ``scheduler`` (``tcp://host:port``) accepts no connection; the
+    Dask extra is imported (a missing extra is named). ``None`` and ``"local"`` pass."""
+    if not scheduler:
+        return
+    import_dask()
+    if scheduler == "local":
+        return
+    import socket
+    from urllib.parse import urlsplit
+
+    where = urlsplit(scheduler if "://" in scheduler else f"tcp://{scheduler}")
+    if where.scheme not in ("tcp", "tls"):
+        return  # another of Dask's transports (inproc, ucx): Dask's own connect says
+    try:
+        host, port = where.hostname, where.port
+    except ValueError:  # a port that is no number
+        host = port = None
+    if not host or port is None:
+        raise InputError("command line", "--scheduler", f"'{scheduler}' is not an address "
+                         "host:port", "give e.g. tcp://host:8786, or 'local'")
+    try:
+        socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
+    except OSError as exc:
+        raise InputError("command line", "--scheduler", f"cannot connect to '{scheduler}' "
+                         f"({exc.strerror or exc})", "give the address of a running Dask "
+                         "scheduler, e.g. tcp://host:8786, or 'local'") from None
+
+
 def _run_dask(fn, cases: Sequence[Any], scheduler: str, workers: int, finish) -> None:
     distributed = import_dask()
+    check_scheduler(scheduler)
     cluster = None
     try:
         if scheduler == "local":

@@ -15,6 +15,11 @@ from spindle.units import ZERO_C_K
 MAX_RELATIVE_IMBALANCE = 1e-3
 
 
+#: the least heat flow [W] a balance is judged against: a microwatt is below any flow a bench
+#: can tell (a sensor's 0.01 K across a 1 W/K path is 10 mW). Without it a spindle with no
+#: heat at its reference temperature, whose flows are round-off, had an "imbalance" of 100 %
+FLOW_FLOOR_W = 1e-6
+
 #: iron melts at 1811 K: a solid model's temperature above it is no result, it is a unit or
 #: an exponent off in the spec (a conductivity in kW/(m K), a source of 1e300 W)
 T_MELT_K = 1811.0
@@ -62,7 +67,8 @@ class SteadyTable:
         """Global balance [W]: heat in - heat out (no storage at steady state)."""
         out = sum(self.heat_out_W.values())
         imbalance = self.heat_in_W - out
-        scale = max(abs(self.heat_in_W), abs(out), 1e-300)
+        scale = max(abs(self.heat_in_W), sum(abs(v) for v in self.heat_out_W.values()),
+                    FLOW_FLOOR_W)
         return {"heat_in_W": self.heat_in_W, "heat_out_W": out, "imbalance_W": imbalance,
                 "relative_imbalance": abs(imbalance) / scale,
                 **{f"out_{k}_W": v for k, v in self.heat_out_W.items()}}
@@ -117,7 +123,8 @@ class TransientTable:
         """Cumulative balance [J]: in - out - stored, and its size relative to the flows."""
         imb = self.energy_in_J - self.energy_out_J - self.energy_stored_J
         scale = max(abs(self.energy_in_J), abs(self.energy_out_J),
-                    abs(self.energy_stored_J), 1e-300)
+                    abs(self.energy_stored_J),
+                    FLOW_FLOOR_W * float(self.times_s[-1] - self.times_s[0]))
         return {"energy_in_J": self.energy_in_J, "energy_out_J": self.energy_out_J,
                 "energy_stored_J": self.energy_stored_J, "imbalance_J": imb,
                 "relative_imbalance": abs(imb) / scale}

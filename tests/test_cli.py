@@ -307,9 +307,13 @@ def test_an_empty_option_is_refused_not_taken_for_its_default(tmp_path, option):
     assert r.returncode == 2 and f"{option}: is empty" in r.stderr and "fix:" in r.stderr
 
 
-def test_a_speed_beside_a_cycle_is_refused_not_ignored(tmp_path):
-    """`solve --cycle C --speed N` ran the cycle at its own speeds and said nothing of N."""
-    r = run("solve", "fin-shaft", "--model", "lumped", "--cycle", "spl-16h", "--speed", "1000",
+@pytest.mark.parametrize("spec, option, value", [("fin-shaft", "--cycle", "spl-16h"),
+                                                 ("spl2782", "--case", "nominal")])
+def test_a_speed_beside_a_cycle_is_refused_not_ignored(tmp_path, spec, option, value):
+    """`solve --cycle C --speed N` ran the cycle at its own speeds and said nothing of N;
+    `solve spl2782 --case nominal --speed 1000` solved at 1000 rpm with the 5146 W of the
+    nominal 4300 rpm (found by fuzzing)."""
+    r = run("solve", spec, "--model", "lumped", option, value, "--speed", "1000",
             "--out", str(tmp_path / "o"))
     assert r.returncode == 2 and "--speed:" in r.stderr and "drop --speed" in r.stderr
     assert not (tmp_path / "o").exists()
@@ -455,3 +459,22 @@ def test_crosscheck_takes_a_spec_whose_name_is_no_file_name(tmp_path, capsys):
     assert main(["crosscheck", str(spec), "--level", "0", "--quiet", "--out",
                  str(tmp_path / "o")]) == 0
     assert (tmp_path / "o" / "crosscheck.json").is_file()
+
+
+@pytest.mark.parametrize("model", [("--level", "0"), ("--model", "lumped")])
+def test_a_spindle_without_heat_sits_at_its_reference_temperature(tmp_path, capsys, model):
+    """The fin-shaft with both sources at 0 W: every temperature is the room's. solve refused
+    it as "ill-conditioned" (its round-off flows were judged against themselves, an
+    imbalance of 100 %; found by fuzzing); the balance is now judged against at least
+    spindle.results.FLOW_FLOOR_W."""
+    text = (Path(__file__).resolve().parents[1] / "spindle" / "data" / "specs"
+            / "fin-shaft.toml").read_text(encoding="utf-8")
+    assert text.count("power_W = 15.0") == 1 and text.count("power_W = 45.0") == 1
+    spec = tmp_path / "cold.toml"
+    spec.write_text(text.replace("power_W = 15.0", "power_W = 0.0")
+                    .replace("power_W = 45.0", "power_W = 0.0"), encoding="utf-8")
+    out = tmp_path / "o"
+    assert main(["solve", str(spec), *model, "--no-pictures", "--quiet", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    # the room is 20 °C; 1e-9 K is round-off on 293 K
+    assert all(abs(v - 20.0) < 1e-9 for v in summary["sensors_C"].values())

@@ -227,3 +227,11 @@ def test_the_options_take_the_range_of_the_table(tmp_path, capsys, option, entry
         assert main(["fit", str(tmp_path / "run.csv"), option, text, "--out", str(out),
                      "--quiet"]) == 2
         assert "run.csv" in capsys.readouterr().err
+
+
+def test_a_file_with_a_byte_order_mark_reads_as_without(tmp_path):
+    """Some editors start a file with a UTF-8 byte-order mark; the spec and cycle readers
+    dropped it, the criteria file read it as a "syntax" error on line 1 (found by fuzzing)."""
+    own = tmp_path / "bom.toml"
+    own.write_text("\ufeffalpha = 0.05\n", encoding="utf-8")
+    assert Criteria().with_file(own) == Criteria().with_options(alpha=0.05)

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import socket
 import sys
+import time
 import types
 from concurrent.futures import Future
 
 import pytest
 
-from compare.executor import DASK_FIX, case_label, run_cases
+from compare.executor import CONNECT_TIMEOUT_S, DASK_FIX, case_label, run_cases
 from spindle.errors import InputError
 
 
@@ -107,6 +109,16 @@ def _fake_dask(monkeypatch):
     dask.distributed = dist
     monkeypatch.setitem(sys.modules, "dask", dask)
     monkeypatch.setitem(sys.modules, "dask.distributed", dist)
+    real = socket.create_connection
+
+    def connect(address, timeout=None):  # the fake hosts accept; the machine's own are real
+        if address[0] == "h":
+            return types.SimpleNamespace(close=lambda: None)
+        if address[0] == "nowhere":
+            raise OSError("Name or service not known")
+        return real(address, timeout=timeout)
+
+    monkeypatch.setattr(socket, "create_connection", connect)
 
 
 def test_dask_backend_keeps_order_and_captures_failures(monkeypatch):
@@ -175,3 +187,22 @@ def test_a_bound_progress_is_not_replaced():
               workers=1, progress=lines.append)
     assert mine == [(1, 4), (2, 4), (3, 4), (4, 4)]
     assert not any(" of 4" in ln for ln in lines)
+
+
+def test_a_scheduler_address_where_nothing_listens_is_named_at_once(monkeypatch):
+    """Dask retried a refused connection for its 30 s timeout before the message came (found
+    by fuzzing); the address is tried once, with compare.executor.CONNECT_TIMEOUT_S."""
+    _fake_dask(monkeypatch)
+    _FakeClient.addresses = []
+    with socket.socket() as s:  # a port of this machine that nothing listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    t = time.perf_counter()
+    with pytest.raises(InputError) as exc:
+        run_cases(square_or_fail, [1], scheduler=f"tcp://127.0.0.1:{port}")
+    # a refused connection is refused at once; the bound is the check's own timeout
+    assert time.perf_counter() - t < CONNECT_TIMEOUT_S
+    assert f"cannot connect to 'tcp://127.0.0.1:{port}'" in str(exc.value)
+    assert _FakeClient.addresses == []  # Dask was never asked
+    with pytest.raises(InputError, match="is not an address"):
+        run_cases(square_or_fail, [1], scheduler="tcp://127.0.0.1:port")

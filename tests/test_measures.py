@@ -550,3 +550,14 @@ alpha_M_W_m2K = 10.0
         read_measures(p, body)
     assert [q.field for q in exc.value.problems] == [f"sweeps.{field}"]
     assert "is not " in str(exc.value) and "fix: give" in str(exc.value)
+
+
+def test_a_measures_file_with_a_byte_order_mark_reads_as_without(tmp_path, body):
+    """Some editors start a file with a UTF-8 byte-order mark; the spec and cycle readers
+    dropped it, the measures file read it as "Invalid statement" on line 1 (found by
+    fuzzing)."""
+    text = (DATA / "uniform_body_measures.toml").read_text(encoding="utf-8")
+    p = _write(tmp_path, "\ufeff" + text)
+    got, plain = read_measures(p, body), read_measures(DATA / "uniform_body_measures.toml", body)
+    assert (got.measures, got.inverse, got.sweeps) == (plain.measures, plain.inverse,
+                                                       plain.sweeps)

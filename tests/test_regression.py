@@ -104,6 +104,10 @@ def test_shipped_baselines_still_hold(name, capsys):
     (("settings", "nodes"), [10 ** 8], "settings.nodes"),  # ran for hours
     (("settings", "transient"), "no", "settings.transient"),  # text is true in Python
     (("spec",), 5, "spec"),
+    # a misspelt tolerance or setting was ignored, its default used (found by fuzzing)
+    (("tolerances", "temperature_k"), 1.0, "tolerances.temperature_k"),
+    (("settings", "dt"), 60.0, "settings.dt"),
+    (("comment",), "mine", "comment"),
 ])
 def test_a_baseline_field_of_the_wrong_type_or_range_is_named(baseline, tmp_path, path, value,
                                                               field):
@@ -121,3 +125,23 @@ def test_a_baseline_field_of_the_wrong_type_or_range_is_named(baseline, tmp_path
         read_baseline(bad)
     assert err.value.problem.field.startswith(field)
     assert main(["check", str(bad), "--quiet"]) == 2
+
+
+def test_a_baseline_naming_no_spec_is_named_as_the_baseline_s_field(baseline, tmp_path, capsys):
+    """A baseline whose spec is "nope": the error named the spec "nope" as a file, not the
+    baseline or its field (found by fuzzing)."""
+    doc = json.loads(baseline.read_text())
+    doc["spec"] = "nope"
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(doc))
+    assert main(["check", str(bad), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}: spec: names 'nope'" in err and "fix:" in err
+
+
+def test_a_baseline_with_a_byte_order_mark_reads_as_without(baseline, tmp_path):
+    """A baseline opened and saved by an editor that writes a UTF-8 byte-order mark was
+    "not valid JSON" (found by fuzzing)."""
+    bom = tmp_path / "bom.json"
+    bom.write_text("\ufeff" + baseline.read_text(encoding="utf-8"), encoding="utf-8")
+    assert read_baseline(bom) == read_baseline(baseline)

@@ -45,8 +45,17 @@ def _cmd_baseline(args: argparse.Namespace, progress: Progress) -> int:
 @with_progress("check")
 def _cmd_check(args: argparse.Namespace, progress: Progress) -> int:
     from compare.verify.regression import check, read_baseline
+    from spindle.errors import InputError, SpindleVerifyError
+    from spindle.spec_reader import load_spec
 
     doc = read_baseline(args.file)
+    try:  # the spec the baseline names: its problem is the baseline's field, named as such
+        load_spec(doc["spec"])
+    except SpindleVerifyError as exc:
+        raise InputError(args.file, "spec", f"names {doc['spec']!r}, which is no spec it can "
+                         f"read ({str(exc).splitlines()[0]})", "give the name of a shipped "
+                         "spec or the path of the spec the baseline was written from"
+                         ) from None
     changes = check(doc, progress=progress.say)
     progress.done()
     moved = [c for c in changes if c.moved]

@@ -33,7 +33,8 @@ def _check_cycles(texts: list[str]) -> None:
         name, _, seed = text.partition(":")
         if seed and not seed.isdigit():
             raise InputError("command line", "--cycle/--held-out", f"'{text}': the seed "
-                             f"'{seed}' is not a whole number", "write NAME or NAME:SEED")
+                             f"'{seed}' is not a whole number >= 0 (a seed of the random "
+                             "stream)", "write NAME or NAME:SEED, e.g. random:0")
         if name not in RANDOM_CYCLES and name not in shipped_cycles():
             from pathlib import Path
 

@@ -50,6 +50,13 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
         raise InputError("command line", "--speed", "sets a steady solve's speed, and --cycle "
                          "gives the transient its own speeds, so it would be ignored",
                          "drop --speed, or drop --cycle for a steady solve at that speed")
+    if args.speed is not None and args.case:
+        # the case's losses are its own speed's (its power balance), so a new speed beside
+        # them gave 4300 rpm's 5146 W at 1000 rpm
+        raise InputError("command line", "--speed", "sets a steady solve's speed, and --case "
+                         "gives its own speed with the losses of that speed",
+                         "drop --speed, or drop --case for the spec's operating point at that "
+                         "speed")
     progress.stage("reading the spec")
     spec = load_spec_with_sensors(args.spec)
     inputs = [spec.path, *input_files(args.case, args.cycle)]

@@ -167,7 +167,7 @@ def read_measures(path: str | Path, spec: Spec, points: int | None = None) -> Me
     path = Path(path)
     r = _Reader(str(path))
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except FileNotFoundError:
         raise MeasureFileError([Problem(str(path), "file", "does not exist",
                                         "give the path of a measures TOML file")]) from None

@@ -155,7 +155,7 @@ class Criteria:
         the entry's range, a unit other than the table's or a file that is not TOML is an
         InputError naming the file and the entry."""
         try:
-            given = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+            given = tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
             raise InputError(str(path), "-", f"cannot be read as TOML ({err})",
                              "give a TOML file of name = value lines") from None

@@ -119,7 +119,7 @@ class Change:
 def read_baseline(path: str | Path) -> dict:
     path = Path(path)
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        doc = json.loads(path.read_text(encoding="utf-8-sig"))
     except (OSError, UnicodeDecodeError) as exc:
         why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
         raise InputError(str(path), "file", f"cannot be read ({why})",
@@ -142,6 +142,15 @@ def read_baseline(path: str | Path) -> dict:
 def _check_contents(doc: dict, refuse: Callable[..., InputError]) -> None:
     """Every field ``check`` reads has its type and range (``refuse(field, message[, fix])``
     makes the error): a NaN tolerance passed every figure, a figure of text was a TypeError."""
+    known = ("format", "spec", "settings", "tolerances", "created_with_runtime_s", "figures")
+    for where, table, keys in (("", doc, known), ("tolerances.", doc["tolerances"],
+                                                  DEFAULT_TOLERANCES),
+                               ("settings.", doc["settings"], DEFAULT_SETTINGS)):
+        # a misspelt tolerance or setting was ignored, and its default used without a word
+        extra = next((k for k in table if k not in keys), None) if isinstance(table, dict) else None
+        if extra is not None:
+            raise refuse(f"{where}{extra}", "is not a field of a baseline",
+                         f"remove it or use one of {list(keys)}")
     tol = doc["tolerances"]
     if not isinstance(tol, dict):
         raise refuse("tolerances", "must be a table of numbers")

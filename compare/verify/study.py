@@ -355,13 +355,13 @@ def run_study(spec: Spec, levels: Sequence[int] = (0, 1, 2, 3), nodes: Sequence[
     training cycle's FEM run) and the build's candidate vectors (about 0.6 GB at level 2;
     docs/rom.md gives the measured cost).
     """
-    from compare.executor import import_dask, run_cases
+    from compare.executor import check_scheduler, run_cases
 
     if workers < 1:
         raise InputError("command line", "--workers", f"{workers} is below 1",
                          "give --workers 1 (serial) or more")
-    if scheduler:
-        import_dask()  # a missing extra fails now, not after the grid convergence
+    check_scheduler(scheduler)  # a missing extra or no scheduler there: now, not after the
+    # grid convergence
     t0 = time.perf_counter()
     s_case, t_case = study_cases(spec)
     s_case = steady_case or s_case
