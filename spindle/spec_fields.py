@@ -79,7 +79,8 @@ class FieldReader:
         self.quiet: set[str] = set()
         #: names of parts, surfaces and materials that are defined but could not be read:
         #: a reference to one is not a second problem
-        self.broken: dict[str, set[str]] = {"part": set(), "surface": set(), "material": set()}
+        self.broken: dict[str, set[str]] = {"part": set(), "surface": set(), "material": set(),
+                                            "section": set()}  # sections as "part/section"
         #: required lists (``parts``, ``surfaces``) that are missing or could not be read:
         #: every name a reference looks up in one is unknown, and not a problem of its own
         self.absent: set[str] = set()
@@ -226,6 +227,10 @@ class FieldReader:
                 return None
             if any(b <= a for a, b in zip(n, n[1:], strict=False)):
                 self.add(f"{path}.{key}.speed_rpm", "must increase", "sort the table by speed")
+                return None
+            if min(n) < 0:  # a speed is its magnitude, as in the cycles
+                self.add(f"{path}.{key}.speed_rpm", f"{min(n):g} rpm is below 0",
+                         "give speeds >= 0 rpm (the direction of rotation plays no part)")
                 return None
             if min(vals) < 0:
                 self.add(f"{path}.{key}.value", f"negative {unit} is not physical",

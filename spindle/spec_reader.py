@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from spindle.errors import Problem, SpecError
-from spindle.geometry import TOL_M
+from spindle.geometry import TOL_M, contact_length, overlap
 from spindle.spec import (
     LINK_TYPES,
     ROLES,
@@ -47,11 +47,18 @@ from spindle.spec_fields import (
     show_value,
 )
 
+#: the least conductivity [W/(m K)] a material may have: an order below the least conducting
+#: solids and gases (aerogels 0.013, air 0.026)
+K_MIN_W_MK = 1e-3
+
 
 def _read_material(r: FieldReader, name: str, d: dict, path: str) -> Material | None:
     # upper limits: beyond every engineering solid (diamond conducts 2200 W/m/K, osmium is
     # 22600 kg/m3, E of diamond 1.2e12 Pa, thermal expansion of polymers 2e-4 1/K); k up to
-    # 1e6 W/m/K for the near-ideal conductors of verification cases
+    # 1e6 W/m/K for the near-ideal conductors of verification cases. Lower limits: below any
+    # solid or gas the spec may mesh (air's layer: 0.026 W/m/K, 1.18 kg/m3, its E 1e5 Pa so that
+    # it carries no load; lead's 129 J/kg/K), so that a unit slip (c in kJ/kg/K, E in GPa) or
+    # an exponent is named rather than solved
     n0 = len(r.problems)
     r.keys(d, KNOWN_FIELDS["materials"], path)
     if "k_W_mK" in d and ("k_r_W_mK" in d or "k_z_W_mK" in d):
@@ -59,13 +66,13 @@ def _read_material(r: FieldReader, name: str, d: dict, path: str) -> Material | 
               "give either k_W_mK (isotropic) or both k_r_W_mK and k_z_W_mK")
         kr = kz = None
     elif "k_W_mK" in d:
-        kr = kz = r.number(d, "k_W_mK", path, "W/m/K", lo=0.0, lo_open=True, hi=1e6)
+        kr = kz = r.number(d, "k_W_mK", path, "W/m/K", lo=K_MIN_W_MK, hi=1e6)
     else:
-        kr = r.number(d, "k_r_W_mK", path, "W/m/K", lo=0.0, lo_open=True, hi=1e6)
-        kz = r.number(d, "k_z_W_mK", path, "W/m/K", lo=0.0, lo_open=True, hi=1e6)
-    rho = r.number(d, "rho_kg_m3", path, "kg/m3", lo=0.0, lo_open=True, hi=30000.0)
-    c = r.number(d, "c_J_kgK", path, "J/kg/K", lo=0.0, lo_open=True, hi=20000.0)
-    E = r.number(d, "E_Pa", path, "Pa", lo=0.0, lo_open=True, hi=2e12)
+        kr = r.number(d, "k_r_W_mK", path, "W/m/K", lo=K_MIN_W_MK, hi=1e6)
+        kz = r.number(d, "k_z_W_mK", path, "W/m/K", lo=K_MIN_W_MK, hi=1e6)
+    rho = r.number(d, "rho_kg_m3", path, "kg/m3", lo=0.1, hi=30000.0)
+    c = r.number(d, "c_J_kgK", path, "J/kg/K", lo=50.0, hi=20000.0)
+    E = r.number(d, "E_Pa", path, "Pa", lo=1e3, hi=2e12)
     nu = r.number(d, "nu", path, "-", lo=-1.0, lo_open=True, hi=0.4999)
     alpha = r.number(d, "alpha_1_K", path, "1/K", lo=0.0, hi=1e-3)
     if len(r.problems) > n0:
@@ -244,6 +251,8 @@ def _read_parts(r: FieldReader, data: dict[str, Any], materials: dict[str, Mater
             sec = _read_section(r, sd, f"{path}.sections[{j}]", path, pmat, materials)
             if sec is not None:
                 sections.append(sec)
+            elif pname is not None and isinstance(sd.get("name"), str):
+                r.broken["section"].add(f"{pname}/{sd['name']}")
         if len(sections) == len(secs):
             _check_sections_join(r, sections, path)
         ok = pname is not None and role is not None and bool(sections)
@@ -255,9 +264,11 @@ def _read_parts(r: FieldReader, data: dict[str, Any], materials: dict[str, Mater
 
 
 def _check_sections_join(r: FieldReader, sections: list[Section], path: str) -> None:
-    """A part is one body: its sections, in z order, must meet without a gap."""
+    """A part is one body: its sections, in z order, must meet without a gap along z, and
+    each must share a face with another (a ring on a shaft, a step in diameter)."""
     order = sorted(range(len(sections)), key=lambda j: sections[j].z_start)
-    for a, b in zip(order, order[1:], strict=False):
+    a = order[0]  # of the sections so far, the one reaching furthest along z
+    for b in order[1:]:
         gap = sections[b].z_start - sections[a].z_end
         if gap > TOL_M:
             r.add(f"{path}.sections[{b}].z_start",
@@ -265,6 +276,28 @@ def _check_sections_join(r: FieldReader, sections: list[Section], path: str) -> 
                   f"{sections[b].z_start:g} m): a part is one body",
                   f"give z_start = {sections[a].z_end:g} (or make the piece beyond the gap a "
                   "part of its own, joined by a link)")
+            return
+        a = b if sections[b].z_end > sections[a].z_end else a
+    # no gap along z, but sections may still meet in a point or not at all (a bore wider
+    # than the neighbour's outside): the sections joined by a shared face, from the first
+    joined, grown = {order[0]}, True
+    while grown:
+        grown = False
+        for j in order:
+            if j not in joined and any(contact_length(sections[j], sections[k]) > TOL_M
+                                       or overlap(sections[j], sections[k]) for k in joined):
+                joined.add(j)
+                grown = True
+    alone = next((j for j in order if j not in joined), None)
+    if alone is not None:
+        sj = sections[alone]
+        r.add(f"{path}.sections[{alone}]",
+              f"shares no face with the part's sections[{order[0]}] and those joined to it "
+              f"(z = {sj.z_start:g} to {sj.z_end:g} m, r = {sj.r_inner[0]:g} to "
+              f"{sj.r_outer[0]:g} m): a part is one body",
+              "make its radii meet a neighbour's (one's r_outer the other's r_inner, or "
+              "overlapping radial ranges where one ends and the next starts), or make it a "
+              "part of its own, joined by a link")
 
 
 def _read_section(r: FieldReader, sd: dict, sp: str, path: str, pmat: Any,
@@ -329,8 +362,9 @@ def _read_bearing_link(r: FieldReader, ld: dict, path: str, parts: list[Part]) -
               f"give G_W_K <= {MAX_G_W_K:g} W/K")
     elif pn is not None and sn is not None and not any(
             s.name == sn for s in next(p for p in parts if p.name == pn).sections):
-        r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
-              f"add name = \"{sn}\" to the rolling-element section of part '{pn}'")
+        if f"{pn}/{sn}" not in r.broken["section"]:  # else its own problem is reported
+            r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
+                  f"add name = \"{sn}\" to the rolling-element section of part '{pn}'")
     elif G is not None and G.min <= 0:
         r.add(f"{path}.G_W_K", "a bearing conductance must be > 0 W/K",
               "give G_W_K > 0 (typ. 5-50 W/K per bearing pair)")
@@ -436,8 +470,9 @@ def _read_heat_source(r: FieldReader, hd: dict, path: str, parts: list[Part],
         return None
     if sn is not None and not any(s.name == sn for s in
                                   next(p for p in parts if p.name == pn).sections):
-        r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
-              f"name one of its sections '{sn}' or drop the section field")
+        if f"{pn}/{sn}" not in r.broken["section"]:  # else its own problem is reported
+            r.add(f"{path}.section", f"part '{pn}' has no section named '{sn}'",
+                  f"name one of its sections '{sn}' or drop the section field")
         return None
     if surf is not None and surf not in surface_names:
         r.unknown("surface", str(surf), f"{path}.surface",

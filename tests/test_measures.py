@@ -561,3 +561,31 @@ def test_a_measures_file_with_a_byte_order_mark_reads_as_without(tmp_path, body)
     got, plain = read_measures(p, body), read_measures(DATA / "uniform_body_measures.toml", body)
     assert (got.measures, got.inverse, got.sweeps) == (plain.measures, plain.inverse,
                                                        plain.sweeps)
+
+
+def test_a_target_of_a_broken_measure_is_not_a_second_problem(tmp_path, body):
+    """A measure with A_M_m2 = 0 also gave "inverse[0].measure: 'fins' is not a measure of
+    this file" (found by fuzzing): one problem, one message."""
+    p = _write(tmp_path, """
+spec = "uniform-body"
+
+[[measure]]
+name = "fins"
+kind = "added_surface"
+surfaces = ["lateral"]
+A_M_m2 = 0.0
+alpha_M_W_m2K = 10.0
+
+[[inverse]]
+name = "fins_for_1pct"
+measure = "fins"
+xi_pct = 1.0
+
+[[inverse]]
+name = "other"
+measure = ["fins"]
+xi_pct = 1.0
+""")
+    with pytest.raises(MeasureFileError) as exc:
+        read_measures(p, body)
+    assert [q.field for q in exc.value.problems] == ["measure[0].A_M_m2", "inverse[1].measure"]

@@ -250,3 +250,85 @@ def test_an_array_radius_outside_its_part_is_one_problem(tmp_path):
     found = problems_of_file(tmp_path, text.replace(old, old.replace('"mid"', "5.0")))
     assert len(found) == 1 and found[0].field == "sensor_arrays.shaft.radius", found
     assert "puts 11 of the array's 11 sensors outside every part" in found[0].message
+
+
+def test_a_section_whose_material_is_broken_is_one_problem(tmp_path):
+    """A conductivity of 0 in the bearings' rolling-layer material also gave four lines
+    "part '...' has no section named 'rolling'" for the links and sources that use the
+    sections of that material (found by fuzzing)."""
+    text = _shipped_text() + """
+[materials.rolling_layer_equivalent]
+k_W_mK = 0.0
+rho_kg_m3 = 7800.0
+c_J_kgK = 470.0
+E_Pa = 2.0e11
+nu = 0.3
+alpha_1_K = 1.1e-5
+"""
+    found = problems_of_file(tmp_path, text)
+    assert [p.field for p in found] == ["materials.rolling_layer_equivalent.k_W_mK"], found
+
+
+@pytest.mark.parametrize("sections, alone", [
+    # a bore wider than the neighbour's outside: the two touch in no face (found by fuzzing)
+    ("[{ z_start = 0.0, z_end = 0.25, r_inner = 0.0, r_outer = 0.01 }, "
+     "{ z_start = 0.25, z_end = 0.5, r_inner = 0.02, r_outer = 0.025 }]", 1),
+    # a ring around the shaft with a 1 mm gap between them, listed first
+    ("[{ z_start = 0.1, z_end = 0.2, r_inner = 0.026, r_outer = 0.03 }, "
+     "{ z_start = 0.0, z_end = 0.5, r_inner = 0.0, r_outer = 0.025 }]", 0),
+])
+def test_sections_that_share_no_face_are_not_one_part(tmp_path, sections, alone):
+    """A part is one body: its sections were checked for gaps along z only, so two bodies
+    that meet in a line or not at all were solved as one part."""
+    text = shipped_specs()["fin-shaft"].read_text(encoding="utf-8")
+    old = "sections = [{ z_start = 0.0, z_end = 0.5, r_inner = 0.0, r_outer = 0.025 }]"
+    assert old in text
+    found = problems_of_file(tmp_path, text.replace(old, f"sections = {sections}"))
+    assert [p.field for p in found] == [f"parts[0].sections[{alone}]"], found
+    assert "shares no face" in found[0].message
+
+
+def test_sections_joined_radially_or_end_to_end_are_one_part(tmp_path):
+    """The joins a part may have: a ring on the shaft (one's r_outer the other's r_inner) and
+    a step in diameter where one ends and the next starts (as the shipped specs' bearings
+    and shafts)."""
+    text = shipped_specs()["fin-shaft"].read_text(encoding="utf-8")
+    old = "sections = [{ z_start = 0.0, z_end = 0.5, r_inner = 0.0, r_outer = 0.025 }]"
+    path = tmp_path / "joined.toml"
+    path.write_text(text.replace(old, (
+        "sections = [{ z_start = 0.0, z_end = 0.25, r_inner = 0.0, r_outer = 0.025 }, "
+        "{ z_start = 0.25, z_end = 0.5, r_inner = 0.0, r_outer = 0.02 }, "
+        "{ z_start = 0.1, z_end = 0.2, r_inner = 0.025, r_outer = 0.03 }]")), encoding="utf-8")
+    assert len(load_spec(path).parts[0].sections) == 3
+
+
+@pytest.mark.parametrize("old, new, field", [
+    # a unit slip or an exponent below any solid or gas a spec meshes (found by fuzzing:
+    # E = 1 Pa solved to a TCP growth of 33.9 µm)
+    ("E_Pa = 1e9", "E_Pa = 1.0", "materials.mat_a.E_Pa"),
+    ("E_Pa = 1e9", "E_Pa = 200.0", "materials.mat_a.E_Pa"),  # GPa written as Pa
+    ("c_J_kgK = 500.0", "c_J_kgK = 1e-300", "materials.mat_a.c_J_kgK"),
+    ("c_J_kgK = 500.0", "c_J_kgK = 0.5", "materials.mat_a.c_J_kgK"),  # kJ/kg/K
+    ("rho_kg_m3 = 1000.0", "rho_kg_m3 = 1e-3", "materials.mat_a.rho_kg_m3"),
+    ("k_r_W_mK = 1.0", "k_r_W_mK = 1e-300", "materials.mat_a.k_r_W_mK"),
+])
+def test_a_material_below_any_solid_or_gas_is_named(tmp_path, old, new, field):
+    """The lower bounds of spindle.spec_reader._read_material: air's layer (0.026 W/m/K,
+    1.18 kg/m3, E 1e5 Pa) and lead's 129 J/kg/K pass, these do not."""
+    from tests.conftest import MATERIALS
+
+    assert old in MATERIALS  # its first occurrence is mat_a's
+    path = write_spec(tmp_path, GOOD)
+    path.write_text(path.read_text(encoding="utf-8").replace(old, new, 1), encoding="utf-8")
+    with pytest.raises(SpecError) as exc:
+        load_spec(path)
+    assert [p.field for p in exc.value.problems] == [field], exc.value.problems
+    assert "is not physical (must be >=" in exc.value.problems[0].message
+
+
+def test_a_film_table_at_a_negative_speed_is_named(tmp_path):
+    """A speed is its magnitude, as in the cycles: a table row at -100 rpm was accepted and
+    never used (found by fuzzing)."""
+    found = problems(tmp_path, GOOD.replace(
+        "h_W_m2K = 10.0", "h_W_m2K = { speed_rpm = [-100.0, 0.0], value = [10.0, 10.0] }", 1))
+    assert [p.field for p in found] == ["surfaces[0].h_W_m2K.speed_rpm"], found

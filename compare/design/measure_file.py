@@ -240,6 +240,9 @@ def _read_inverse(r: _Reader, data: dict, measures: dict[str, Measure],
     if not (isinstance(items, list) and all(isinstance(x, dict) for x in items)):
         r.add("inverse", "must be a list of tables", "write each target as [[inverse]]")
         return []
+    listed = data.get("measure")
+    written = {x.get("name") for x in listed if isinstance(x, dict)} if isinstance(
+        listed, list) else set()
     out, seen = [], set()
     for i, d in enumerate(items):
         where = f"inverse[{i}]"
@@ -248,8 +251,10 @@ def _read_inverse(r: _Reader, data: dict, measures: dict[str, Measure],
         mname = d.get("measure")
         m = measures.get(mname) if isinstance(mname, str) else None
         if m is None:
-            r.add(f"{where}.measure", f"{mname!r} is not a measure of this file",
-                  f"name one of {sorted(measures)}")
+            if not (isinstance(mname, str) and mname in written):  # else its own problems
+                # (a measure of this file that could not be read) are said already
+                r.add(f"{where}.measure", f"{mname!r} is not a measure of this file",
+                      f"name one of {sorted(measures)}")
             continue
         vary = d.get("vary", SIZE_FIELDS[m.kind][0])
         if vary not in SIZE_FIELDS[m.kind]:
