@@ -495,22 +495,26 @@ def test_fig15_spreads_lambdas_near_one_and_survives_a_loss(tmp_path, monkeypatc
     assert labels[0].startswith("fins\no 0.08 K, ■ 0.64 K")  # eq. 24: 34.8 * 0.0188 / 1.0188
 
 
-@pytest.mark.parametrize("key, value", [("A_M_m2", 1e300), ("alpha_M_W_m2K", 1e300)])
-def test_a_measure_far_beyond_any_spindle_is_named(tmp_path, body, key, value):
-    """An added surface of 1e300 m2 ran, printed numpy's overflow warnings, and wrote its
-    folder with exit 1; the bounds (100 m2, 1e5 W/(m2 K): compare.design.measure_file) name
-    it instead."""
-    values = {"A_M_m2": 0.01, "alpha_M_W_m2K": 10.0, key: value}
-    p = _write(tmp_path, f"""
+def _fins_file(A_M_m2: float = 0.01, alpha_M_W_m2K: float = 10.0) -> str:
+    """A measures file of the uniform body with one added surface."""
+    return f"""
 spec = "uniform-body"
 
 [[measure]]
 name = "fins"
 kind = "added_surface"
 surfaces = ["lateral"]
-A_M_m2 = {values["A_M_m2"]}
-alpha_M_W_m2K = {values["alpha_M_W_m2K"]}
-""")
+A_M_m2 = {A_M_m2}
+alpha_M_W_m2K = {alpha_M_W_m2K}
+"""
+
+
+@pytest.mark.parametrize("key, value", [("A_M_m2", 1e300), ("alpha_M_W_m2K", 1e300)])
+def test_a_measure_far_beyond_any_spindle_is_named(tmp_path, body, key, value):
+    """An added surface of 1e300 m2 ran, printed numpy's overflow warnings, and wrote its
+    folder with exit 1; the bounds (100 m2, 1e5 W/(m2 K): compare.design.measure_file) name
+    it instead."""
+    p = _write(tmp_path, _fins_file(**{key: value}))
     with pytest.raises(MeasureFileError) as exc:
         read_measures(p, body)
     assert [q.field for q in exc.value.problems] == [f"measure[0].{key}"]
@@ -533,16 +537,7 @@ def test_a_sweep_far_beyond_any_spindle_is_named(tmp_path, body, entry, field):
     own (100 m2, 1e5 W/(m2 K)), the spec's largest source (1e6 W: spindle.spec_fields) and
     a length within 0.1-10 times the spindle's."""
     source = body.heat_sources[0].name
-    p = _write(tmp_path, f"""
-spec = "uniform-body"
-
-[[measure]]
-name = "fins"
-kind = "added_surface"
-surfaces = ["lateral"]
-A_M_m2 = 0.01
-alpha_M_W_m2K = 10.0
-
+    p = _write(tmp_path, _fins_file() + f"""
 [sweeps]
 {entry.replace("SOURCE", source)}
 """)
@@ -566,16 +561,7 @@ def test_a_measures_file_with_a_byte_order_mark_reads_as_without(tmp_path, body)
 def test_a_target_of_a_broken_measure_is_not_a_second_problem(tmp_path, body):
     """A measure with A_M_m2 = 0 also gave "inverse[0].measure: 'fins' is not a measure of
     this file" (found by fuzzing): one problem, one message."""
-    p = _write(tmp_path, """
-spec = "uniform-body"
-
-[[measure]]
-name = "fins"
-kind = "added_surface"
-surfaces = ["lateral"]
-A_M_m2 = 0.0
-alpha_M_W_m2K = 10.0
-
+    p = _write(tmp_path, _fins_file(A_M_m2=0.0) + """
 [[inverse]]
 name = "fins_for_1pct"
 measure = "fins"
