@@ -326,7 +326,8 @@ def read_bench(path: str | Path) -> BenchRun:
     Checks the structure (header, duplicate columns, required columns, one cell per column),
     every cell of the known columns (numbers, finite), ``time_s`` (present in every row,
     >= 0, strictly increasing), plausibility (°C not kelvin, >= -60 °C; speed 0..100 000 rpm;
-    power within ±1000 kW), no known column all empty, and that there is enough data to fit
+    power within ±1000 kW), no required column all empty (an optional one all empty was not
+    measured: left out with a BenchWarning), and that there is enough data to fit
     (>= 50 rows with a measured channel over >= 30 min). Raises InputError naming the file,
     the column and/or the file line, and the fix.
     """
@@ -342,7 +343,7 @@ def read_bench(path: str | Path) -> BenchRun:
     table = _read_rows(lines, header_idx, header, error)
     line_no = table.line_no
     t = _read_time(table, seen["time_s"], error)
-    columns = _read_known_columns(table, seen, error)
+    columns = _read_known_columns(table, seen, error, name)
     _check_plausible(columns, line_no, error)
     extra = _read_unknown_columns(table, header)
     unknown = list(extra)
@@ -478,12 +479,15 @@ def _read_time(table: _Table, j: int, error: _ErrorFor) -> np.ndarray:
     return t
 
 
-def _read_known_columns(table: _Table, seen: dict[str, int],
-                        error: _ErrorFor) -> dict[str, np.ndarray]:
+def _read_known_columns(table: _Table, seen: dict[str, int], error: _ErrorFor,
+                        name: str) -> dict[str, np.ndarray]:
     """The known columns present except time_s, in file units: numbers or empty cells,
-    finite, not empty in every row."""
+    finite. A required column empty in every row is an error; an optional one (a sensor,
+    the load torque) was not measured: it is left out with a :class:`BenchWarning`, and at
+    least one sensor column must remain."""
     line_no = table.line_no
     columns: dict[str, np.ndarray] = {}
+    empty: list[str] = []
     for col in KNOWN_COLUMNS[1:]:
         if col not in seen:
             continue
@@ -497,9 +501,24 @@ def _read_known_columns(table: _Table, seen: dict[str, int],
             raise error(f"{col} (line {line_no[inf[0]]})", "is not finite",
                         "write a finite number, or leave the cell empty when not measured")
         if np.isnan(arr).all():
-            raise error(col, "the column is empty in every row",
-                        "export the measurement, or drop the column if it was not measured")
+            if col in REQUIRED_COLUMNS:
+                raise error(col, "the column is empty in every row", "export the measurement "
+                            f"(required: {', '.join(REQUIRED_COLUMNS)})")
+            empty.append(col)  # "not measured at this instant" (the format), at every one
+            continue
         columns[col] = arr
+    if not any(col in columns for col in CHANNEL_COLUMNS.values()):
+        present = [c for c in CHANNEL_COLUMNS.values() if c in seen]
+        raise error(", ".join(present), "no measured channel: every sensor column is empty in "
+                    "every row", "export at least one of the sensor columns the model is "
+                    f"checked against ({', '.join(CHANNEL_COLUMNS.values())}) with its values")
+    for col in empty:  # never measured: as if the column were not there
+        warnings.warn(BenchWarning(
+            f"{name}: {col}: empty in every row, read as not measured"
+            + (": the run is taken as a no-load run (no process torque), so the motor's losses "
+               "are the electrical power less the bearings' friction only"
+               if col == "load_torque_Nm" else " (the run is checked on the other channels)")),
+            stacklevel=3)
     return columns
 
 

@@ -184,8 +184,12 @@ ERRORS = [
      "power_kW (line 22)", "'1,2' is not a number"),
     ("cell inf", HEADER, lambda ls: ls[:3] + [row(180, power="inf")] + ls[4:], "power_kW (line 5)",
      "is not finite"),
-    ("column empty", HEADER, lambda ls: [ln.rsplit(",", 1)[0] + "," for ln in ls], "P1_um",
+    ("required column empty", HEADER, lambda ls: [row(i * 60.0, speed="4300", env="")
+                                                  for i in range(61)], "T_env_C",
      "empty in every row"),
+    ("every channel empty", HEADER, lambda ls: [row(i * 60.0, speed="4300", t1="", t2="", ts="",
+                                                    p1="") for i in range(61)],
+     "T1_C, T2_C, T_stator_C, P1_um", "every sensor column is empty in every row"),
     ("kelvin median", HEADER, lambda ls: [ln.replace(",22.0,", ",295.15,") for ln in ls],
      "T1_C (line 2)", "looks like kelvin"),
     ("kelvin one", HEADER, lambda ls: ls[:30] + [row(1800, ts="300")] + ls[31:], "T_stator_C (line 32)",
@@ -467,3 +471,24 @@ def test_settled_speed_merges_drive_scatter_and_keeps_real_steps():
         assert np.unique(step).size == 1 and abs(step[0] - level) <= 5
     assert np.all(out[set_speed == 0.0] == 0.0)
     assert np.unique(out).size == 4  # 0, 1500, 1530, 6000: five steps, two at standstill
+
+
+@pytest.mark.parametrize("column, cell", [("P1_um", "p1"), ("T2_C", "t2")])
+def test_a_sensor_column_empty_in_every_row_was_not_measured(tmp_path, column, cell):
+    """An empty cell means "not measured at this instant" (the format), and users should not
+    have to edit their exports: a sensor column empty in every row is read as absent, with a
+    warning naming it (it was an error asking to drop the column; found by fuzzing)."""
+    path = write(tmp_path, [row(i * 60.0, speed="4300", **{cell: ""}) for i in range(61)])
+    with pytest.warns(BenchWarning, match=f"{column}: empty in every row, read as not measured"):
+        run = read_bench(path)
+    assert column not in run.columns and column.rsplit("_", 1)[0] not in run.channels
+    assert len(run.channels) == 3
+
+
+def test_a_torque_column_empty_in_every_row_is_a_no_load_run_said_so(tmp_path):
+    """As a file without the column (the format: absent means a no-load run), with a warning
+    that says what that assumes."""
+    lines = [row(i * 60.0, speed="4300") + "," for i in range(61)]
+    with pytest.warns(BenchWarning, match="load_torque_Nm: empty in every row.*no-load run"):
+        run = read_bench(write(tmp_path, lines, header=HEADER + ",load_torque_Nm"))
+    assert not run.load_torque_measured and not run.columns["load_torque_Nm"].any()
