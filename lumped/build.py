@@ -31,6 +31,8 @@ bearing's rolling layer exchanges heat only with its own rings.
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -248,7 +250,8 @@ def _node_number(nodes: int | str) -> int:
             raise SpecError([Problem("command line", "--nodes", f"unknown preset '{nodes}'",
                                      f"use an integer >= 2 or one of {sorted(PRESETS)}")])
         nodes = PRESETS[nodes]
-    if int(nodes) != nodes or not 2 <= nodes <= MAX_NODES:
+    if isinstance(nodes, bool) or not isinstance(nodes, numbers.Real) or not (
+            math.isfinite(nodes) and int(nodes) == nodes and 2 <= nodes <= MAX_NODES):
         raise SpecError([Problem("command line", "--nodes",
                                  f"{nodes!r} is not an integer in 2..{MAX_NODES}",
                                  "give the number of masses along shaft and housing, "

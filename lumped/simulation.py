@@ -18,7 +18,13 @@ from lumped.results import LumpedSteadyResult, LumpedTransientResult
 from spindle.drive import as_load_case
 from spindle.errors import SolverError
 from spindle.geometry import TOL_M
-from spindle.loads import LoadCase, start_temperature_K, time_grid
+from spindle.loads import (
+    LoadCase,
+    check_start_temperature,
+    start_temperature_K,
+    time_grid,
+    time_step_s,
+)
 from spindle.spec import Spec
 from spindle.spec_reader import as_spec
 
@@ -134,7 +140,7 @@ class LumpedModel:
         ambient at t = 0; the growth readings are zeroed at the start, as a bench zeroes
         P1."""
         case = as_load_case(self.spec, case)
-        if dt_s <= 0 or case.duration_s <= 0:
+        if time_step_s(dt_s) <= 0 or case.duration_s <= 0:
             raise SolverError("a transient run needs dt_s > 0 and a duration > 0")
         sys = self.system
         grid = time_grid(case, dt_s)
@@ -174,6 +180,7 @@ class LumpedModel:
             return np.full(n, self.spec.T_initial_K)
         if T0 is None or np.isscalar(T0):
             return np.full(n, start_temperature_K(case, T0))
+        check_start_temperature(T0)
         x = np.asarray(T0, dtype=float)
         if x.shape != (n,):
             raise SolverError(f"T0 has shape {x.shape}; the model has {n} masses")

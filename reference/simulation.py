@@ -15,11 +15,12 @@ from meshes import build_mesh
 from reference.elastic import ThermoelasticModel
 from reference.results import SteadyResult, TransientResult
 from reference.thermal import ThermalModel
+from spindle.arguments import whole_number
 from spindle.drive import as_load_case
 from spindle.loads import LoadCase
 from spindle.spec import Spec
 from spindle.spec_reader import as_spec
-from spindle.units import RPM_TO_RAD_S
+from spindle.units import MESH_LEVEL_MAX, RPM_TO_RAD_S
 
 
 class ReferenceModel:
@@ -32,6 +33,8 @@ class ReferenceModel:
     def __init__(self, spec: Spec | str, level: int = 2, order: int = 2,
                  centrifugal: bool = False, elastic: bool = True):
         spec = as_spec(spec)
+        level = whole_number(level, "level", 0, MESH_LEVEL_MAX)
+        order = whole_number(order, "order", 1, 2)
         self.spec, self.centrifugal = spec, centrifugal
         self.thermal = ThermalModel(build_mesh(spec, level), order)
         self.elastic = ThermoelasticModel(self.thermal) if elastic else None

@@ -26,7 +26,13 @@ from reference.assembly import assemble, light_basis, return_free_memory
 from reference.forms import capacity, conduction, film, surface_flux, volume_source
 from reference.probes import probe_matrix
 from spindle.errors import SolverError
-from spindle.loads import LoadCase, start_temperature_K, time_grid
+from spindle.loads import (
+    LoadCase,
+    check_start_temperature,
+    start_temperature_K,
+    time_grid,
+    time_step_s,
+)
 from spindle.spec import BearingLink, ContactLink
 from spindle.units import ZERO_C_K
 
@@ -164,7 +170,7 @@ class ThermalModel:
 
     def __init__(self, smesh: SpindleMesh, order: int = 2):
         if order not in ELEMENTS:
-            raise ValueError(f"order must be 1 or 2, not {order}")
+            raise ValueError(f"order must be 1 or 2, not {order!r}")
         self.smesh, self.order, self.spec = smesh, order, smesh.spec
         mesh = smesh.mesh
         self.intorder = 2 * order + 1
@@ -477,7 +483,7 @@ class ThermalModel:
 
         if not 0.0 <= theta <= 1.0:
             raise ValueError("theta must be within [0, 1]")
-        if dt_s <= 0 or case.duration_s <= 0:
+        if time_step_s(dt_s) <= 0 or case.duration_s <= 0:
             raise SolverError("a transient run needs dt_s > 0 and a duration > 0")
         grid = time_grid(case, dt_s)
         op = self.op
@@ -485,6 +491,7 @@ class ThermalModel:
         if T0 is None or np.isscalar(T0):
             T = np.full(N, start_temperature_K(case, T0))
         else:
+            check_start_temperature(T0)
             T = np.asarray(T0, dtype=float).copy()
         T_start = T.copy()
         names, pts = self.sensor_points()

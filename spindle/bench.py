@@ -331,6 +331,8 @@ def read_bench(path: str | Path) -> BenchRun:
     (>= 50 rows with a measured channel over >= 30 min). Raises InputError naming the file,
     the column and/or the file line, and the fix.
     """
+    if not isinstance(path, str | Path):
+        raise TypeError(f"a bench run is the path of its CSV file, not {type(path).__name__}")
     path = Path(path)
     name = str(path)
 

@@ -21,7 +21,7 @@ from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
 from spindle.power import power_balance
 from spindle.spec import Spec
-from spindle.units import ZERO_C_K
+from spindle.units import MAX_SERIES_POINTS, ZERO_C_K
 
 
 def bench_grid(run: BenchRun, grid_s: float | None = None) -> np.ndarray:
@@ -38,6 +38,10 @@ def bench_grid(run: BenchRun, grid_s: float | None = None) -> np.ndarray:
         raise InputError(str(run.path), "grid_s", f"{grid_s!r} is not a time step > 0 s",
                          "give the grid spacing in seconds, e.g. 60")
     t0, t1 = float(run.time_s[0]), float(run.time_s[-1])
+    if (t1 - t0) / step > MAX_SERIES_POINTS:  # before the arange: 1e-3 s over 16 h is 5.8e7
+        raise InputError(str(run.path), "grid_s", f"{step:g} s over the run's "
+                         f"{(t1 - t0) / 3600:.4g} h is more than {MAX_SERIES_POINTS:.0e} grid "
+                         "points", f"give grid_s >= {(t1 - t0) / MAX_SERIES_POINTS:.3g} s")
     pts = np.arange(math.floor(t0 / step) * step, t1, step)
     tol = 1e-6 * step
     pts = pts[(np.abs(pts - t0) > tol) & (np.abs(pts - t1) > tol)]

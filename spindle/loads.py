@@ -38,6 +38,12 @@ class TimeSeries:
     def __post_init__(self) -> None:
         if len(self.time_s) != len(self.values) or not self.values:
             raise ValueError("TimeSeries needs as many times as values, at least one")
+        try:
+            finite = bool(np.isfinite(np.asarray((*self.time_s, *self.values), dtype=float)).all())
+        except (TypeError, ValueError):
+            raise TypeError("TimeSeries times [s] and values must be numbers") from None
+        if not finite:  # a NaN compares false with everything: it ran to NaN results
+            raise ValueError("TimeSeries times [s] and values must be finite numbers")
         if any(b <= a for a, b in zip(self.time_s, self.time_s[1:], strict=False)):
             raise ValueError("TimeSeries times must increase strictly")
         if self.interpolation not in ("linear", "previous"):
@@ -116,6 +122,23 @@ class LoadCase:
     #: further times [s] every transient of this case lands on (with_jump_ladder)
     extra_times_s: tuple[float, ...] = ()
 
+    def __post_init__(self) -> None:
+        # a number where a TimeSeries belongs failed only at solve time ("'float' object is
+        # not callable"): say which input, here
+        for name in ("speed_rpm", "T_ambient_K", "T_coolant_K"):
+            if not isinstance(getattr(self, name), TimeSeries):
+                raise TypeError(f"LoadCase {name} must be a TimeSeries (TimeSeries.constant(x) "
+                                f"for a constant), not {type(getattr(self, name)).__name__}")
+        bad = next((k for k, v in dict(self.sources).items() if not isinstance(v, TimeSeries)),
+                   None)
+        if bad is not None:
+            raise TypeError(f"LoadCase sources['{bad}'] must be a TimeSeries of W, not "
+                            f"{type(self.sources[bad]).__name__}")
+        if not (isinstance(self.duration_s, int | float) and math.isfinite(self.duration_s)
+                and self.duration_s >= 0):
+            raise ValueError(f"LoadCase duration_s must be a finite number >= 0 s, not "
+                             f"{self.duration_s!r}")
+
     def breakpoints(self) -> np.ndarray:
         """All sample times of all inputs [s] and the extra times, sorted and unique."""
         series = [self.speed_rpm, self.T_ambient_K, self.T_coolant_K, *self.sources.values()]
@@ -147,7 +170,22 @@ def start_temperature_K(case: LoadCase, T0: float | None = None) -> float:
     """The uniform temperature [K] a transient of ``case`` starts from: ``T0``, or by default
     the case's ambient at t = 0 (a spindle at rest in its room). Every model starts there,
     and their growth read-outs are zeroed there."""
-    return float(case.T_ambient_K(0.0)) if T0 is None else float(T0)
+    if T0 is None:
+        return float(case.T_ambient_K(0.0))
+    check_start_temperature(T0)
+    return float(T0)
+
+
+def check_start_temperature(T0) -> None:
+    """ValueError unless ``T0`` [K] (a number, or one per mass or node) is finite and above
+    0 K: a NaN ran to the end and wrote empty cells, a negative one solved."""
+    try:
+        x = np.asarray(T0, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"T0 must be a temperature in K (or one per mass or node), not "
+                        f"{type(T0).__name__}") from None
+    if not (np.isfinite(x).all() and (x > 0).all()):
+        raise ValueError("T0 must be finite temperatures above 0 K (kelvin, not °C)")
 
 
 def time_grid(case: LoadCase, dt_s: float) -> np.ndarray:
@@ -161,9 +199,18 @@ def time_grid(case: LoadCase, dt_s: float) -> np.ndarray:
     return grid[np.concatenate([[True], np.diff(grid) > 1e-9 * dt_s])]
 
 
+def time_step_s(dt_s) -> float:
+    """``dt_s`` [s] as a float; TypeError naming it where it is no number (a '60' failed as
+    "'<=' not supported between instances of 'str' and 'int'")."""
+    if isinstance(dt_s, bool) or not isinstance(dt_s, int | float | np.integer | np.floating):
+        raise TypeError(f"dt_s must be a time step in s (a number), not {type(dt_s).__name__}")
+    return float(dt_s)
+
+
 def check_time_step(case: LoadCase, dt_s: float) -> None:
     """InputError naming --dt where dt_s [s] is not positive or gives ``case`` more than
     MAX_SERIES_POINTS time steps (a command asks this before its work)."""
+    dt_s = time_step_s(dt_s)
     if not (math.isfinite(dt_s) and dt_s > 0):
         raise InputError("command line", "--dt", f"{dt_s:g} s is not a positive time step",
                          "give a time step > 0 s, e.g. 60")

@@ -120,6 +120,8 @@ def drive_file_path(spec_file: str | Path, preset: str) -> Path | None:
 
 def resolve_spec_path(name_or_path: str | Path) -> Path:
     """A path to a TOML file, or the name of a shipped spec."""
+    if not isinstance(name_or_path, str | Path):
+        raise TypeError(f"a spec is a shipped name or a path, not {type(name_or_path).__name__}")
     p = Path(name_or_path)
     if p.is_file():
         return p

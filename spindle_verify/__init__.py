@@ -77,13 +77,10 @@ def solve(spec, case=None, dt_s: float | None = None, model: str = "fem:2"):
     its steady state when ``dt_s`` is None, else the transient over the case read every
     ``dt_s`` [s] (backward Euler for the FEM, the exact zero-order hold for a lumped model).
     Returns the result object (``.summary()``, ``.to_pandas()``, ``.plot()``, ``.save()``)."""
-    kind, _, size = model.partition(":")
-    if kind == "fem":
-        m = reference_model(spec, int(size or 2))
-    elif kind == "lumped":
-        m = lumped_model(spec, int(size) if size.isdigit() else (size or 11))
-    else:
-        raise ValueError(f"model '{model}': use 'fem:L' or 'lumped:N'")
+    from spindle.arguments import model_choice
+
+    kind, size = model_choice(model)
+    m = reference_model(spec, size) if kind == "fem" else lumped_model(spec, size)
     return m.steady(case) if dt_s is None else m.transient(case, dt_s)
 
 
@@ -115,9 +112,11 @@ def synth(spec, cycle: str, effect, seed: int, out_csv: str | Path, **options) -
     (``RUN.truth.json``; ``fit`` never reads it). Returns the truth. Options as
     :func:`compare.synth.bench.synth` (``level``, ``dt_s``, ``mismatch``)."""
     from compare.synth.bench import synth as make
+    from spindle.arguments import whole_number
     from spindle.spec_reader import as_spec
 
-    return make(as_spec(spec), cycle, effect, seed, Path(out_csv), **options)
+    return make(as_spec(spec), cycle, effect, whole_number(seed, "seed", 0), Path(out_csv),
+                **options)
 
 
 def register_effect(effect) -> None:

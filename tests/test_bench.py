@@ -310,6 +310,10 @@ def test_grid_every_60_s_plus_the_runs_start_and_end(tmp_path):
                                                3600.0, 3630.0]
     with pytest.raises(InputError, match="grid_s"):
         bench_grid(run, 0.0)
+    # 1e-4 s over the hour is 3.6e7 points (spindle.units.MAX_SERIES_POINTS): it ran for
+    # minutes in the API (found by fuzzing); the command line's --dt had the check
+    with pytest.raises(InputError, match="grid_s: 0.0001 s over the run's 1.007 h is more than"):
+        bench_grid(run, 1e-4)
 
 
 def test_a_run_whose_clock_starts_late_gets_the_grid_of_the_shifted_run(tmp_path):

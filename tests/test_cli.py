@@ -478,3 +478,21 @@ def test_a_spindle_without_heat_sits_at_its_reference_temperature(tmp_path, caps
     summary = json.loads((out / "summary.json").read_text())
     # the room is 20 °C; 1e-9 K is round-off on 293 K
     assert all(abs(v - 20.0) < 1e-9 for v in summary["sensors_C"].values())
+
+
+@pytest.mark.parametrize("effects, words", [(["sensor_lag", "sensor_lag"], "given twice"),
+                                            (["clean", "fixture_expansion"], "'clean'")])
+def test_synth_refuses_an_effect_twice_or_clean_with_effects(tmp_path, capsys, effects, words):
+    """`synth --effect sensor_lag sensor_lag` applied the lag twice and wrote one parameter
+    set to the truth (5.60 K for the effect, 8.28 K in the run; found by fuzzing)."""
+    out = tmp_path / "run.csv"
+    assert main(["synth", "--level", "0", "--effect", *effects, "--out", str(out),
+                 "--quiet"]) == 2
+    assert words in capsys.readouterr().err and not out.exists()
+    from compare.synth.bench import synth
+    from spindle.errors import InputError
+    from spindle.spec_reader import load_spec
+
+    with pytest.raises(InputError, match=words):  # the library refuses it too, before work
+        synth(load_spec("spl2782"), "spl-16h", effects, 0, out)
+    assert not out.exists()

@@ -61,3 +61,57 @@ def test_the_examples_use_only_the_public_name():
             names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
                      [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
             assert not {n.split(".")[0] for n in names} & internal, (path.name, names)
+
+
+def _constant_case(**change):
+    from spindle.loads import LoadCase, TimeSeries
+
+    values = {"speed_rpm": 4300.0, "T_ambient_K": 293.15, "T_coolant_K": 293.15, **change}
+    sources = values.pop("sources", {})
+    return LoadCase("c", *(TimeSeries.constant(values[k]) for k in
+                           ("speed_rpm", "T_ambient_K", "T_coolant_K")),
+                    {k: TimeSeries.constant(v) for k, v in sources.items()})
+
+
+# Each was found by fuzzing the API:
+# a NaN ran to NaN results or empty CSV cells, an impossible value solved, a wrong type failed
+# deep in pathlib, numpy or scikit-fem without naming the argument.
+BAD_CALLS = [
+    (lambda: sv.reference_model("fin-shaft", level="1"), TypeError, "level must be a whole"),
+    (lambda: sv.reference_model("fin-shaft", level=1.5), TypeError, "level must be a whole"),
+    (lambda: sv.reference_model("fin-shaft", level=0, order="2"), TypeError, "order"),
+    (lambda: sv.lumped_model("spl2782", nodes=None), Exception, "None is not an integer"),
+    (lambda: sv.solve("spl2782", model=5), TypeError, "model must be"),
+    (lambda: sv.solve("spl2782", model="fem:x"), ValueError, "L is a mesh level"),
+    (lambda: sv.solve("spl2782", 42, model="lumped:5"), TypeError, "a case is a LoadCase"),
+    (lambda: sv.solve("spl2782", "spl-16h", dt_s="60", model="lumped:5"), TypeError, "dt_s"),
+    (lambda: sv.lumped_model("spl2782", 5).transient("spl-16h", 600.0, T0=float("nan")),
+     ValueError, "T0 must be finite"),
+    (lambda: sv.lumped_model("spl2782", 5).transient("spl-16h", 600.0, T0=-5.0), ValueError,
+     "above 0 K"),
+    (lambda: _constant_case(speed_rpm=float("nan")), ValueError, "must be finite"),
+    (lambda: sv.solve("spl2782", _constant_case(T_ambient_K=20.0), model="lumped:5"),
+     ValueError, "T_ambient_K reaches 20 K"),
+    (lambda: sv.solve("spl2782", _constant_case(speed_rpm=-4300.0), model="lumped:5"),
+     ValueError, "speed_rpm reaches -4300 rpm"),
+    (lambda: sv.solve("spl2782", _constant_case(sources={"front_bearing": -500.0}),
+                      model="lumped:5"), ValueError, "reaches -500 W"),
+    (lambda: sv.solve("spl2782", _constant_case(sources={"no_such": 10.0}), model="lumped:5"),
+     ValueError, "not heat sources of spec"),
+    (lambda: __import__("spindle.loads", fromlist=["LoadCase"]).LoadCase(
+        "x", 4300.0, 293.15, 293.15), TypeError, "speed_rpm must be a TimeSeries"),
+    (lambda: sv.assert_within("fin-shaft", "lumped:5", tol_temp_K="5", reference_level=0),
+     TypeError, "tol_temp_K must be a number"),
+    (lambda: sv.synth("spl2782", "spl-16h", "clean", -1, "x.csv"), ValueError, "seed is -1"),
+    (lambda: sv.fit("no-such.csv", alpha="0.01"), Exception, "alpha: is '0.01', not a float"),
+    (lambda: sv.fit(123), TypeError, "path of its CSV file"),
+    (lambda: __import__("spindle.spec_reader", fromlist=["load_spec"]).load_spec(123),
+     TypeError, "a spec is a shipped name or a path"),
+]
+
+
+@pytest.mark.parametrize("call, kind, words", BAD_CALLS,
+                         ids=[f"bad{i}" for i in range(len(BAD_CALLS))])
+def test_a_bad_argument_is_named_where_it_is_given(call, kind, words):
+    with pytest.raises(kind, match=words):
+        call()

@@ -145,8 +145,14 @@ class Criteria:
         return value
 
     def with_options(self, **values) -> Criteria:
-        """These criteria with some entries set (None leaves one as it is), range-checked."""
-        return replace(self, **{k: self.checked(k, v) for k, v in values.items() if v is not None})
+        """These criteria with some entries set (None leaves one as it is), of the entry's
+        type (a '0.01' for alpha failed deep in scipy after the base's calibration) and
+        range-checked."""
+        hints = typing.get_type_hints(Criteria)
+        return replace(self, **{
+            k: self.checked(k, conform(list(v) if isinstance(v, tuple) else v, hints[k],
+                                       ("criteria", k)))
+            for k, v in values.items() if v is not None})
 
     def with_file(self, path: str | Path) -> Criteria:
         """These criteria with the entries a TOML file sets: ``name = value`` lines, or

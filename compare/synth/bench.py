@@ -255,6 +255,13 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
                          "add a [[sensors]] entry with name = \"P1\" and kind = "
                          "\"axial_displacement\" (docs/spec.md)")
     names = [effect] if isinstance(effect, str) else list(effect)
+    twice = next((n for n in names if names.count(n) > 1), None)
+    if twice is not None:  # its truth has one parameter set: injected twice, it would lie
+        raise InputError("synth", "effect", f"'{twice}' is given twice",
+                         "give each effect once (several different ones are injected together)")
+    if "clean" in names and len(names) > 1:
+        raise InputError("synth", "effect", "'clean' (no effect) is given with effects",
+                         "give clean alone, or the effects without it")
     names = [n for n in names if n != "clean"]
     for n in names:
         kind_of(n)

@@ -40,27 +40,32 @@ class Verdict:
 def model_error(spec_ref: str, model: str, case: str | None = None, reference_level: int = 2,
                 dt_s: float = 120.0) -> Verdict:
     """Errors of ``model`` against the FEM reference on ``case`` (see the module doc)."""
+    from spindle.arguments import model_choice, real_number, whole_number
     from spindle.drive import as_load_case
     from spindle.spec_reader import as_spec
+    from spindle.units import MESH_LEVEL_MAX
 
     spec = as_spec(spec_ref)
-    kind, _, size = model.partition(":")
+    kind, size = model_choice(model)
+    reference_level = whole_number(reference_level, "reference_level", 0, MESH_LEVEL_MAX)
+    dt_s = real_number(dt_s, "dt_s", 1e-9, unit="s")
     load = as_load_case(spec, case)  # None: the spec's own steady case
     transient = case is not None and case != "nominal"
     dt = dt_s if transient else None
     T0 = float(load.T_ambient_K(0.0)) if transient else None
     ref = fem_entry(spec, reference_level, load, dt, T0)
     if kind == "lumped":
-        nodes = int(size) if size.isdigit() else size
+        nodes = size
         if isinstance(nodes, str):
             from lumped import PRESETS
 
+            if nodes not in PRESETS:
+                raise ValueError(f"model '{model}': N is a number of masses or one of "
+                                 f"{sorted(PRESETS)}")
             nodes = PRESETS[nodes]
         entry: Entry = lumped_entries(spec, load, [nodes], dt, T0)[0]
-    elif kind == "fem":
-        entry = fem_entry(spec, int(size), load, dt, T0)
     else:
-        raise ValueError(f"model '{model}': use 'lumped:N' or 'fem:L'")
+        entry = fem_entry(spec, size, load, dt, T0)
     acc = AccuracyResult(spec, load.name, transient, ref, f"FEM level {reference_level}",
                          [entry])
     row = acc.errors(entry)
@@ -73,6 +78,10 @@ def assert_within(spec: str, model: str, case: str | None = None,
     """:func:`model_error`, and ``AssertionError`` with a readable message when the worst
     temperature error exceeds ``tol_temp_K`` [K] or the P1 error ``tol_growth_um`` [µm]
     (defaults: the paper's 1 K and 1.5 µm). Returns the errors when within."""
+    from spindle.arguments import real_number
+
+    tol_temp_K = real_number(tol_temp_K, "tol_temp_K", 0.0, unit="K")
+    tol_growth_um = real_number(tol_growth_um, "tol_growth_um", 0.0, unit="µm")
     v = model_error(spec, model, case, reference_level, dt_s)
     msgs = []
     if not v.worst_temp_K <= tol_temp_K:
