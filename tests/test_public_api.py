@@ -105,6 +105,7 @@ BAD_CALLS = [
     (lambda: sv.synth("spl2782", "spl-16h", "clean", -1, "x.csv"), ValueError, "seed is -1"),
     (lambda: sv.fit("no-such.csv", alpha="0.01"), Exception, "alpha: is '0.01', not a float"),
     (lambda: sv.fit(123), TypeError, "path of its CSV file"),
+    (lambda: sv.fit("no-such.csv", workers=0), ValueError, "workers is 0, outside 1.."),
     (lambda: __import__("spindle.spec_reader", fromlist=["load_spec"]).load_spec(123),
      TypeError, "a spec is a shipped name or a path"),
 ]

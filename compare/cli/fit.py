@@ -102,7 +102,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     fp.add_argument("--cv-blocks", type=_criterion("cv_blocks", integer=True),
                     help="blocked cross-validation of the base and the final model: each of "
                     "this many blocks held out in turn, the model refitted without it and "
-                    f"simulated over it (default {table.cv_blocks}; 0: none)")
+                    f"simulated over it (default {table.cv_blocks}; 0: none, and then only "
+                    "an effect with a signature test in the raw samples can be named, as the "
+                    "others' evidence is the cross-validated prediction)")
     fp.add_argument("--alpha", type=_criterion("alpha"),
                     help="the level of every test: an effect's likelihood-ratio test, the "
                     "signature tests, the competitor's scan (against the same scan on noise) and the "

@@ -288,8 +288,11 @@ def summary_text(rep) -> str:
     warnings and the cross-validated error."""
     doc = rep.to_dict()
     lines = verdict_lines(doc)
+    unknown = rep.run.unknown_columns  # kept and reported, as the bench format asks
     lines.append(f"{rep.run.path}: {len(rep.run.time_s)} rows, {rep.run.duration_s / 3600:.2f} "
-                 f"h, channels {', '.join(rep.channels)}; {rep.runtime_s:.1f} s")
+                 f"h, channels {', '.join(rep.channels)}"
+                 + (f"; unknown columns kept, not used: {', '.join(unknown)}" if unknown else "")
+                 + f"; {rep.runtime_s:.1f} s")
     ad = doc.get("base_adequacy")
     if ad:
         lines.append(f"The base model {ad['statement']}.")

@@ -248,8 +248,10 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
     processes move the parameters' late digits, docs/fit.md "Options")."""
     from compare.fit.adequacy import base_adequacy, extrapolation_warnings
     from compare.residuals import diagnose
+    from spindle.arguments import whole_number
 
     t0 = time.perf_counter()
+    workers = whole_number(workers, "workers", 1)
     criteria = (criteria or Criteria()).with_options(alpha=alpha, cv_gain=min_gain,
                                                      cv_blocks=cv_blocks)
     unknown = [c for c in (candidates or []) if c not in LIBRARY]
