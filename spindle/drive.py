@@ -92,30 +92,34 @@ def as_load_case(spec: Spec, case: LoadCase | str | Path | None) -> LoadCase:
 
 
 def check_load_case(spec: Spec, case: LoadCase) -> None:
-    """ValueError where a LoadCase built in Python asks what no input file may (the cycle
-    readers' bounds): a source the spec does not have (it was ignored: the spec's own power
-    stood), a speed outside 0..SPEED_MAX_RPM, a temperature outside T_MIN_C..T_MAX_C, a heat
-    outside 0..POWER_MAX_KW. Found by fuzzing the API: each of these solved."""
-    from spindle.cycles import T_MAX_C, T_MIN_C
+    """InputError (the case named as its file) where a LoadCase built in Python asks what no
+    input file may: a source the spec does not have (it was ignored: the spec's own power
+    stood), a speed outside 0..SPEED_MAX_RPM, a temperature outside the bench's -60..250 °C
+    (the most a file may give), a heat outside 0..POWER_MAX_KW. Found by fuzzing the API:
+    each of these solved."""
+    from spindle.bench import T_KELVIN_MAX_C, T_MIN_C
     from spindle.units import POWER_MAX_KW, SPEED_MAX_RPM, ZERO_C_K
 
+    where = f"load case '{case.name}'"
     names = [h.name for h in spec.heat_sources]
     unknown = [k for k in case.sources if k not in names]
     if unknown:
-        raise ValueError(f"LoadCase '{case.name}': sources {unknown} are not heat sources of "
-                         f"spec '{spec.name}' ({names})")
+        raise InputError(where, "sources", f"{unknown} are not heat sources of spec "
+                         f"'{spec.name}'", f"name sources of the spec: {names}")
     limits = [("speed_rpm", case.speed_rpm, 0.0, SPEED_MAX_RPM, "rpm"),
-              ("T_ambient_K", case.T_ambient_K, T_MIN_C + ZERO_C_K, T_MAX_C + ZERO_C_K, "K"),
-              ("T_coolant_K", case.T_coolant_K, T_MIN_C + ZERO_C_K, T_MAX_C + ZERO_C_K, "K"),
+              ("T_ambient_K", case.T_ambient_K, T_MIN_C + ZERO_C_K, T_KELVIN_MAX_C + ZERO_C_K,
+               "K"),
+              ("T_coolant_K", case.T_coolant_K, T_MIN_C + ZERO_C_K, T_KELVIN_MAX_C + ZERO_C_K,
+               "K"),
               *((f"sources['{k}']", v, 0.0, POWER_MAX_KW * 1e3, "W")
                 for k, v in case.sources.items())]
     for what, series, lo, hi, unit in limits:
         v = np.asarray(series.values, dtype=float)
         if v.min() < lo or v.max() > hi:
             bad = v.min() if v.min() < lo else v.max()
-            raise ValueError(f"LoadCase '{case.name}': {what} reaches {bad:g} {unit}, outside "
-                             f"{lo:g}..{hi:g} {unit}" + (" (temperatures are in K)"
-                                                         if unit == "K" else ""))
+            raise InputError(where, what, f"reaches {bad:g} {unit}, outside {lo:g}..{hi:g} "
+                             f"{unit}", "give temperatures in K" if unit == "K" else
+                             f"give values in {lo:g}..{hi:g} {unit}")
 
 
 def load_case(spec: Spec, name_or_path: str | Path, base: LoadCase | None = None) -> LoadCase:
