@@ -230,6 +230,12 @@ def _split_contacts(spec: Spec, regions: list[Region], p: np.ndarray, t: np.ndar
 _LEVEL0: dict[int, tuple[Spec, list[Region], MeshTri, np.ndarray]] = {}
 
 
+#: the most elements a mesh may have: level 6 of spl2782 (5.6 million) takes 72 s and 2 GB to
+#: mesh, and its P2 assembly and solve several times that; 2e7 is what a 24 GB machine can
+#: still mesh (a spec with a fine h0_m asked for 90 million at level 6, killed after 3 min)
+MAX_ELEMENTS = 20_000_000
+
+
 def build_mesh(spec: Spec | str, level: int = 0) -> SpindleMesh:
     """Mesh of ``spec`` (a Spec, a shipped name or a path) at refinement ``level`` (each
     level halves every edge of level 0)."""
@@ -245,6 +251,7 @@ def build_mesh(spec: Spec | str, level: int = 0) -> SpindleMesh:
             _LEVEL0.pop(next(iter(_LEVEL0)))
         _LEVEL0[id(spec)] = (spec, regions, MeshTri(p, np.ascontiguousarray(t)), tags)
     _, regions, m0, tags = _LEVEL0[id(spec)]
+    check_level(spec, level)  # before the refinement asks for the memory
     mesh = m0.refined(level) if level else m0
     # uniform refinement numbers the 4 children of element i as i + k * nelements
     element_region = np.tile(tags, 4 ** level)
@@ -254,6 +261,20 @@ def build_mesh(spec: Spec | str, level: int = 0) -> SpindleMesh:
     sm.mesh = mesh.with_subdomains({n: sm.elements_of(n) for n in sm.part_names}) \
         .with_boundaries(dict(sm.surfaces))
     return sm
+
+
+def check_level(spec: Spec, level: int) -> None:
+    """SpecError naming ``level`` where its mesh would have more than :data:`MAX_ELEMENTS`
+    (level 0's count times 4 per level; level 0 is meshed, and kept, to count)."""
+    if id(spec) not in _LEVEL0 or _LEVEL0[id(spec)][0] is not spec:
+        build_mesh(spec, 0)
+    n0 = _LEVEL0[id(spec)][2].t.shape[1]
+    if n0 * 4 ** level > MAX_ELEMENTS:
+        raise SpecError([Problem(spec.path, "level", f"level {level} of this spec would have "
+                                 f"{n0 * 4 ** level:.3g} elements, more than "
+                                 f"{MAX_ELEMENTS:.0e}", "give a level of at most "
+                                 f"{int(np.log(MAX_ELEMENTS / n0) / np.log(4))}, or a coarser "
+                                 "mesh.h0_m")])
 
 
 def _classify_facets(sm: SpindleMesh) -> None:

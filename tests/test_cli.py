@@ -496,3 +496,18 @@ def test_synth_refuses_an_effect_twice_or_clean_with_effects(tmp_path, capsys, e
     with pytest.raises(InputError, match=words):  # the library refuses it too, before work
         synth(load_spec("spl2782"), "spl-16h", effects, 0, out)
     assert not out.exists()
+
+
+def test_a_mesh_level_beyond_the_machine_is_refused_before_it_is_made(tmp_path, capsys):
+    """A spec with a fine h0_m passes the level-0 check, and `mesh --level 6` then built 90
+    million elements until it was killed (found by fuzzing). meshes.build.MAX_ELEMENTS is
+    checked from level 0's count before the refinement."""
+    text = (Path(__file__).resolve().parents[1] / "spindle" / "data" / "specs"
+            / "fin-shaft.toml").read_text(encoding="utf-8")
+    spec = tmp_path / "fine.toml"
+    spec.write_text(text.replace("h0_m = 0.025", "h0_m = 0.002"), encoding="utf-8")
+    out = tmp_path / "m"
+    assert main(["mesh", str(spec), "--level", "6", "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "level: level 6 of this spec would have" in err and "fix: give a level of at most" \
+        in err and not out.exists()

@@ -23,12 +23,14 @@ if TYPE_CHECKING:
 @with_progress("mesh")
 def _cmd_mesh(args: argparse.Namespace, progress: Progress) -> int:
     from meshes import build_mesh
+    from meshes.build import check_level
     from meshes.io import mesh_png, save_mesh_vtu
     from spindle.outputs import output_dir, safe_name
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", [spec.path], force=args.force)
+    check_level(spec, args.level)  # before levels 0 .. N - 1 are made
     rows = []
     print(f"{'level':>5} {'elements':>9} {'nodes':>8} {'dofs_P1':>8} {'dofs_P2':>8} {'h_max_mm':>9}")
     for level in range(args.level + 1):
