@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from spindle import plots
-from spindle.outputs import expect_pictures, jsonable, write_csv, write_json
+from spindle.outputs import expect_pictures, jsonable, result_folder, write_csv, write_json
 from spindle.results import SteadyTable, TransientTable
 from spindle.units import ZERO_C_K
 
@@ -72,8 +72,7 @@ class LumpedSteadyResult(SteadyTable):
         """JSON summary, sensor and mass CSVs, PNG profiles."""
         from spindle.outputs import atomic_write
 
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
+        out = result_folder(out, pictures)
         table = self.sensor_table()
         masses = self.mass_table()
         write_json(out / "summary.json", self.summary())
@@ -116,8 +115,7 @@ class LumpedTransientResult(TransientTable):
 
     def save(self, out: Path, pictures: bool = True) -> list[Path]:
         """Summary JSON, sensor time series CSV, PNGs (sensors; T1 and P1 with the band)."""
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
+        out = result_folder(out, pictures)
         write_json(out / "summary.json", self.summary())
         write_csv(out / "sensors_timeseries.csv", *self.timeseries_rows())
         files = ["summary.json", "sensors_timeseries.csv"]

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from spindle import plots as shared_plots
-from spindle.outputs import atomic_write, expect_pictures, jsonable
+from spindle.outputs import atomic_write, expect_pictures, jsonable, result_folder
 from spindle.outputs import write_csv as _write_csv
 from spindle.outputs import write_json as _write_json
 from spindle.results import SteadyTable, TransientTable
@@ -66,8 +66,7 @@ class SteadyResult(SteadyTable):
         from reference import plots
         from reference.fields import add_displacement, field_grid
 
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
+        out = result_folder(out, pictures)
         table = self.sensor_table()
         _write_json(out / "summary.json", self.summary())
         _write_csv(out / "sensors.csv", list(table), zip(*table.values(), strict=True))
@@ -137,8 +136,7 @@ class TransientResult(TransientTable):
         from reference import plots
         from reference.fields import add_displacement, field_grid
 
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
+        out = result_folder(out, pictures)
         _write_json(out / "summary.json", self.summary())
         _write_csv(out / "sensors_timeseries.csv", *self.timeseries_rows())
         (out / "fields").mkdir(exist_ok=True)

@@ -407,3 +407,19 @@ def write_json(path: Path, data: dict) -> None:
     atomically."""
     text = json.dumps(jsonable(data), indent=2, allow_nan=False) + "\n"
     atomic_write(path, lambda tmp: tmp.write_text(text, "utf-8"))
+
+
+def result_folder(out, pictures: bool = True) -> Path:
+    """The folder ``out`` for a result's ``save``, made with its parents: TypeError unless
+    ``out`` is a path and ``pictures`` True or False (a ``pictures='no'`` drew them),
+    NotADirectoryError where ``out`` is a file."""
+    if not isinstance(out, str | os.PathLike):
+        raise TypeError(f"out must be a folder's path, not {type(out).__name__}")
+    if not isinstance(pictures, bool):
+        raise TypeError(f"pictures must be True or False, not {pictures!r}")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(f"{out} is a file, not a folder for the result's files")
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+

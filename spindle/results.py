@@ -135,6 +135,8 @@ class TransientTable:
 
     def sensor(self, name: str) -> np.ndarray:
         """History of one sensor [K]."""
+        if name not in self.names:
+            raise KeyError(f"no sensor named {name!r}; the sensors are {list(self.names)}")
         return self.sensor_K[:, self.names.index(name)]
 
     def to_pandas(self):

@@ -109,6 +109,13 @@ BAD_CALLS = [
     (lambda: sv.fit("no-such.csv", workers=0), ValueError, "workers is 0, outside 1.."),
     (lambda: __import__("spindle.spec_reader", fromlist=["load_spec"]).load_spec(123),
      TypeError, "a spec is a shipped name or a path"),
+    # a result's save and read-outs: pictures='no' drew them; sensor(5) said "5 is not in list"
+    (lambda: sv.solve("fin-shaft", model="lumped:5").save("x", pictures="no"), TypeError,
+     "pictures must be True or False"),
+    (lambda: sv.solve("fin-shaft", model="lumped:5").save(123), TypeError,
+     "out must be a folder's path"),
+    (lambda: sv.solve("spl2782", "spl-16h", dt_s=3600.0, model="lumped:5").sensor(5),
+     KeyError, "no sensor named 5; the sensors are"),
 ]
 
 
@@ -117,3 +124,12 @@ BAD_CALLS = [
 def test_a_bad_argument_is_named_where_it_is_given(call, kind, words):
     with pytest.raises(kind, match=words):
         call()
+
+
+def test_a_result_is_not_saved_over_a_file(tmp_path):
+    """save(out) onto an existing file failed in pathlib's mkdir with "File exists"."""
+    f = tmp_path / "afile.txt"
+    f.write_text("mine", encoding="utf-8")
+    with pytest.raises(NotADirectoryError, match="is a file, not a folder"):
+        sv.solve("fin-shaft", model="lumped:5").save(f)
+    assert f.read_text(encoding="utf-8") == "mine"
