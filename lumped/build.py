@@ -31,8 +31,6 @@ bearing's rolling layer exchanges heat only with its own rings.
 
 from __future__ import annotations
 
-import math
-import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -48,6 +46,7 @@ from lumped.blocks import (
     TwoPort,
 )
 from lumped.network import Network, ThermalSystem
+from spindle.arguments import whole_number
 from spindle.errors import Problem, SpecError
 from spindle.faces import (
     Face,
@@ -250,13 +249,13 @@ def _node_number(nodes: int | str) -> int:
             raise SpecError([Problem("command line", "--nodes", f"unknown preset '{nodes}'",
                                      f"use an integer >= 2 or one of {sorted(PRESETS)}")])
         nodes = PRESETS[nodes]
-    if isinstance(nodes, bool) or not isinstance(nodes, numbers.Real) or not (
-            math.isfinite(nodes) and int(nodes) == nodes and 2 <= nodes <= MAX_NODES):
+    try:
+        return whole_number(nodes, "nodes", 2, MAX_NODES)
+    except (TypeError, ValueError):
         raise SpecError([Problem("command line", "--nodes",
                                  f"{nodes!r} is not an integer in 2..{MAX_NODES}",
                                  "give the number of masses along shaft and housing, "
-                                 f"2 to {MAX_NODES}")])
-    return int(nodes)
+                                 f"2 to {MAX_NODES}")]) from None
 
 
 def _capacity_J_K(spec: Spec, sec: Section, volume_m3: float) -> float:

@@ -99,11 +99,16 @@ def _write_manifest(folder: Path) -> None:
             files[rel] = _sha256(p)
         elif p.is_dir() and not any(p.iterdir()):
             files[rel + "/"] = "folder"
-    text = json.dumps({"format": MANIFEST_FORMAT, "written_by": "spindle-verify",
-                       "note": "the files the run wrote; the next run into this folder replaces "
-                               "these and refuses (or with --force moves aside) anything else",
-                       "files": files}, indent=1) + "\n"
+    text = _manifest_text(files, "the files the run wrote; the next run into this folder "
+                          "replaces these and refuses (or with --force moves aside) anything else")
     (folder / MARKER).write_text(text, encoding="utf-8")
+
+
+def _manifest_text(files: dict[str, str], note: str) -> str:
+    """A marker's JSON (:func:`_manifest` reads it): the files the tool wrote and their
+    SHA-256."""
+    return json.dumps({"format": MANIFEST_FORMAT, "written_by": "spindle-verify",
+                       "note": note, "files": files}, indent=1) + "\n"
 
 
 def foreign_files(folder: str | Path) -> list[str]:
@@ -280,10 +285,9 @@ def write_output_file(path: str | Path, write: Callable[[Path], Any], force: boo
         print(f"spindle-verify: moved {path} aside to {kept} (--force)", file=sys.stderr)
     atomic_write(path, write)
     files = {**_manifest(path.parent, FILE_MARKER), path.name: _sha256(path)}
-    text = json.dumps({"format": MANIFEST_FORMAT, "written_by": "spindle-verify",
-                       "note": "single files spindle-verify wrote into this folder; a later run "
-                               "replaces these and refuses (or with --force moves aside) any "
-                               "other file", "files": files}, indent=1) + "\n"
+    text = _manifest_text(files, "single files spindle-verify wrote into this folder; a later "
+                          "run replaces these and refuses (or with --force moves aside) any "
+                          "other file")
     atomic_write(path.parent / FILE_MARKER, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 

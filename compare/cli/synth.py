@@ -26,12 +26,6 @@ def _cmd_synth(args: argparse.Namespace, progress: Progress) -> int:
     if bad:
         raise InputError("command line", "--effect", f"unknown effect '{bad[0]}'",
                          f"use one of {', '.join(known)}")
-    twice = next((e for e in args.effect if args.effect.count(e) > 1), None)
-    if twice is not None or ("clean" in args.effect and len(args.effect) > 1):
-        # the truth file records one parameter set an effect, and clean is no effect
-        raise InputError("command line", "--effect", f"'{twice}' is given twice" if twice
-                         else "'clean' (no effect) is given with effects",
-                         "give each effect once, or clean alone")
     from functools import partial
 
     from spindle.outputs import check_output_file, write_output_file
