@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spindle.bench import DEFAULT_GRID_S, STANDSTILL_RPM, BenchRun, BenchWarning
+from spindle.checks import omega_rad_s
 from spindle.drive import Drive, drive_for
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
@@ -175,6 +176,76 @@ def interval_heat_W(drive: Drive, speed_rpm: float, load_torque_Nm: float,
         return drive.heat_W(speed_rpm, load_torque_Nm, pb.motor.P_mech_W / 1e3), True
 
 
+@dataclass(frozen=True)
+class NoLoadExcess:
+    """How far a run's power goes beyond what a spindle without a load can draw
+    (:func:`no_load_excess`): the largest ratio of an interval's mean power to the drive's
+    losses at the same speed and its rated torque [-], that interval's index, and the
+    number of running intervals over 1 and in all."""
+
+    ratio: float
+    interval: int
+    over: int
+    running: int
+
+
+def no_load_excess(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray
+                   ) -> NoLoadExcess | None:
+    """Each running interval's mean electrical power [kW] against the losses of ``drive`` at
+    its speed [rpm] and its rated torque (the nominal point's P_mech / omega). Load only adds
+    losses, so a spindle without a load cannot draw more than that: for spl2782 five times its
+    no-load losses at the nominal speed, thirty times at 1000 rpm. None without a nominal
+    point or a running interval with a measured power."""
+    if drive.nominal is None:
+        return None
+    rated_Nm = drive.nominal.P_mech_W / omega_rad_s(drive.nominal.speed_rpm)
+    limits: dict[int, float] = {}
+    best: tuple[float, int] | None = None
+    over = running = 0
+    for i, (n, P) in enumerate(zip(speed_rpm, power_kW, strict=True)):
+        if n < STANDSTILL_RPM or not math.isfinite(P):
+            continue
+        running += 1
+        key = round(float(n))
+        if key not in limits:
+            limits[key] = sum(drive.heat_W(float(key), rated_Nm, None).values())
+        ratio = P * 1e3 / limits[key]
+        over += ratio > 1.0
+        if best is None or ratio > best[0]:
+            best = (ratio, i)
+    return None if best is None else NoLoadExcess(best[0], best[1], over, running)
+
+
+def check_no_load_power(run: BenchRun, drive: Drive, grid_s: np.ndarray,
+                        speed_rpm: np.ndarray, power_kW: np.ndarray) -> None:
+    """Refuse a run without ``load_torque_Nm`` whose power is not all heat.
+
+    Such a run is a no-load run (docs/bench.md), whose electrical power is its losses. Where
+    an interval's mean power exceeds what the drive loses even at its rated torque
+    (:func:`no_load_excess`), the spindle worked against a load the run does not give, and
+    taking the power as heat would put kilowatts into the model that never were (the ratio
+    on the drawn families and the peer's runs: docs/bench.md). Per interval arrays on
+    ``grid_s`` [s]. InputError naming the largest such interval."""
+    if run.load_torque_measured:
+        return
+    ex = no_load_excess(drive, speed_rpm, power_kW)
+    if ex is None or ex.over == 0:
+        return
+    i = ex.interval
+    rated_Nm = drive.nominal.P_mech_W / omega_rad_s(drive.nominal.speed_rpm)
+    raise InputError(
+        str(run.path), "load_torque_Nm",
+        f"the run has no load torque, so it is a no-load run whose electrical power is all "
+        f"heat; but in {ex.over} of its {ex.running} running intervals it draws more than the "
+        f"drive '{drive.name}' loses even at its rated torque ({rated_Nm:.0f} N m), up to "
+        f"{power_kW[i]:.2f} kW at {speed_rpm[i]:.0f} rpm (t = {grid_s[i] / 3600:.2f} h), "
+        f"{ex.ratio:.1f} times those losses: the spindle worked against a load the run does "
+        "not give",
+        "add the load_torque_Nm column the bench logged (docs/bench.md); if the spindle ran "
+        "without a load, check that power_kW is in kW and that the spec's [power_balance] "
+        "preset is this spindle's drive")
+
+
 def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
            grid_s: float | None = None) -> tuple[LoadCase, np.ndarray]:
     """The model inputs of a bench run on a time grid: ``(LoadCase, grid [s])``.
@@ -216,6 +287,7 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
     torque = (cell_means(*valid_samples(run, "load_torque_Nm"), grid, mids, hold)
               if run.load_torque_measured else np.zeros(len(mids)))
 
+    check_no_load_power(run, drive, grid, speed[:-1], power)
     heats: list[dict[str, float]] = []
     clipped: list[float] = []
     for i, (n, M, P) in enumerate(zip(speed[:-1], torque, power, strict=True)):

@@ -125,6 +125,20 @@ def test_fit_bad_base_extra_exits_2(tmp_path, extra, words):
     assert "Traceback" not in r.stderr and not (tmp_path / "o").exists()
 
 
+def test_fit_refuses_a_loaded_run_without_its_torque_before_any_fitting(tmp_path):
+    """The peer's dev2-10 exported without load_torque_Nm: one message naming the column and
+    the fix, exit 2, nothing written (it had fitted 33 kW of heat and ended in an internal
+    error while writing report.html)."""
+    from tests.test_bench import PEER_RUNS, _without_torque
+
+    csv = _without_torque(PEER_RUNS / "bench-runs-2" / "dev2-10.csv", tmp_path / "dev2-10.csv")
+    r = run("fit", str(csv), "--spec", "spl2782", "--out", str(tmp_path / "o"))
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert f"{csv}: load_torque_Nm: the run has no load torque" in r.stderr
+    assert "fix: add the load_torque_Nm column" in r.stderr
+    assert not (tmp_path / "o").exists()
+
+
 def test_output_never_overwrites_input(tmp_path):
     spec = tmp_path / "sensors.csv"  # an input named like an output
     from spindle.spec_reader import load_spec

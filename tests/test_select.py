@@ -335,28 +335,34 @@ class _RunsAway(Effect):
     params = (Param("k_runs_away", "-", 0.0, 0.0, 1.0, "the rise's share", log=False),)
     channels = ("T1",)
 
-    def __init__(self, k_max: float):
-        self.k_max = k_max
+    def __init__(self, k_max: float, huge: float | None = None):
+        self.k_max, self.huge = k_max, huge
 
     def as_measured(self, out, theta, inputs, channel):
         k = theta["k_runs_away"]
-        if k > self.k_max:
-            return {c: v * np.nan for c, v in out.items()}
         g = np.asarray(inputs.grid_s, dtype=float)
-        return {**out, "T1": out["T1"] + k * 5.0 * (g - g[0]) / (g[-1] - g[0])}
+        ramp = (g - g[0]) / (g[-1] - g[0])
+        if k > self.k_max:
+            if self.huge:  # finite, but its squares overflow: a dev2-10 exported without its
+                # load torque ran a preload to 1e268 K, whose gain came out NaN
+                return {**out, "T1": out["T1"] + self.huge * k * ramp}
+            return {c: v * np.nan for c, v in out.items()}
+        return {**out, "T1": out["T1"] + k * 5.0 * ramp}
 
 
-@pytest.mark.parametrize("k_true, k_max, start, expect", [
-    (0.3, 0.6, 0.95, "near truth"),  # a start where the model runs away is halved to 0.475
-    (0.9, 0.6, None, "at the edge"),  # every step towards the truth lands beyond the edge
-    (0.3, 0.0, None, "none"),  # the model runs away wherever the effect is
+@pytest.mark.parametrize("k_true, k_max, huge, start, expect", [
+    (0.3, 0.6, None, 0.95, "near truth"),  # a start where the model runs away is halved to 0.475
+    (0.9, 0.6, None, None, "at the edge"),  # every step towards the truth lands beyond the edge
+    (0.3, 0.0, None, None, "none"),  # the model runs away wherever the effect is
+    (0.3, 0.0, 1e200, None, "none"),  # finite, but beyond what a gain can be computed on
 ])
 def test_a_candidate_that_makes_the_model_run_away_is_fitted_where_it_does_not(
-        setup, k_true, k_max, start, expect):
+        setup, k_true, k_max, huge, start, expect):
     """compare.fit.linear.fit_effect halves a start or a Gauss-Newton step that lands where
     the model is not finite, back towards where it is; where it is nowhere but at the neutral
     value, there is no estimate (None), and the selection goes on without the candidate
-    instead of failing."""
+    instead of failing. A model finite but so large that the step's gain is not (1e200 K)
+    has run away as well: its NaN gain had reached report.html, which failed on it."""
     from compare.fit.effects import register, unregister
     from compare.fit.linear import fit_effect, local
 
@@ -365,7 +371,7 @@ def test_a_candidate_that_makes_the_model_run_away_is_fitted_where_it_does_not(
     g = inp.grid_s
     truth["T1"] = truth["T1"] + k_true * 5.0 * (g - g[0]) / (g[-1] - g[0])
     vals = _noisy(truth, len(g), 11)
-    effect = register(_RunsAway(k_max))
+    effect = register(_RunsAway(k_max, huge))
     try:
         cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(g, vals), CHANNELS)
         base = cal.fit()
@@ -747,3 +753,15 @@ def test_the_refit_of_a_joining_effect_is_no_worse_than_its_nested_start(setup):
     assert posterior(from_start(stepped)) < nested - 0.5
     fit, start = refit(cal, loc, far, crit)
     assert posterior(fit) >= nested - 1e-6 and start == "nested"
+
+
+def test_the_criteria_table_shows_a_figure_report_json_could_not_hold_as_not_available():
+    """report.json writes a non-finite figure as None (NaN is not JSON); report.html's table
+    of candidates formatted it with ':.1f' and the whole fit ended in an internal error after
+    the fitting (a dev2-10 exported without its load torque, whose preload ran away)."""
+    from compare.fit.report import _criteria_html
+
+    row = {"candidate": "bearing_preload", "round": 1, "gain": None, "p_value": None,
+           "peak_tolerances": None, "criteria": {}, "route": None}
+    html = _criteria_html({"candidates": [row]})
+    assert html.count("n/a") == 3, html

@@ -12,7 +12,7 @@ same step. One Jacobian costs one simulation per free parameter.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -228,6 +228,19 @@ class EffectFit:
     shift: np.ndarray  # what the effect alone moves every row by [tolerances]
 
 
+def _columns(at: Callable[[np.ndarray], np.ndarray], z: np.ndarray, r_z: np.ndarray,
+             hi: np.ndarray) -> np.ndarray:
+    """The residual's forward differences in each of the effect's parameters at ``z``
+    (``r_z`` the residual there), stepping back from an upper bound."""
+    cols = np.empty((len(r_z), len(z)))
+    for i in range(len(z)):
+        h = STEP if z[i] + STEP <= hi[i] else -STEP
+        zz = z.copy()
+        zz[i] += h
+        cols[:, i] = (at(zz) - r_z) / h
+    return cols
+
+
 def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
                iterations: int = 6) -> EffectFit | None:
     """The effect ``label`` fitted jointly with the base parameters on the linearized model
@@ -263,7 +276,10 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
         return simulated[key]
 
     def finite(zv: np.ndarray) -> bool:
-        return bool(np.all(np.isfinite(at_once(zv))))
+        # a residual whose sum of squares overflows has no likelihood either
+        r = at_once(zv)
+        with np.errstate(over="ignore", invalid="ignore"):
+            return bool(np.isfinite(np.dot(r, r)))
 
     r_neutral = at_once(z_n)
     # a feedback beyond its stability (a preload near 1/K) runs away, which no spindle on a
@@ -275,12 +291,7 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
     best = None
     for _ in range(iterations if finite(z) else 0):
         r_z = at_once(z)
-        cols = np.empty((len(r_z), len(params)))
-        for i in range(len(params)):
-            h = STEP if z[i] + STEP <= hi[i] else -STEP
-            zz = z.copy()
-            zz[i] += h
-            cols[:, i] = (at(zz) - r_z) / h
+        cols = _columns(at, z, r_z, hi)
         if not np.all(np.isfinite(cols)):  # at the edge of a runaway: stop where it is
             break
         # the base parameters' step from the current model and the effect's from z
@@ -295,6 +306,8 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
             break
         r1 = shifted.residual(step, cols)
         gain = loc.gain_of(r1, step)
+        if not np.isfinite(gain):  # finite but overflowing in the step: a runaway as well
+            break
         # the gain is that of the stepped parameters, so the estimate is where the step lands
         # (not where it was taken from: a mount fitted from 0 W/K to 3 W/K has the gain of
         # 3 W/K, and its shift at 0 W/K is nothing)

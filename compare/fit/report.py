@@ -45,6 +45,11 @@ def p_text(p: float | None) -> str:
     return "p < 1e-300" if p < 1e-300 else f"p = {p:.2g}"
 
 
+def _number(x: float | None, fmt: str) -> str:
+    """A figure of report.json, where a non-finite one is None: "n/a" for it."""
+    return "n/a" if x is None or not math.isfinite(x) else format(x, fmt)
+
+
 def _errors(fit: Fit) -> dict:
     out = {}
     for window, chans in fit.errors.items():
@@ -423,8 +428,8 @@ def _criteria_html(doc: dict) -> str:
     rows = []
     for c in doc.get("candidates", []):
         crit = c["criteria"]
-        rows.append([c["candidate"], c["round"], f"{c['gain']:.1f}", p_text(c["p_value"]),
-                     f"{c['peak_tolerances']:.2f}",
+        rows.append([c["candidate"], c["round"], _number(c["gain"], ".1f"),
+                     p_text(c["p_value"]), _number(c["peak_tolerances"], ".2f"),
                      *["—" if crit.get(k) is None else ("pass" if crit[k] else "FAIL")
                        for k in names], ", ".join(c.get("complements") or []),
                      c.get("route") or "no"])

@@ -32,7 +32,7 @@ from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAM
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
 from spindle.bench import BenchRun, check_against_spec, read_bench
-from spindle.bench_inputs import Inputs, interval_inputs, resample, valid_samples
+from spindle.bench_inputs import Inputs, check_no_load_power, interval_inputs, resample, valid_samples
 from spindle.drive import drive_for
 from spindle.errors import InputError, SolverError
 from spindle.results import check_plausible
@@ -92,6 +92,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
                          "add [power_balance] preset to the spec")
     raw = interval_inputs(run, grid_s, criteria.gap_min_steps)
+    check_no_load_power(run, drive, raw.grid_s, raw.speed_rpm, raw.power_kW)
     measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks, criteria)
     inputs, switches = _place_gap_switches(run, spec, drive, raw, measured, channels, nodes,
                                            base_extra, say, criteria)
