@@ -56,6 +56,24 @@ def valid_samples(run: BenchRun, col: str) -> tuple[np.ndarray, np.ndarray]:
     return run.time_s[ok], y[ok]
 
 
+def input_samples(run: BenchRun, col: str, grid_step_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """(times [s], values) of an input column's non-empty cells, each time placed where the
+    value most likely began. A value first logged after a silence longer than a grid step
+    (``grid_step_s`` [s]) but not a gap (:func:`silence_s`) began somewhere in that silence:
+    a regular logger that writes every 10 min sees a speed step up to 10 min late, and held
+    from its row the step is late by half the silence on average, which the fit would read
+    as a lag. Such a time moves to the silence's middle, the unbiased estimate (the value is
+    then held from halfway, the nearest sample). A silence within a grid step is below the
+    model's resolution, and a gap's change is placed by the fit (compare.fit.gaps): both
+    keep the logged time."""
+    t, y = valid_samples(run, col)
+    rows = run.time_s
+    k = np.searchsorted(rows, t, side="left")  # the cell's own row
+    before = np.where(k > 0, t - rows[np.clip(k - 1, 0, None)], 0.0)
+    centre = (before > grid_step_s) & (before <= silence_s(HOLD_STEPS, grid_step_s, rows))
+    return np.where(centre, t - 0.5 * before, t), y
+
+
 def held(t_samples: np.ndarray, y_samples: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Zero-order hold: at each ``t`` the last sample at or before it; before the first
     sample, the first value (units of y)."""
@@ -63,10 +81,27 @@ def held(t_samples: np.ndarray, y_samples: np.ndarray, t: np.ndarray) -> np.ndar
     return y_samples[np.clip(idx, 0, len(y_samples) - 1)]
 
 
-#: a logged value holds for at most this many grid steps: a bench that logs on change writes
-#: at least a heartbeat that often, so a longer silence is a gap (the fit's criterion
+#: a logged value holds for at most this many steps, of the grid or of the run's own logging
+#: where it logs more sparsely (:func:`silence_s`): a bench that logs on change writes at
+#: least a heartbeat that often, so a longer silence is a gap (the fit's criterion
 #: gap_min_steps takes this value)
 HOLD_STEPS = 2.0
+
+
+def logging_step_s(time_s: np.ndarray) -> float:
+    """A run's logging step [s]: the median spacing of its rows' times ``time_s`` [s] (a
+    regular logger's period; a heartbeat or less where it logs on change). 0 with fewer than
+    two rows."""
+    t = np.asarray(time_s, dtype=float)
+    return float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+
+
+def silence_s(steps: float, grid_step_s: float, time_s: np.ndarray) -> float:
+    """The longest stretch without a row [s] that is not a logging gap: ``steps`` steps of
+    the model grid (``grid_step_s`` [s]) or of the run's own logging (:func:`logging_step_s`
+    of its rows' times ``time_s``), whichever is longer. A logger writing every 10 min has
+    no gap between its rows; one writing every second has one after two silent minutes."""
+    return float(steps) * max(float(grid_step_s), logging_step_s(time_s))
 
 #: speed scatter a drive shows around its set speed: a logged speed within this band of the
 #: current operating step belongs to it (the spindle's drive holds 0.1-0.3 % in practice)
@@ -129,11 +164,14 @@ def cell_means(t_samples: np.ndarray, y_samples: np.ndarray, edges: np.ndarray,
     return out
 
 
-def resample(t_s: np.ndarray, y: np.ndarray, grid_s: np.ndarray, gap_steps: float
-             ) -> np.ndarray:
+def resample(t_s: np.ndarray, y: np.ndarray, grid_s: np.ndarray, gap_steps: float,
+             logging_step: float = 0.0) -> np.ndarray:
     """A logged channel's values at the grid points [s] (units of y): linear between valid
-    samples; NaN outside the samples and inside gaps longer than ``gap_steps`` grid steps (the
-    fit's criterion gap_min_steps)."""
+    samples; NaN outside the samples and inside gaps longer than ``gap_steps`` steps of the
+    grid, of the run's logging (``logging_step`` [s], :func:`logging_step_s`) or of the
+    channel's own (the median spacing of its valid samples: a bench may log temperatures
+    every 10 min beside a drive every 10 s), whichever is longest (the fit's criterion
+    gap_min_steps)."""
     ok = ~np.isnan(y)
     t, v = t_s[ok], y[ok]
     out = np.full(len(grid_s), np.nan)
@@ -141,7 +179,7 @@ def resample(t_s: np.ndarray, y: np.ndarray, grid_s: np.ndarray, gap_steps: floa
         return out
     inside = (grid_s >= t[0]) & (grid_s <= t[-1])
     out[inside] = np.interp(grid_s[inside], t, v)
-    step = np.median(np.diff(grid_s))
+    step = max(float(np.median(np.diff(grid_s))), float(logging_step), logging_step_s(t))
     k = np.clip(np.searchsorted(t, grid_s), 1, len(t) - 1)
     gap = (t[k] - t[k - 1]) > gap_steps * step
     out[gap & inside] = np.nan
@@ -176,11 +214,15 @@ def interval_heat_W(drive: Drive, speed_rpm: float, load_torque_Nm: float,
         return drive.heat_W(speed_rpm, load_torque_Nm, pb.motor.P_mech_W / 1e3), True
 
 
+#: a process torque up to this is no load (a load cell's zero drift) [N m]; the fit's
+#: criterion no_load_Nm takes the same value
+LOAD_CELL_ZERO_NM = 0.5
+
+
 @dataclass(frozen=True)
-class NoLoadExcess:
-    """How far a run's power goes beyond what a spindle without a load can draw
-    (:func:`no_load_excess`): the largest ratio of an interval's mean power to the drive's
-    losses at the same speed and its rated torque [-], that interval's index, and the
+class LossExcess:
+    """How far a run's losses go beyond what the drive can make (:func:`loss_excess`): the
+    largest ratio of an interval's losses to the bound [-], that interval's index, and the
     number of running intervals over 1 and in all."""
 
     ratio: float
@@ -189,61 +231,114 @@ class NoLoadExcess:
     running: int
 
 
-def no_load_excess(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray
-                   ) -> NoLoadExcess | None:
-    """Each running interval's mean electrical power [kW] against the losses of ``drive`` at
-    its speed [rpm] and its rated torque (the nominal point's P_mech / omega). Load only adds
-    losses, so a spindle without a load cannot draw more than that: for spl2782 five times its
-    no-load losses at the nominal speed, thirty times at 1000 rpm. None without a nominal
-    point or a running interval with a measured power."""
+def rated_torque_Nm(drive: Drive) -> float | None:
+    """The drive's rated torque [N m]: its nominal point's P_mech / omega (None without one)."""
     if drive.nominal is None:
         return None
-    rated_Nm = drive.nominal.P_mech_W / omega_rad_s(drive.nominal.speed_rpm)
-    limits: dict[int, float] = {}
+    return drive.nominal.P_mech_W / omega_rad_s(drive.nominal.speed_rpm)
+
+
+def loss_excess(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
+                load_torque_Nm: np.ndarray) -> LossExcess | None:
+    """Each running interval's losses, its mean electrical power [kW] less the load's
+    mechanical power M omega (torque [N m], speed [rpm]), against the losses of ``drive`` at
+    its speed and the larger of the load's torque and the rated one. A torque only adds
+    losses, so no spindle makes more: for spl2782 at no load five times its no-load losses at
+    the nominal speed, thirty times at 1000 rpm. None without a nominal point or a running
+    interval with a measured power."""
+    rated = rated_torque_Nm(drive)
+    if rated is None:
+        return None
+    limits: dict[tuple[int, float], float] = {}
     best: tuple[float, int] | None = None
     over = running = 0
-    for i, (n, P) in enumerate(zip(speed_rpm, power_kW, strict=True)):
+    for i, (n, P, M) in enumerate(zip(speed_rpm, power_kW, load_torque_Nm, strict=True)):
         if n < STANDSTILL_RPM or not math.isfinite(P):
             continue
         running += 1
-        key = round(float(n))
+        key = (round(float(n)), max(abs(float(M)), rated))
         if key not in limits:
-            limits[key] = sum(drive.heat_W(float(key), rated_Nm, None).values())
-        ratio = P * 1e3 / limits[key]
+            limits[key] = sum(drive.heat_W(float(key[0]), key[1], None).values())
+        ratio = (P * 1e3 - M * omega_rad_s(float(n))) / limits[key]
         over += ratio > 1.0
         if best is None or ratio > best[0]:
             best = (ratio, i)
-    return None if best is None else NoLoadExcess(best[0], best[1], over, running)
+    return None if best is None else LossExcess(best[0], best[1], over, running)
 
 
-def check_no_load_power(run: BenchRun, drive: Drive, grid_s: np.ndarray,
-                        speed_rpm: np.ndarray, power_kW: np.ndarray) -> None:
-    """Refuse a run without ``load_torque_Nm`` whose power is not all heat.
+def load_efficiency(speed_rpm: np.ndarray, power_kW: np.ndarray, load_torque_Nm: np.ndarray,
+                    loaded_Nm: float = LOAD_CELL_ZERO_NM) -> tuple[float, int]:
+    """(median of M omega / P_el [-], intervals): the share of the electrical power [kW]
+    that the load's torque [N m] takes at the speed [rpm], over the running intervals with
+    a load above ``loaded_Nm`` (a power at or below 0 counts as infinite). A motor delivers
+    at most what it draws, so the median lies below 1 (bench runs: docs/bench.md); nan
+    without a loaded interval."""
+    ratios = [float("inf") if not P > 0 else M * omega_rad_s(float(n)) / (P * 1e3)
+              for n, P, M in zip(speed_rpm, power_kW, load_torque_Nm, strict=True)
+              if n >= STANDSTILL_RPM and M > loaded_Nm and not math.isnan(P)]
+    return (float(np.median(ratios)) if ratios else float("nan")), len(ratios)
 
-    Such a run is a no-load run (docs/bench.md), whose electrical power is its losses. Where
-    an interval's mean power exceeds what the drive loses even at its rated torque
-    (:func:`no_load_excess`), the spindle worked against a load the run does not give, and
-    taking the power as heat would put kilowatts into the model that never were (the ratio
-    on the drawn families and the peer's runs: docs/bench.md). Per interval arrays on
-    ``grid_s`` [s]. InputError naming the largest such interval."""
+
+def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
+                        speed_rpm: np.ndarray, power_kW: np.ndarray,
+                        load_torque_Nm: np.ndarray,
+                        loaded_Nm: float = LOAD_CELL_ZERO_NM) -> None:
+    """Refuse a run whose power, torque and speed cannot belong together, by energy
+    conservation, before they become heat sources (per interval arrays on ``grid_s`` [s]):
+
+    - a load that takes more than the drive draws (:func:`load_efficiency` above 1): a
+      torque in N cm, a power in MW;
+    - losses beyond what the drive makes even at its rated torque (:func:`loss_excess`):
+      without a torque column a run is a no-load run whose power is all heat, so a loaded run
+      exported without its torque; with one, power and torque swapped, a torque of the
+      wrong sign, or a speed not in rpm.
+
+    The margins on runs this project did not make: docs/bench.md. InputError naming the
+    column and the largest excess."""
+    path = str(run.path)
     if run.load_torque_measured:
-        return
-    ex = no_load_excess(drive, speed_rpm, power_kW)
+        eta, n_loaded = load_efficiency(speed_rpm, power_kW, load_torque_Nm, loaded_Nm)
+        if eta > 1.0:
+            raise InputError(
+                path, "load_torque_Nm",
+                f"the load takes more power than the drive draws: over the {n_loaded} loaded "
+                f"running intervals the median of M omega / P_el is {eta:.3g}, where a motor "
+                "delivers at most what it draws",
+                "export load_torque_Nm in N m (a torque in N cm is 100 times too large) and "
+                "power_kW in kW (a power in MW is 1000 times too small)")
+    ex = loss_excess(drive, speed_rpm, power_kW, load_torque_Nm)
     if ex is None or ex.over == 0:
         return
     i = ex.interval
-    rated_Nm = drive.nominal.P_mech_W / omega_rad_s(drive.nominal.speed_rpm)
+    n, P, M = float(speed_rpm[i]), float(power_kW[i]), float(load_torque_Nm[i])
+    where = f"at {n:.0f} rpm (t = {grid_s[i] / 3600:.2f} h)"
+    rated = rated_torque_Nm(drive)
+    if run.load_torque_measured:
+        raise InputError(
+            path, "power_kW",
+            f"the losses, the power less the load's M omega, exceed in {ex.over} of the "
+            f"{ex.running} running intervals what the drive '{drive.name}' loses at that "
+            f"speed and torque (at least its rated {rated:.0f} N m), up to {ex.ratio:.1f} "
+            f"times that {where}: {P:.2f} kW drawn against {M:.1f} N m",
+            "check that power_kW is the drive's electrical power in kW, load_torque_Nm the "
+            "process torque in N m (positive where it loads the spindle) and speed_rpm in rpm: "
+            "swapped columns, a torque's sign or a speed in rad/s or Hz show this way")
+    rated_input_kW = drive.nominal_point().motor.P_el_W / 1e3
+    if P > rated_input_kW:
+        raise InputError(
+            path, "power_kW",
+            f"up to {P:.4g} kW {where}, more than the drive '{drive.name}' draws at its "
+            f"nominal point ({rated_input_kW:.1f} kW): the column looks like watts",
+            "export the electrical power in kW (W / 1000)")
     raise InputError(
-        str(run.path), "load_torque_Nm",
+        path, "load_torque_Nm",
         f"the run has no load torque, so it is a no-load run whose electrical power is all "
         f"heat; but in {ex.over} of its {ex.running} running intervals it draws more than the "
-        f"drive '{drive.name}' loses even at its rated torque ({rated_Nm:.0f} N m), up to "
-        f"{power_kW[i]:.2f} kW at {speed_rpm[i]:.0f} rpm (t = {grid_s[i] / 3600:.2f} h), "
-        f"{ex.ratio:.1f} times those losses: the spindle worked against a load the run does "
-        "not give",
+        f"drive '{drive.name}' loses even at its rated torque ({rated:.0f} N m), up to "
+        f"{P:.2f} kW {where}, {ex.ratio:.1f} times those losses: the spindle worked "
+        "against a load the run does not give",
         "add the load_torque_Nm column the bench logged (docs/bench.md); if the spindle ran "
-        "without a load, check that power_kW is in kW and that the spec's [power_balance] "
-        "preset is this spindle's drive")
+        "without a load, check that the spec's [power_balance] preset is this spindle's drive")
 
 
 def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
@@ -278,16 +373,17 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
     mids = 0.5 * (grid[:-1] + grid[1:])
     dual = np.concatenate([[grid[0]], mids, [grid[-1]]])
 
-    ts, ys = valid_samples(run, "speed_rpm")
+    step = float(np.median(np.diff(grid)))
+    ts, ys = input_samples(run, "speed_rpm", step)
     speed = held(ts, ys, grid)
-    hold = HOLD_STEPS * float(np.median(np.diff(grid)))
-    T_env = cell_means(*valid_samples(run, "T_env_C"), dual, grid, hold) + ZERO_C_K
-    T_cool = cell_means(*valid_samples(run, "T_coolant_C"), dual, grid, hold) + ZERO_C_K
-    power = cell_means(*valid_samples(run, "power_kW"), grid, mids, hold)
-    torque = (cell_means(*valid_samples(run, "load_torque_Nm"), grid, mids, hold)
+    hold = silence_s(HOLD_STEPS, step, run.time_s)
+    T_env = cell_means(*input_samples(run, "T_env_C", step), dual, grid, hold) + ZERO_C_K
+    T_cool = cell_means(*input_samples(run, "T_coolant_C", step), dual, grid, hold) + ZERO_C_K
+    power = cell_means(*input_samples(run, "power_kW", step), grid, mids, hold)
+    torque = (cell_means(*input_samples(run, "load_torque_Nm", step), grid, mids, hold)
               if run.load_torque_measured else np.zeros(len(mids)))
 
-    check_no_load_power(run, drive, grid, speed[:-1], power)
+    check_power_balance(run, drive, grid, speed[:-1], power, torque)
     heats: list[dict[str, float]] = []
     clipped: list[float] = []
     for i, (n, M, P) in enumerate(zip(speed[:-1], torque, power, strict=True)):
@@ -345,9 +441,9 @@ def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOL
     - speed [rpm]: the one logged at the interval's middle (held), settled to the drive's
       scatter band (a step inside an interval is at most half an interval off);
     - power [kW], ambient and coolant [K]: the time mean over the interval of the signal as
-      logged, each sample held until the next one, for ``hold_steps`` grid steps at most (a
-      bench that logs on change writes at least a heartbeat that often: the fit's criterion
-      gap_min_steps);
+      logged, each sample held until the next one, for ``hold_steps`` steps of the grid or
+      of the run's logging at most (:func:`silence_s`: a bench that logs on change writes
+      at least a heartbeat that often; the fit's criterion gap_min_steps);
     - load torque [N m]: the torque that at the middle's speed does the interval's mean
       mechanical work, mean(M n) / n_mid (torque and speed each held). The losses the power
       balance takes from the interval are then mean(P_el - M omega), as the samples give
@@ -356,12 +452,12 @@ def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOL
     """
     grid = bench_grid(run, grid_s)
     mids = 0.5 * (grid[:-1] + grid[1:])
-    hold = hold_steps * grid_s
-    t_n, n = valid_samples(run, "speed_rpm")
+    hold = silence_s(hold_steps, grid_s, run.time_s)
+    t_n, n = input_samples(run, "speed_rpm", grid_s)
     speed = settled_speed(held(t_n, n, mids))
-    power = cell_means(*valid_samples(run, "power_kW"), grid, mids, hold)
+    power = cell_means(*input_samples(run, "power_kW", grid_s), grid, mids, hold)
     if run.load_torque_measured:
-        t_m, m = valid_samples(run, "load_torque_Nm")
+        t_m, m = input_samples(run, "load_torque_Nm", grid_s)
         # mean M n [N m rpm], each held
         work = cell_means(*held_product(t_m, m, t_n, n), grid, mids, hold)
         moving = speed >= STANDSTILL_RPM
@@ -369,7 +465,7 @@ def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOL
                           cell_means(t_m, m, grid, mids, hold))
     else:
         torque = np.zeros(len(mids))
-    t_env, y_env = valid_samples(run, "T_env_C")
+    t_env, y_env = input_samples(run, "T_env_C", grid_s)
     T_env = cell_means(t_env, y_env, grid, mids, hold) + ZERO_C_K
-    T_cool = cell_means(*valid_samples(run, "T_coolant_C"), grid, mids, hold) + ZERO_C_K
+    T_cool = cell_means(*input_samples(run, "T_coolant_C", grid_s), grid, mids, hold) + ZERO_C_K
     return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + ZERO_C_K)

@@ -75,3 +75,58 @@ def test_an_on_change_log_averages_over_time_not_over_samples():
     yr = np.where(tr < 50, 1.0, 5.0)
     assert cell_means(tr, yr, edges[:2], centres, hold_s=120.0)[0] == pytest.approx(
         cell_means(tr, yr, edges[:2], centres)[0])
+
+
+def _logged_every(step_s: float, switch_s: float = 3 * 3600.0 + 0.5 * 600.0,
+                  temperatures_s: float | None = None) -> BenchRun:
+    """6 h of a no-load run logged every ``step_s`` (the temperatures every
+    ``temperatures_s`` where given, their cells empty between): 2000 rpm, stepping to 6000
+    rpm at ``switch_s``, between two of a 10 min logger's rows; T1 a smooth warming."""
+    t = np.arange(0.0, 6 * 3600.0 + 1.0, step_s)
+    n = np.where(t < switch_s, 2000.0, 6000.0)
+    T1 = 20.0 + 5.0 * (1.0 - np.exp(-t / 7200.0))
+    if temperatures_s:
+        T1 = np.where(np.isclose(np.mod(t, temperatures_s), 0.0), T1, np.nan)
+    cols = {"speed_rpm": n, "power_kW": np.where(n > 3000.0, 1.5, 0.3),
+            "T_env_C": np.full_like(t, 20.0), "T_coolant_C": np.full_like(t, 20.0),
+            "T1_C": T1}
+    return BenchRun(Path("sparse.csv"), {}, t, cols, {}, [], ["T1"], float(t[-1]))
+
+
+@pytest.mark.parametrize("step_s, temperatures_s", [(600.0, None), (130.0, None),
+                                                    (10.0, 600.0)])
+def test_a_sparse_logger_has_no_gaps_between_its_rows(step_s, temperatures_s):
+    """A bench that writes a row every 10 min (or its temperatures every 10 min beside a
+    drive every 10 s) logs throughout: no logging gap, and the channel is known at every
+    grid point between its samples. A stretch without a row was a gap when longer than two
+    60 s grid steps, so fit refused such runs ("too few samples") or, logged every 2 min
+    with jitter, cut them into hundreds of gaps (fuzzing round 4)."""
+    from compare.fit.gaps import logging_gaps
+    from spindle.bench_inputs import bench_grid, logging_step_s, resample
+
+    run = _logged_every(step_s, temperatures_s=temperatures_s)
+    grid = bench_grid(run, 60.0)
+    assert logging_gaps(run.time_s, grid) == []
+    t, y = run.channel("T1")
+    values = resample(t, y, grid, 2.0, logging_step_s(run.time_s))
+    assert np.all(np.isfinite(values[grid <= t[~np.isnan(y)][-1]]))
+    # a real gap is still one: two hours without a row in a run logged every 10 min
+    cut = (run.time_s < 2 * 3600.0) | (run.time_s > 4 * 3600.0)
+    kept = run.time_s[cut]
+    assert logging_gaps(kept, grid) == [(float(kept[kept < 7200.0][-1]),
+                                         float(kept[kept > 14400.0][0]))]
+
+
+def test_a_step_between_a_sparse_loggers_rows_is_placed_at_the_silences_middle():
+    """A 10 min logger sees a speed step up to 10 min late. Held from the row that logs it,
+    the step came 5 min late on average, which fit read as a sensor lag of 1020 s on a clean
+    control (fuzzing round 4). It now begins halfway between that row and the one before,
+    the unbiased estimate; a run logged every second keeps the logged time (the shift would
+    be below the grid's resolution)."""
+    expect_s = 3 * 3600.0 + 300.0  # the true switch, midway between two 10 min rows
+    for step_s in (600.0, 1.0):
+        run = _logged_every(step_s)
+        inp = interval_inputs(run, 60.0)
+        first = float(inp.grid_s[np.flatnonzero(inp.speed_rpm > 3000.0)[0]])
+        # the interval whose middle lies past the step's estimate is the first at 6000 rpm
+        assert expect_s - 60.0 <= first <= expect_s, (step_s, first)

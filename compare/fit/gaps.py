@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from compare.fit.criteria import Criteria
-from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM, Inputs
+from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM, Inputs, silence_s
 
 #: the criteria of the gaps (gap_min_steps, gap_judge_s, gap_level_s) when none are given
 _DEFAULT = Criteria()
@@ -100,11 +100,11 @@ def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.
 def logging_gaps(t_rows_s: np.ndarray, grid_s: np.ndarray, criteria: Criteria = _DEFAULT
                  ) -> list[tuple[float, float]]:
     """(start, end) [s] of each stretch without any row (``t_rows_s``, every row's time)
-    longer than ``criteria.gap_min_steps`` steps of the grid ``grid_s`` [s]."""
-    step = float(np.median(np.diff(grid_s)))
+    longer than ``criteria.gap_min_steps`` steps of the grid ``grid_s`` [s] or of the run's
+    own logging, whichever is longer (spindle.bench_inputs.silence_s)."""
     t = np.asarray(t_rows_s, dtype=float)
-    return [(float(t[i]), float(t[i + 1]))
-            for i in np.where(np.diff(t) > criteria.gap_min_steps * step)[0]]
+    longest = silence_s(criteria.gap_min_steps, float(np.median(np.diff(grid_s))), t)
+    return [(float(t[i]), float(t[i + 1])) for i in np.where(np.diff(t) > longest)[0]]
 
 
 def unknown_input_spans(t_rows_s: np.ndarray, grid_s: np.ndarray,

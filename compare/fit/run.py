@@ -32,7 +32,14 @@ from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAM
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
 from spindle.bench import BenchRun, check_against_spec, read_bench
-from spindle.bench_inputs import Inputs, check_no_load_power, interval_inputs, resample, valid_samples
+from spindle.bench_inputs import (
+    Inputs,
+    check_power_balance,
+    interval_inputs,
+    logging_step_s,
+    resample,
+    valid_samples,
+)
 from spindle.drive import drive_for
 from spindle.errors import InputError, SolverError
 from spindle.results import check_plausible
@@ -92,7 +99,8 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
                          "add [power_balance] preset to the spec")
     raw = interval_inputs(run, grid_s, criteria.gap_min_steps)
-    check_no_load_power(run, drive, raw.grid_s, raw.speed_rpm, raw.power_kW)
+    check_power_balance(run, drive, raw.grid_s, raw.speed_rpm, raw.power_kW,
+                        raw.load_torque_Nm, criteria.no_load_Nm)
     measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks, criteria)
     inputs, switches = _place_gap_switches(run, spec, drive, raw, measured, channels, nodes,
                                            base_extra, say, criteria)
@@ -319,7 +327,7 @@ def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fracti
     values = {}
     for c in channels:
         t, y = run.channel(c)
-        values[c] = resample(t, y, grid_s, criteria.gap_min_steps)
+        values[c] = resample(t, y, grid_s, criteria.gap_min_steps, logging_step_s(run.time_s))
     measured = Measured(grid_s, values, fit_fraction, blocks)
     for c in channels:
         if measured.mask(c, "fit").sum() < 10 or measured.mask(c, "validation").sum() < 5:

@@ -158,10 +158,12 @@ def load_response_test(run, gb, theta: dict[str, float], criteria) -> EventTest:
         return _not_applicable(len(keys), "too few logged blocks in the load plateaus")
     # the paths must be separable: where the coolant's route to the rings is the rotor's
     # route (no cooled seats), a misfit of one reads as the other
-    r_paths = float(np.corrcoef(X[:, 0], X[:, 1])[0, 1])
+    with np.errstate(invalid="ignore", divide="ignore"):  # a path without variation: nan
+        r_paths = float(np.corrcoef(X[:, 0], X[:, 1])[0, 1])
     if not abs(r_paths) <= criteria.max_path_correlation:
+        why = ("one of them does not vary" if np.isnan(r_paths) else f"r = {r_paths:.2f}")
         return _not_applicable(len(keys), "the coolant's and the rotor's paths to the rings "
-                               f"are not separable on this run (r = {r_paths:.2f})")
+                               f"are not separable on this run ({why})")
     coef = np.linalg.lstsq(X, E, rcond=None)[0]
     # jackknife over the plateaus: the blocks within one are correlated
     loo = np.array([np.linalg.lstsq(X[P != k], E[P != k], rcond=None)[0] for k in keys])
