@@ -3,7 +3,8 @@ did not make and on the drawn families: per run, the largest ratio of an interva
 (power less the load's M omega) to the drive's losses at its speed and torque (at least the
 rated one), which must stay below 1; the same for loaded runs read as if they had no torque
 column (which the bound must catch); and the median share of the power the load takes,
-M omega / P_el, which must stay below 1.
+M omega / P_el, which must stay below 1; without a load, the median power against the
+bearings' friction at a third of their friction factor, which must stay above 1.
 
     python benchmarks/bench_power_balance.py [--families benchmarks/.families-cache]
         [--out docs/figures/power-balance.json]
@@ -27,17 +28,18 @@ from figures import ROOT, write_figures
 
 
 def measure(paths: list[Path]) -> dict[str, list[float]]:
-    """Per run: "no_torque" (loss ratio of runs without a torque column), "loaded" (loss
+    """Per run: "no_torque" (loss ratio of runs without a torque column), "friction_share"
+    (their median power against the bearings' friction at f0 / 3), "loaded" (loss
     ratio of runs with one), "loaded_without_torque" (the same runs' ratio with the torque
     taken as 0) and "efficiency" (their median M omega / P_el)."""
     from spindle import load_spec
     from spindle.bench import read_bench
-    from spindle.bench_inputs import interval_inputs, load_efficiency, loss_excess
+    from spindle.bench_inputs import friction_share, interval_inputs, load_efficiency, loss_excess
     from spindle.drive import drive_for
 
     drive = drive_for(load_spec("spl2782"))
-    out: dict[str, list[float]] = {"no_torque": [], "loaded": [], "loaded_without_torque": [],
-                                   "efficiency": []}
+    out: dict[str, list[float]] = {"no_torque": [], "friction_share": [], "loaded": [],
+                                   "loaded_without_torque": [], "efficiency": []}
     for i, path in enumerate(paths, 1):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -48,6 +50,7 @@ def measure(paths: list[Path]) -> dict[str, list[float]]:
             continue
         if not run.load_torque_measured:
             out["no_torque"].append(ex.ratio)
+            out["friction_share"].append(friction_share(drive, raw.speed_rpm, raw.power_kW))
         else:
             out["loaded"].append(ex.ratio)
             zero = np.zeros_like(raw.load_torque_Nm)

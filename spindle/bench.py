@@ -470,9 +470,18 @@ def _read_time(table: _Table, j: int, error: _ErrorFor) -> np.ndarray:
     back = np.flatnonzero(np.diff(t) <= 0)
     if len(back):
         k = int(back[0]) + 1
-        raise error(f"time_s (line {line_no[k]})", f"{t[k]:g} s is not after {t[k - 1]:g} s on line "
-                    f"{line_no[k - 1]}: time must increase strictly",
-                    "export the rows in time order without duplicate rows")
+        what = f"{t[k]:g} s is not after {t[k - 1]:g} s on line {line_no[k - 1]}"
+        if t[k] == t[k - 1]:
+            fix = "export the rows in time order without duplicate rows"
+        elif t[k] <= t[0] + 0.01 * (t[k - 1] - t[0]):
+            # back to (near) the first row's time: a second run appended, not a row misplaced
+            what += ": the time starts again, as if a second run followed the first"
+            fix = f"export one run a file (the second starts at line {line_no[k]})"
+        else:
+            what += f": the time goes back by {t[k - 1] - t[k]:g} s"
+            fix = ("export the rows in time order; if the bench's clock was set back, export "
+                   "the time since the start of the run")
+        raise error(f"time_s (line {line_no[k]})", f"{what}: time must increase strictly", fix)
     if t[-1] - t[0] > CYCLE_MAX_S:
         k = len(t) - 1
         raise error(f"time_s (line {line_no[k]})", f"the run spans {(t[-1] - t[0]) / 3600:.4g} h, "
@@ -560,10 +569,13 @@ def _check_enough_data(t: np.ndarray, columns: dict[str, np.ndarray], channels: 
     tm = t[measured]
     span = float(tm[-1] - tm[0]) if len(tm) else 0.0
     if len(tm) < MIN_ROWS or span < MIN_SPAN_S:
+        fix = (f"export a run with at least {MIN_ROWS} rows with a measured channel over at "
+               f"least {MIN_SPAN_S / 60:.0f} min")
+        if len(tm) >= MIN_ROWS and span > 0:  # rows enough, time too short: its unit?
+            fix += (f"; {len(tm)} rows in {span:.4g} s is a row every {span / (len(tm) - 1):.3g} "
+                    "s: if time_s is in minutes or hours, export seconds")
         raise error("rows", f"too little data to fit: {len(tm)} rows with a measured channel "
-                    f"({', '.join(channels)}) spanning {span / 60:.1f} min",
-                    f"export a run with at least {MIN_ROWS} rows with a measured channel over at "
-                    f"least {MIN_SPAN_S / 60:.0f} min")
+                    f"({', '.join(channels)}) spanning {span / 60:.1f} min", fix)
 
 
 def _is_number(s: str) -> bool:
@@ -637,6 +649,19 @@ def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error:
 
 
 # ============================================================================ spec
+
+
+def stuck_channels(run: BenchRun, channels: list[str]) -> list[str]:
+    """The ``channels`` whose valid samples all read one value. A sensor on a spindle shows
+    at least its noise or its room's drift over a run, so such a channel is stuck or not
+    connected; it carries nothing to fit."""
+    out = []
+    for c in channels:
+        y = run.columns[CHANNEL_COLUMNS[c]]
+        y = y[~np.isnan(y)]
+        if len(y) > 1 and float(np.max(y)) == float(np.min(y)):
+            out.append(c)
+    return out
 
 
 def check_against_spec(run: BenchRun, spec: Spec) -> list[str]:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -20,7 +20,7 @@ from spindle.checks import omega_rad_s
 from spindle.drive import Drive, drive_for
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
-from spindle.power import power_balance
+from spindle.power import bearing_friction, power_balance
 from spindle.spec import Spec
 from spindle.units import MAX_SERIES_POINTS, ZERO_C_K
 
@@ -266,6 +266,30 @@ def loss_excess(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
     return None if best is None else LossExcess(best[0], best[1], over, running)
 
 
+#: Palmgren's friction factor f0 spans a factor 2-3 over lubrication and preload (Harris,
+#: Rolling Bearing Analysis): a bearing set turns with at least its f0 / 3
+PALMGREN_SPREAD = 3.0
+
+
+def friction_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray) -> float:
+    """The median, over the running intervals with a measured power, of the power [kW]
+    against the bearings' friction at the speed [rpm] with their friction factors divided by
+    :data:`PALMGREN_SPREAD` [-]: a spindle turning without a load draws at least that, its
+    motor's losses aside (the peer's no-load runs draw 6 times it and more: docs/bench.md).
+    nan without such an interval."""
+    low = {k: replace(b, f0=b.f0 / PALMGREN_SPREAD) for k, b in drive.bearings.items()}
+    cache: dict[int, float] = {}
+    shares = []
+    for n, P in zip(speed_rpm, power_kW, strict=True):
+        if n < STANDSTILL_RPM or math.isnan(P):
+            continue
+        key = round(float(n))
+        if key not in cache:
+            cache[key] = sum(bearing_friction(b, float(key)).heat_W for b in low.values())
+        shares.append(P * 1e3 / cache[key])
+    return float(np.median(shares)) if shares else float("nan")
+
+
 def load_efficiency(speed_rpm: np.ndarray, power_kW: np.ndarray, load_torque_Nm: np.ndarray,
                     loaded_Nm: float = LOAD_CELL_ZERO_NM) -> tuple[float, int]:
     """(median of M omega / P_el [-], intervals): the share of the electrical power [kW]
@@ -287,7 +311,8 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
     conservation, before they become heat sources (per interval arrays on ``grid_s`` [s]):
 
     - a load that takes more than the drive draws (:func:`load_efficiency` above 1): a
-      torque in N cm, a power in MW;
+      torque in N cm, a power in MW; without a load, less power than the bearings' friction
+      alone (:func:`friction_share` below 1): a power in MW or not logged;
     - losses beyond what the drive makes even at its rated torque (:func:`loss_excess`):
       without a torque column a run is a no-load run whose power is all heat, so a loaded run
       exported without its torque; with one, power and torque swapped, a torque of the
@@ -306,6 +331,16 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
                 "delivers at most what it draws",
                 "export load_torque_Nm in N m (a torque in N cm is 100 times too large) and "
                 "power_kW in kW (a power in MW is 1000 times too small)")
+    else:
+        share = friction_share(drive, speed_rpm, power_kW)
+        if share < 1.0:
+            raise InputError(
+                path, "power_kW",
+                f"the spindle turns, but in most running intervals it draws less than its "
+                f"bearings' friction alone at a third of the spec's friction factor (median "
+                f"{share:.3g} of it), which no turning spindle can",
+                "export the drive's electrical power in kW (a power in MW is 1000 times too "
+                "small; a column of zeros was not logged)")
     ex = loss_excess(drive, speed_rpm, power_kW, load_torque_Nm)
     if ex is None or ex.over == 0:
         return

@@ -436,11 +436,13 @@ def test_load_torque_is_averaged_into_the_power_balance(tmp_path, spec):
 
 def test_standstill_and_noisy_power_do_not_crash(tmp_path, spec):
     """Standstill: no losses, even with a slightly negative power; a running interval whose
-    power is below the friction power: motor losses 0, bearings keep their friction heat."""
+    power is below the friction power: motor losses 0, bearings keep their friction heat.
+    (Five such intervals of thirty: in most, a spindle draws at least its bearings'
+    friction, or the run is refused, test_a_no_load_power_in_megawatts_or_zero_is_refused.)"""
     lines = [row(i * 60.0, speed="0" if i == 0 else ("12000" if i == 30 else ""),
-                 power="-0.02" if i < 30 else "0.1") for i in range(61)]
+                 power="-0.02" if i < 30 else ("0.1" if i < 35 else "3.0")) for i in range(61)]
     run = read_bench(write(tmp_path, lines))
-    with pytest.warns(BenchWarning, match=r"power_kW: in 30 of 60 intervals \(first at t = 1800 s\)"):
+    with pytest.warns(BenchWarning, match=r"power_kW: in 5 of 60 intervals \(first at t = 1800 s\)"):
         case, grid = inputs(run, spec)
     assert all(case.sources[k](600.0) == 0.0 for k in case.sources)
     drive = drive_for(spec)
@@ -578,15 +580,23 @@ def test_the_no_load_bound_is_the_drives_losses_at_its_rated_torque(tmp_path, sp
 def test_every_peer_run_keeps_the_power_balance():
     """The bounds refuse none of the peer's 23 runs (the figures of docs/bench.md, whose
     table is the benchmark's; these are recomputed): the 17 without a torque column draw at
-    most 0.07-0.14 of the no-load bound; the 6 loaded ones lose 0.30-0.34 of theirs, their
+    most 0.07-0.14 of the no-load bound and at least 6 times their bearings' friction at a
+    third of its factor; the 6 loaded ones lose 0.30-0.34 of theirs, their
     load takes a median 0.93-0.94 of the power, and read as if without a load they draw
     4.6-5.5 times the bound."""
-    from spindle.bench_inputs import check_power_balance, interval_inputs, load_efficiency, loss_excess
+    from spindle.bench_inputs import (
+        check_power_balance,
+        friction_share,
+        interval_inputs,
+        load_efficiency,
+        loss_excess,
+    )
 
     spec = load_spec("spl2782")
     drive = drive_for(spec)
     runs = sorted(PEER_RUNS.glob("bench-runs*/*.csv"))
-    figures: dict[str, list[float]] = {"no_torque": [], "loaded": [], "without": [], "eta": []}
+    figures: dict[str, list[float]] = {"no_torque": [], "loaded": [], "without": [], "eta": [],
+                                       "friction": []}
     for path in runs:
         run = read_bench(path)
         raw = interval_inputs(run)
@@ -595,13 +605,15 @@ def test_every_peer_run_keeps_the_power_balance():
         ratio = loss_excess(drive, n, P, M).ratio
         if not run.load_torque_measured:
             figures["no_torque"].append(ratio)
+            figures["friction"].append(friction_share(drive, n, P))
             continue
         figures["loaded"].append(ratio)
         figures["without"].append(loss_excess(drive, n, P, 0.0 * M).ratio)
         figures["eta"].append(load_efficiency(n, P, M)[0])
     assert len(figures["no_torque"]) == 17 and len(figures["loaded"]) == 6
     for key, lo, hi in (("no_torque", 0.065, 0.145), ("loaded", 0.295, 0.345),
-                        ("without", 4.6, 5.55), ("eta", 0.925, 0.945)):
+                        ("without", 4.6, 5.55), ("eta", 0.925, 0.945),
+                        ("friction", 6.0, 10.5)):
         assert lo <= min(figures[key]) and max(figures[key]) <= hi, (key, figures[key])
 
 
@@ -656,6 +668,20 @@ def test_a_loaded_run_whose_power_torque_and_speed_cannot_belong_together_is_ref
     assert p.field == field and words in p.message + " " + p.fix, str(info.value)
 
 
+@pytest.mark.parametrize("factor", [1e-3, 0.0])
+def test_a_no_load_power_in_megawatts_or_zero_is_refused(tmp_path, spec, factor):
+    """dev-06 with its power in MW, or a column of zeros: it turns, so it draws at least
+    its bearings' friction; both had been clipped without a word to a confident
+    "unexplained" (fuzzing round 4)."""
+    run = read_bench(_edited(PEER_RUNS / "bench-runs" / "dev-06.csv", tmp_path / "run.csv",
+                             "power_kW", factor))
+    with pytest.raises(InputError) as info:
+        inputs(run, spec)
+    p = info.value.problem
+    assert p.field == "power_kW" and "less than its bearings' friction" in p.message
+    assert "MW" in p.fix
+
+
 def test_a_no_load_power_in_watts_is_named_as_watts(tmp_path, spec):
     """A no-load run's power in W exceeds the no-load bound as a missing torque would; where
     it also exceeds what the drive draws at its nominal point, the message names the unit
@@ -675,3 +701,50 @@ def test_the_load_cells_zero_drift_is_the_fits():
     from spindle.bench_inputs import LOAD_CELL_ZERO_NM
 
     assert Criteria().no_load_Nm == LOAD_CELL_ZERO_NM
+
+
+@pytest.mark.parametrize("change, words, fix", [
+    # the time starts again at line 42: two runs in one file (fuzzing: "export the rows in
+    # time order without duplicate rows")
+    (lambda ls: ls[:40] + [row(i * 60.0) for i in range(21)], "the time starts again",
+     "export one run a file (the second starts at line 42)"),
+    # a clock set back by 9 min in the middle of a run
+    (lambda ls: ls[:40] + [row(1800.0 + i * 60.0) for i in range(21)],
+     "the time goes back by 540 s",
+     "if the bench's clock was set back"),
+    (lambda ls: ls[:10] + [row(540)] + ls[11:], "is not after", "without duplicate rows"),
+])
+def test_time_that_goes_back_says_how(tmp_path, change, words, fix):
+    """A time that is not increasing names what it looks like: a duplicate row, a second
+    run appended (the time back near the first row's), or a clock set back."""
+    fld, msg, got_fix = problem(write(tmp_path, change(good_rows())))
+    assert fld.startswith("time_s (line ") and words in msg and fix in got_fix, (msg, got_fix)
+
+
+def test_a_run_of_many_rows_in_minutes_asks_for_seconds(tmp_path):
+    """16 h logged every 10 s with time_s in minutes spans 16 min: "too little data", and the
+    fix now says that 5760 rows in that span is a row every 0.17 s (fuzzing round 4)."""
+    lines = [row(i * 10.0 / 60.0, speed="4300" if i == 0 else "") for i in range(5760)]
+    fld, msg, fix = problem(write(tmp_path, lines))
+    assert fld == "rows" and "spanning 16.0 min" in msg
+    assert "a row every 0.167 s: if time_s is in minutes or hours, export seconds" in fix
+
+
+def test_a_sensor_that_reads_one_value_throughout_is_left_out_with_a_warning(tmp_path):
+    """T1 at 20.00 in every row had been fitted as a model that "misses T1 by 2 tolerances"
+    (fuzzing round 4). A sensor on a spindle shows at least its noise, so fit leaves such a
+    channel out with a BenchWarning naming it; with every channel stuck, nothing is left to
+    fit: InputError."""
+    from compare.fit.run import _without_stuck
+    from spindle.bench import stuck_channels
+
+    lines = [row(i * 60.0, speed="4300" if i == 0 else "", t2=f"{21.5 + 0.01 * i:.2f}",
+                 ts=f"{30 + 0.02 * i:.2f}", p1=f"{1.0 + 0.01 * i:.2f}") for i in range(61)]
+    run = read_bench(write(tmp_path, lines))
+    assert stuck_channels(run, run.channels) == ["T1"]
+    with pytest.warns(BenchWarning, match="T1_C: reads 22 in each of its 61 samples.*left out"):
+        assert _without_stuck(run, run.channels) == ["T2", "T_stator", "P1"]
+    flat = read_bench(write(tmp_path, good_rows(), name="flat.csv"))
+    with pytest.raises(InputError, match="every measured channel reads one value"):
+        with pytest.warns(BenchWarning):
+            _without_stuck(flat, flat.channels)

@@ -264,11 +264,13 @@ def power_balance_text(doc: dict) -> str:
     """docs/bench.md's table of the power balance's bounds from
     docs/figures/power-balance.json (benchmarks/bench_power_balance.py)."""
     figures = (("no_torque", "losses / bound, no torque column (no-load runs)"),
+               ("friction_share", "median P_el / bearing friction at f0 / 3, no-load runs"),
                ("loaded", "losses / bound, loaded runs"),
                ("loaded_without_torque", "losses / bound, loaded runs read without torque"),
                ("efficiency", "median M·ω / P_el, loaded runs"))
     rows = [f"Measured {doc['date']} at commit {doc['commit']}. A valid run's figure stays "
-            "below 1; the rows read without torque show what the bound catches.", "",
+            "below 1, but its power against the friction, which stays above 1; the rows read "
+            "without torque show what the bound catches.", "",
             "| runs | figure | runs | min | median | max |",
             "|---|---|---:|---:|---:|---:|"]
     for group, name in (("peers", "the peer's (tests/data/peer-runs)"),

@@ -31,7 +31,14 @@ from compare.fit.greybox import GreyBox
 from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, default_theta
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
-from spindle.bench import BenchRun, check_against_spec, read_bench
+from spindle.bench import (
+    CHANNEL_COLUMNS,
+    BenchRun,
+    BenchWarning,
+    check_against_spec,
+    read_bench,
+    stuck_channels,
+)
 from spindle.bench_inputs import (
     Inputs,
     check_power_balance,
@@ -94,6 +101,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         channels = check_against_spec(run, spec)
+    channels = _without_stuck(run, channels)
     drive = drive_for(spec)
     if drive is None:
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
@@ -148,6 +156,27 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                 anchor, base = anchored(cal, base.theta)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
                            switches, placed_by)
+
+
+def _without_stuck(run: BenchRun, channels: list[str]) -> list[str]:
+    """``channels`` less those whose sensor reads one value throughout
+    (spindle.bench.stuck_channels), each left out with a BenchWarning; InputError where
+    none is left."""
+    stuck = stuck_channels(run, channels)
+    for c in stuck:
+        col = CHANNEL_COLUMNS[c]
+        y = run.columns[col]
+        warnings.warn(BenchWarning(
+            f"{run.path}: {col}: reads {float(y[~np.isnan(y)][0]):g} in each of its "
+            f"{int(np.sum(~np.isnan(y)))} samples: a sensor on a spindle shows at least its "
+            "noise, so it is stuck or not connected; the channel is left out (fix: check the "
+            "sensor, or drop the column)"), stacklevel=3)
+    kept = [c for c in channels if c not in stuck]
+    if not kept:
+        raise InputError(str(run.path), ", ".join(CHANNEL_COLUMNS[c] for c in channels),
+                         "every measured channel reads one value throughout: no sensor "
+                         "measured the spindle", "check the sensors and their export")
+    return kept
 
 
 def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measured: Measured,
