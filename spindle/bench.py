@@ -235,7 +235,7 @@ class _Table:
             line_no = np.arange(header_idx + 2, header_idx + 2 + len(rest))
             body = text.split("\n") if rest else []
         else:
-            kept = [(k + 1, ln.rstrip("\r")) for k, ln in enumerate(rest, start=header_idx + 1)
+            kept = [(k + 1, ln.replace("\r", "")) for k, ln in enumerate(rest, start=header_idx + 1)
                     if ln.strip() and not ln.lstrip().startswith("#")]
             line_no = np.array([k for k, _ in kept], dtype=int)
             body = [ln for _, ln in kept]
@@ -402,7 +402,8 @@ def _read_header(lines: list[str], header_idx: int,
     """The column names and the index of each: comma-separated, no duplicates, the required
     columns and at least one measured channel."""
     hline = header_idx + 1
-    header = [h.strip() for h in next(csv.reader([lines[header_idx].rstrip("\r")]))]
+    # a carriage return is a line end or nothing, never a cell's text (the body drops it too)
+    header = [h.strip() for h in next(csv.reader([lines[header_idx].replace("\r", "")]))]
     if len(header) == 1 and any(sep in header[0] for sep in (";", "\t")):
         sep_name = "';'" if ";" in header[0] else "tabs"
         raise error(f"header (line {hline})", f"the columns are separated by {sep_name}, not commas",

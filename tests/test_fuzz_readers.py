@@ -168,6 +168,20 @@ def _check_bench(path: Path) -> None:
             _refused_cleanly(exc, path)
 
 
+@pytest.mark.parametrize("where", ["first line", "data row after a comment"])
+def test_a_bare_carriage_return_is_read_or_refused_cleanly(tmp_path_factory, where):
+    """Found by the larger budget (2026-11-29): '\r\x80' before the first line made the
+    header's csv.reader fail ("new-line character seen in unquoted field"), an internal
+    error. A carriage return is a line end or nothing, never a cell's text."""
+    lines = BENCH.split("\n")
+    if where == "first line":
+        text = "\r\x80" + BENCH
+    else:  # a comment among the rows takes the reader's line-by-line path
+        k = next(i for i, ln in enumerate(lines) if ln.startswith("time_s")) + 3
+        text = "\n".join(lines[:k] + ["# a note", "\r" + lines[k]] + lines[k + 1:])
+    _check_bench(_write(tmp_path_factory, "run.csv", text))
+
+
 @settings(FUZZ, max_examples=BUDGET or 200)
 @given(data=st.data(), structural=st.booleans())
 def test_a_mutated_bench_file_is_read_or_refused_cleanly(tmp_path_factory, data, structural):
