@@ -748,3 +748,27 @@ def test_a_sensor_that_reads_one_value_throughout_is_left_out_with_a_warning(tmp
     with pytest.raises(InputError, match="every measured channel reads one value"):
         with pytest.warns(BenchWarning):
             _without_stuck(flat, flat.channels)
+
+
+def test_a_stuck_channel_is_named_in_the_fits_report(tmp_path):
+    """The warning reaches report.json and report.html, not only stderr: the peer's dev-06,
+    its first 2 h, with T1 at 20.00 in every row."""
+    from compare.fit.run import run_fit
+
+    lines = (PEER_RUNS / "bench-runs" / "dev-06.csv").read_text(encoding="utf-8").splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
+    k = lines[head].split(",").index("T1_C")
+    out = lines[:head + 1]
+    for ln in lines[head + 1:]:
+        cells = ln.split(",")
+        if float(cells[0]) > 7200.0:
+            break
+        cells[k] = "20.00"
+        out.append(",".join(cells))
+    path = tmp_path / "dev-06-T1-stuck.csv"
+    path.write_text("\n".join(out) + "\n", encoding="utf-8")
+    with pytest.warns(BenchWarning, match="T1_C: reads 20"):
+        rep = run_fit(path, load_spec("spl2782"))
+    doc = rep.to_dict()
+    assert "T1" not in doc["channels"]
+    assert any(w.startswith("T1_C reads one value in every row") for w in doc["warnings"])

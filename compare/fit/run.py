@@ -78,6 +78,8 @@ class BaseCalibration:
     gap_switches: list = field(default_factory=list)
     #: which model placed them: the calibrated, anchored one (the lumped path) or the spec's
     switches_placed_by: str = "the spec's model"
+    #: channels left out before the fit, each with why (a sensor that reads one value)
+    left_out: list[str] = field(default_factory=list)
 
 
 def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, nodes: int = 11,
@@ -101,7 +103,10 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         channels = check_against_spec(run, spec)
+    measured_channels = list(channels)
     channels = _without_stuck(run, channels)
+    left_out = [f"{CHANNEL_COLUMNS[c]} reads one value in every row (a stuck or disconnected "
+                "sensor) and is left out" for c in measured_channels if c not in channels]
     drive = drive_for(spec)
     if drive is None:
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
@@ -155,7 +160,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                 cal = calibrator(inputs)
                 anchor, base = anchored(cal, base.theta)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
-                           switches, placed_by)
+                           switches, placed_by, left_out)
 
 
 def _without_stuck(run: BenchRun, channels: list[str]) -> list[str]:
@@ -328,8 +333,9 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
     adequacy["with_effects"] = base_adequacy(final.errors, final.theta, prep.spec_values,
                                              cal.prior_z(final), ranges, criteria,
                                              final.partners)
-    warns = extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
-                                   measured.fit_points())
+    warns = list(prep.left_out)
+    warns += extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
+                                    measured.fit_points())
     warns += [f"{g.text()} inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} h); the change "
               f"is placed at {g.switch_s / 3600:.2f} h, where {prep.switches_placed_by} fits "
               "the hour after the gap best (compare.fit.gaps)" for g in prep.gap_switches]
