@@ -684,3 +684,35 @@ def test_paths_that_cannot_be_told_apart_leave_the_test_out():
                               CRITERIA)
     assert math.isnan(test.p_value) and "not separable" in test.meaning
     assert not test.significant(0.01)
+
+
+def test_a_drift_test_the_log_cannot_read_is_unreadable_and_vetoes(tmp_path):
+    """dev-06 (no load, long segments after its speed steps) logged every 5 min: the
+    conditions of the preload's drift test hold, but the power 2-6 min after each step is
+    not in the log. The test is then unreadable, not "not applicable", and its outcome
+    vetoes the open loop (a preload had been named on this control at p = 7e-30 by the open
+    loop alone, fuzzing round 4). Logged every 10 s, the test reads and applies."""
+    from compare.fit.criteria import Criteria
+    from compare.fit.effects.preload import drift_test
+    from compare.fit.select import signature_outcome
+    from compare.fit.signatures import segments
+    from spindle.bench import read_bench
+
+    src = PEER_RUNS / "dev-06.csv"
+    lines = src.read_text(encoding="utf-8").splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
+    sparse, last = lines[:head + 1], -1
+    for ln in lines[head + 1:]:
+        k = int(float(ln.split(",")[0]) // 300.0)
+        if k != last:
+            sparse.append(ln)
+            last = k
+    cr = Criteria()
+    dense = drift_test(segments(read_bench(src), cr), cr, lambda a, b: 1.0)
+    assert dense.applies and not dense.unreadable
+    path = tmp_path / "dev-06-5min.csv"
+    path.write_text("\n".join(sparse) + "\n", encoding="utf-8")
+    test = drift_test(segments(read_bench(path), cr), cr, lambda a, b: 1.0)
+    assert test.unreadable and not test.applies and "unreadable" in test.meaning
+    assert signature_outcome(test, cr.alpha) is False
+    assert signature_outcome(dense, cr.alpha) is not None

@@ -194,7 +194,12 @@ def signature_outcome(signature, alpha: float) -> bool | None:
     """True where the signature test is significant at ``alpha``; None where it does not
     apply (or there is none); False where it applies and is not significant: its own test
     could look for the effect and did not find it, so an attribution of a misfit to it is a
-    guess, and weak evidence ends in 'nothing named' rather than a name."""
+    guess, and weak evidence ends in 'nothing named' rather than a name. False as well
+    where the run holds its conditions but its log is too sparse to read them
+    (``unreadable``): the evidence that would tell the effect from the base's misfit is
+    missing, so the open loop does not name it alone."""
+    if signature is not None and signature.unreadable:
+        return False
     if signature is None or not signature.applies:
         return None
     return bool(signature.significant(alpha))

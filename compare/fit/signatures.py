@@ -77,6 +77,10 @@ class EventTest:
     #: lag tests: the onset scale reported, and the test at every scale
     scale: str | None = None
     scales: list[dict] = field(default_factory=list)
+    #: the run holds the test's conditions, but its log is too sparse to read them (a power
+    #: logged every 5 min has no level 2-6 min after a speed step): unlike a test that does
+    #: not apply, it cannot tell the effect from the base's misfit (select.signature_outcome)
+    unreadable: bool = False
 
     @property
     def applies(self) -> bool:
@@ -90,7 +94,8 @@ class EventTest:
         return {"effect": self.effect, "channel": self.channel, "estimate": self.estimate,
                 "se": self.se, "z": self.z, "p_value": self.p_value, "n_steps": self.n_steps,
                 "unit": self.unit, "meaning": self.meaning, "model_reference": self.reference,
-                "parameter": self.parameter, "scale": self.scale, "scales": self.scales}
+                "parameter": self.parameter, "scale": self.scale, "scales": self.scales,
+                "unreadable": self.unreadable}
 
 
 def speed_steps(t_s: np.ndarray, speed_rpm: np.ndarray, criteria,
