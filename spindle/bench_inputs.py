@@ -56,10 +56,12 @@ def valid_samples(run: BenchRun, col: str) -> tuple[np.ndarray, np.ndarray]:
     return run.time_s[ok], y[ok]
 
 
-def input_samples(run: BenchRun, col: str, grid_step_s: float) -> tuple[np.ndarray, np.ndarray]:
+def input_samples(run: BenchRun, col: str, grid_step_s: float, gap_s: float
+                  ) -> tuple[np.ndarray, np.ndarray]:
     """(times [s], values) of an input column's non-empty cells, each time placed where the
     value most likely began. A value first logged after a silence longer than a grid step
-    (``grid_step_s`` [s]) but not a gap (:func:`silence_s`) began somewhere in that silence:
+    (``grid_step_s`` [s]) but not a gap (none longer than ``gap_s`` [s], the caller's hold:
+    :func:`silence_s`) began somewhere in that silence:
     a regular logger that writes every 10 min sees a speed step up to 10 min late, and held
     from its row the step is late by half the silence on average, which the fit would read
     as a lag. Such a time moves to the silence's middle, the unbiased estimate (the value is
@@ -70,7 +72,7 @@ def input_samples(run: BenchRun, col: str, grid_step_s: float) -> tuple[np.ndarr
     rows = run.time_s
     k = np.searchsorted(rows, t, side="left")  # the cell's own row
     before = np.where(k > 0, t - rows[np.clip(k - 1, 0, None)], 0.0)
-    centre = (before > grid_step_s) & (before <= silence_s(HOLD_STEPS, grid_step_s, rows))
+    centre = (before > grid_step_s) & (before <= gap_s)
     return np.where(centre, t - 0.5 * before, t), y
 
 
@@ -409,13 +411,13 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
     dual = np.concatenate([[grid[0]], mids, [grid[-1]]])
 
     step = float(np.median(np.diff(grid)))
-    ts, ys = input_samples(run, "speed_rpm", step)
-    speed = held(ts, ys, grid)
     hold = silence_s(HOLD_STEPS, step, run.time_s)
-    T_env = cell_means(*input_samples(run, "T_env_C", step), dual, grid, hold) + ZERO_C_K
-    T_cool = cell_means(*input_samples(run, "T_coolant_C", step), dual, grid, hold) + ZERO_C_K
-    power = cell_means(*input_samples(run, "power_kW", step), grid, mids, hold)
-    torque = (cell_means(*input_samples(run, "load_torque_Nm", step), grid, mids, hold)
+    ts, ys = input_samples(run, "speed_rpm", step, hold)
+    speed = held(ts, ys, grid)
+    T_env = cell_means(*input_samples(run, "T_env_C", step, hold), dual, grid, hold) + ZERO_C_K
+    T_cool = cell_means(*input_samples(run, "T_coolant_C", step, hold), dual, grid, hold) + ZERO_C_K
+    power = cell_means(*input_samples(run, "power_kW", step, hold), grid, mids, hold)
+    torque = (cell_means(*input_samples(run, "load_torque_Nm", step, hold), grid, mids, hold)
               if run.load_torque_measured else np.zeros(len(mids)))
 
     check_power_balance(run, drive, grid, speed[:-1], power, torque)
@@ -488,11 +490,11 @@ def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOL
     grid = bench_grid(run, grid_s)
     mids = 0.5 * (grid[:-1] + grid[1:])
     hold = silence_s(hold_steps, grid_s, run.time_s)
-    t_n, n = input_samples(run, "speed_rpm", grid_s)
+    t_n, n = input_samples(run, "speed_rpm", grid_s, hold)
     speed = settled_speed(held(t_n, n, mids))
-    power = cell_means(*input_samples(run, "power_kW", grid_s), grid, mids, hold)
+    power = cell_means(*input_samples(run, "power_kW", grid_s, hold), grid, mids, hold)
     if run.load_torque_measured:
-        t_m, m = input_samples(run, "load_torque_Nm", grid_s)
+        t_m, m = input_samples(run, "load_torque_Nm", grid_s, hold)
         # mean M n [N m rpm], each held
         work = cell_means(*held_product(t_m, m, t_n, n), grid, mids, hold)
         moving = speed >= STANDSTILL_RPM
@@ -500,7 +502,7 @@ def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOL
                           cell_means(t_m, m, grid, mids, hold))
     else:
         torque = np.zeros(len(mids))
-    t_env, y_env = input_samples(run, "T_env_C", grid_s)
+    t_env, y_env = input_samples(run, "T_env_C", grid_s, hold)
     T_env = cell_means(t_env, y_env, grid, mids, hold) + ZERO_C_K
-    T_cool = cell_means(*input_samples(run, "T_coolant_C", grid_s), grid, mids, hold) + ZERO_C_K
+    T_cool = cell_means(*input_samples(run, "T_coolant_C", grid_s, hold), grid, mids, hold) + ZERO_C_K
     return Inputs(grid, speed, power, torque, T_env, T_cool, float(y_env[0]) + ZERO_C_K)
