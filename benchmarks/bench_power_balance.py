@@ -27,24 +27,61 @@ import numpy as np
 from figures import ROOT, write_figures
 
 
+def growth_gain(run, raw, spec, drive) -> float | None:
+    """P1's gain on the growth the spec's own model predicts (compare.fit.growth_check), on
+    the fit's grid and inputs before gap switches are placed."""
+    from compare.fit.criteria import Criteria
+    from compare.fit.greybox import GreyBox
+    from compare.fit.growth_check import growth_gain as gain_of
+    from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, default_theta
+    from spindle.bench_inputs import logging_step_s, resample
+
+    if "P1" not in run.channels:
+        return None
+    t, y = run.channel("P1")
+    measured = resample(t, y, raw.grid_s, Criteria().gap_min_steps, logging_step_s(run.time_s))
+    gb = GreyBox(spec, drive, raw, 11, base_extra=tuple(DEFAULT_BASE_EXTRA))
+    theta = default_theta(gb.parameters(), [*BASE_PARAMS, *DEFAULT_BASE_EXTRA])
+    found = gain_of(measured, gb.simulate(theta)["P1"])
+    return None if found is None else found[0]
+
+
 def measure(paths: list[Path]) -> dict[str, list[float]]:
     """Per run: "no_torque" (loss ratio of runs without a torque column), "friction_share"
     (their median power against the bearings' friction at f0 / 3), "loaded" (loss
     ratio of runs with one), "loaded_without_torque" (the same runs' ratio with the torque
-    taken as 0) and "efficiency" (their median M omega / P_el)."""
+    taken as 0) and "efficiency" (their median M omega / P_el); of every run,
+    "no_load_share" (the median power without a load against the drive's no-load losses),
+    "standstill_kW" (the median power at standstill) and "growth_gain" (P1 on the spec's
+    predicted growth)."""
     from spindle import load_spec
     from spindle.bench import read_bench
-    from spindle.bench_inputs import friction_share, interval_inputs, load_efficiency, loss_excess
+    from spindle.bench_inputs import (
+        friction_share,
+        interval_inputs,
+        load_efficiency,
+        loss_excess,
+        no_load_share,
+        standstill_power,
+    )
     from spindle.drive import drive_for
 
-    drive = drive_for(load_spec("spl2782"))
+    spec = load_spec("spl2782")
+    drive = drive_for(spec)
     out: dict[str, list[float]] = {"no_torque": [], "friction_share": [], "loaded": [],
-                                   "loaded_without_torque": [], "efficiency": []}
+                                   "loaded_without_torque": [], "efficiency": [],
+                                   "no_load_share": [], "standstill_kW": [], "growth_gain": []}
     for i, path in enumerate(paths, 1):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             run = read_bench(path)
             raw = interval_inputs(run)
+        share = no_load_share(drive, raw.speed_rpm, raw.power_kW, raw.load_torque_Nm)[0]
+        still = standstill_power(raw.speed_rpm, raw.power_kW)[0]
+        gain = growth_gain(run, raw, spec, drive)
+        for key, v in (("no_load_share", share), ("standstill_kW", still), ("growth_gain", gain)):
+            if v is not None and np.isfinite(v):
+                out[key].append(v)
         ex = loss_excess(drive, raw.speed_rpm, raw.power_kW, raw.load_torque_Nm)
         if ex is None:
             continue

@@ -39,7 +39,7 @@ def rows(n: int) -> list[str]:
     t = np.arange(n, dtype=float)
     speed = np.where(t < 40_000, 4300.0, 0.0)
     return [f"{t[i]:g},{'' if i and speed[i] == speed[i - 1] else f'{speed[i]:g}'},1.2,20.0,"
-            f"20.0,{22 + i * 1e-4:.4f},21.5,30.0,{'' if i % 7 == 3 else f'{i * 1e-4:.4f}'},45"
+            f"20.0,{22 + i * 1e-4:.4f},21.5,30.0,{'' if i % 7 == 3 else f'{i * 2e-4:.4f}'},45"
             for i in range(n)]
 
 

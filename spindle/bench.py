@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from spindle.errors import InputError
+from spindle.sensor_copies import check_not_copies
 from spindle.spec import Spec
 from spindle.units import CYCLE_MAX_S, POWER_MAX_KW, SPEED_MAX_RPM, TORQUE_MAX_NM, ZERO_C_K
 
@@ -354,6 +355,7 @@ def read_bench(path: str | Path) -> BenchRun:
         if hint:
             warnings.warn(BenchWarning(f"{name}: {h}: kept as an unknown column{hint}"), stacklevel=2)
 
+    check_not_copies(columns, error)
     channels = [c for c, col in CHANNEL_COLUMNS.items() if col in columns]
     p1_ref = _zero_P1(columns)
     _check_enough_data(t, columns, channels, error)

@@ -292,6 +292,41 @@ def friction_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray) ->
     return float(np.median(shares)) if shares else float("nan")
 
 
+def no_load_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
+                  load_torque_Nm: np.ndarray, loaded_Nm: float = LOAD_CELL_ZERO_NM
+                  ) -> tuple[float, int]:
+    """(median [-], intervals) over the running intervals without a load (torque [N m] at
+    most ``loaded_Nm``) of the power [kW] against the drive's no-load losses at the speed
+    [rpm]: all such power is loss, and a spindle's losses lie within a few times its spec's
+    (:data:`PALMGREN_SPREAD`), so a median far above it says the speeds are too low for the
+    power. nan without such an interval."""
+    cache: dict[int, float] = {}
+    shares = []
+    for n, P, M in zip(speed_rpm, power_kW, load_torque_Nm, strict=True):
+        if n < STANDSTILL_RPM or abs(M) > loaded_Nm or not math.isfinite(P):
+            continue
+        key = round(float(n))
+        if key not in cache:
+            cache[key] = sum(drive.heat_W(float(key), 0.0, None).values())
+        shares.append(P * 1e3 / cache[key])
+    return (float(np.median(shares)) if shares else float("nan")), len(shares)
+
+
+def standstill_power(speed_rpm: np.ndarray, power_kW: np.ndarray) -> tuple[float, int]:
+    """(median power [kW], intervals) over the standstill intervals (speed [rpm] below
+    STANDSTILL_RPM) whose neighbours stand too: an interval next to a start or a stop may
+    hold a ramp's power. nan without such an interval."""
+    n = np.asarray(speed_rpm, dtype=float)
+    still = n < STANDSTILL_RPM
+    inner = still.copy()
+    inner[1:] &= still[:-1]
+    inner[:-1] &= still[1:]
+    inner[[0, -1]] = False
+    P = np.asarray(power_kW, dtype=float)[inner]
+    P = P[np.isfinite(P)]
+    return (float(np.median(P)) if len(P) else float("nan")), len(P)
+
+
 def load_efficiency(speed_rpm: np.ndarray, power_kW: np.ndarray, load_torque_Nm: np.ndarray,
                     loaded_Nm: float = LOAD_CELL_ZERO_NM) -> tuple[float, int]:
     """(median of M omega / P_el [-], intervals): the share of the electrical power [kW]
@@ -318,7 +353,12 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
     - losses beyond what the drive makes even at its rated torque (:func:`loss_excess`):
       without a torque column a run is a no-load run whose power is all heat, so a loaded run
       exported without its torque; with one, power and torque swapped, a torque of the
-      wrong sign, or a speed not in rpm.
+      wrong sign, or a speed not in rpm;
+    - without a load, a median power above :data:`PALMGREN_SPREAD` times the drive's no-load
+      losses at the logged speed (:func:`no_load_share`): a speed in rad/s or Hz, or a load
+      the run does not give;
+    - at standstill, a median power above the drive's losses holding its rated torque
+      (:func:`standstill_power`): the spindle turned where the speed says it stood.
 
     The margins on runs this project did not make: docs/bench.md. InputError naming the
     column and the largest excess."""
@@ -344,8 +384,40 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
                 "export the drive's electrical power in kW (a power in MW is 1000 times too "
                 "small; a column of zeros was not logged)")
     ex = loss_excess(drive, speed_rpm, power_kW, load_torque_Nm)
-    if ex is None or ex.over == 0:
-        return
+    if ex is not None and ex.over > 0:
+        _refuse_loss_excess(run, drive, grid_s, speed_rpm, power_kW, load_torque_Nm, ex)
+    share, n_free = no_load_share(drive, speed_rpm, power_kW, load_torque_Nm, loaded_Nm)
+    if share > PALMGREN_SPREAD:
+        raise InputError(
+            path, "speed_rpm",
+            f"without a load the spindle draws a median {share:.3g} times what the drive "
+            f"'{drive.name}' loses at the logged speeds (over {n_free} running intervals), "
+            f"where a spindle whose friction and motor losses are within {PALMGREN_SPREAD:g} "
+            "times its spec's draws at most that: the speeds are too low for the power",
+            "export speed_rpm in rpm (a speed in rad/s is 9.55 times too small, in Hz 60 "
+            "times); if the spindle worked against a load, add the load_torque_Nm column the "
+            "bench logged (docs/bench.md)")
+    rated = rated_torque_Nm(drive)
+    P_still, n_still = standstill_power(speed_rpm, power_kW)
+    if rated is not None and P_still > 0:
+        holding_kW = sum(drive.heat_W(0.0, rated, None).values()) / 1e3
+        if P_still > holding_kW:
+            raise InputError(
+                path, "speed_rpm",
+                f"in its {n_still} standstill intervals (speed below {STANDSTILL_RPM:g} rpm) "
+                f"the drive draws a median {P_still:.3g} kW, more than the drive "
+                f"'{drive.name}' loses holding its rated {rated:.0f} N m at standstill "
+                f"({holding_kW:.3g} kW): a spindle that stands turns no power into motion, "
+                "so it turned while speed_rpm says it stood",
+                "export speed_rpm as the bench logged it (a column of zeros, or another "
+                "channel mapped to it)")
+
+
+def _refuse_loss_excess(run: BenchRun, drive: Drive, grid_s: np.ndarray,
+                        speed_rpm: np.ndarray, power_kW: np.ndarray,
+                        load_torque_Nm: np.ndarray, ex: LossExcess) -> None:
+    """The InputError of :func:`check_power_balance` for losses beyond the bound."""
+    path = str(run.path)
     i = ex.interval
     n, P, M = float(speed_rpm[i]), float(power_kW[i]), float(load_torque_Nm[i])
     where = f"at {n:.0f} rpm (t = {grid_s[i] / 3600:.2f} h)"

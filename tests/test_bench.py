@@ -149,7 +149,7 @@ def test_big_file_parses(tmp_path):
     t = np.arange(n, dtype=float)
     speed = np.where(t < 40_000, 4300.0, 0.0)
     lines = [f"{t[i]:g},{'' if i and speed[i] == speed[i - 1] else f'{speed[i]:g}'},1.2,20.0,20.0,"
-             f"{22 + i * 1e-4:.4f},21.5,30.0,{'' if i % 7 == 3 else f'{i * 1e-4:.4f}'}" for i in range(n)]
+             f"{22 + i * 1e-4:.4f},21.5,30.0,{'' if i % 7 == 3 else f'{i * 2e-4:.4f}'}" for i in range(n)]
     run = read_bench(write(tmp_path, lines, comments=("# spindle: spl2782",)))
     assert len(run.time_s) == n and run.duration_s == n - 1
     assert run.columns["T1_C"][-1] == pytest.approx(22 + (n - 1) * 1e-4)
@@ -566,12 +566,35 @@ def test_the_no_load_bound_is_the_drives_losses_at_its_rated_torque(tmp_path, sp
         base = power_balance(drive.motor, drive.bearings, n, rated, drive.T_winding_K)
         more = power_balance(drive.motor, rough, n, rated, drive.T_winding_K)
         assert more.total_heat_W < 1.08 * base.total_heat_W
+    # an hour at 4300 rpm whose no-load power is the spec's, but for ten minutes at the
+    # bound: the median rule (3 times the no-load losses) lets a few intervals through,
+    # the loss bound judges each one
+    usual_kW = no_load_W(4300.0) / 1e3
     for factor, refused in ((0.99, False), (1.01, True)):
-        lines = [row(i * 60.0, speed="4300", power=f"{factor * limit_kW:.6f}")
+        lines = [row(i * 60.0, speed="4300",
+                     power=f"{(factor * limit_kW if 20 <= i < 30 else usual_kW):.6f}")
                  for i in range(61)]
         run = read_bench(write(tmp_path, lines, name=f"run-{factor}.csv"))
         if refused:
             with pytest.raises(InputError, match="load_torque_Nm"):
+                inputs(run, spec)
+        else:
+            inputs(run, spec)
+
+
+def test_the_no_load_median_bound_is_three_times_the_drives_no_load_losses(tmp_path, spec):
+    """An hour at 4300 rpm without a load at 2.9 times the drive's no-load losses (from
+    spindle.power's balance directly) passes; at 3.1 times it is refused, naming the speed
+    (Palmgren's spread, spindle.bench_inputs.PALMGREN_SPREAD)."""
+    drive = drive_for(spec)
+    no_load_kW = power_balance(drive.motor, drive.bearings, 4300.0, 0.0,
+                               drive.T_winding_K).total_heat_W / 1e3
+    for factor, refused in ((2.9, False), (3.1, True)):
+        lines = [row(i * 60.0, speed="4300", power=f"{factor * no_load_kW:.6f}")
+                 for i in range(61)]
+        run = read_bench(write(tmp_path, lines, name=f"run-{factor}.csv"))
+        if refused:
+            with pytest.raises(InputError, match="speed_rpm"):
                 inputs(run, spec)
         else:
             inputs(run, spec)
@@ -583,25 +606,32 @@ def test_every_peer_run_keeps_the_power_balance():
     most 0.07-0.14 of the no-load bound and at least 6 times their bearings' friction at a
     third of its factor; the 6 loaded ones lose 0.30-0.34 of theirs, their
     load takes a median 0.93-0.94 of the power, and read as if without a load they draw
-    4.6-5.5 times the bound."""
+    4.6-5.5 times the bound. Without a load, 21 of them draw a median 0.24-0.42 times the
+    drive's no-load losses (bound 3), and at standstill none draws a watt."""
     from spindle.bench_inputs import (
         check_power_balance,
         friction_share,
         interval_inputs,
         load_efficiency,
         loss_excess,
+        no_load_share,
+        standstill_power,
     )
 
     spec = load_spec("spl2782")
     drive = drive_for(spec)
     runs = sorted(PEER_RUNS.glob("bench-runs*/*.csv"))
     figures: dict[str, list[float]] = {"no_torque": [], "loaded": [], "without": [], "eta": [],
-                                       "friction": []}
+                                       "friction": [], "no_load": [], "standstill": []}
     for path in runs:
         run = read_bench(path)
         raw = interval_inputs(run)
         n, P, M = raw.speed_rpm, raw.power_kW, raw.load_torque_Nm
         check_power_balance(run, drive, raw.grid_s, n, P, M)
+        share = no_load_share(drive, n, P, M)[0]
+        if np.isfinite(share):
+            figures["no_load"].append(share)
+        figures["standstill"].append(abs(standstill_power(n, P)[0]))
         ratio = loss_excess(drive, n, P, M).ratio
         if not run.load_torque_measured:
             figures["no_torque"].append(ratio)
@@ -613,7 +643,8 @@ def test_every_peer_run_keeps_the_power_balance():
     assert len(figures["no_torque"]) == 17 and len(figures["loaded"]) == 6
     for key, lo, hi in (("no_torque", 0.065, 0.145), ("loaded", 0.295, 0.345),
                         ("without", 4.6, 5.55), ("eta", 0.925, 0.945),
-                        ("friction", 6.0, 10.5)):
+                        ("friction", 6.0, 10.5), ("no_load", 0.235, 0.425),
+                        ("standstill", 0.0, 0.001)):
         assert lo <= min(figures[key]) and max(figures[key]) <= hi, (key, figures[key])
 
 
@@ -739,7 +770,7 @@ def test_a_sensor_that_reads_one_value_throughout_is_left_out_with_a_warning(tmp
     from spindle.bench import stuck_channels
 
     lines = [row(i * 60.0, speed="4300" if i == 0 else "", t2=f"{21.5 + 0.01 * i:.2f}",
-                 ts=f"{30 + 0.02 * i:.2f}", p1=f"{1.0 + 0.01 * i:.2f}") for i in range(61)]
+                 ts=f"{30 + 0.02 * i:.2f}", p1=f"{1.0 + 0.015 * i:.2f}") for i in range(61)]
     run = read_bench(write(tmp_path, lines))
     assert stuck_channels(run, run.channels) == ["T1"]
     with pytest.warns(BenchWarning, match="T1_C: reads 22 in each of its 61 samples.*left out"):
@@ -772,3 +803,77 @@ def test_a_stuck_channel_is_named_in_the_fits_report(tmp_path):
     doc = rep.to_dict()
     assert "T1" not in doc["channels"]
     assert any(w.startswith("T1_C reads one value in every row") for w in doc["warnings"])
+
+
+@pytest.mark.parametrize("factor, unit", [(2.0 * np.pi / 60.0, "rad/s"), (1.0 / 60.0, "Hz")])
+def test_a_no_load_speed_in_rad_s_or_hz_is_refused(tmp_path, spec, factor, unit):
+    """dev-06 with its speed in rad/s or Hz: without a load all its power is loss, and it
+    draws 5 or 37 times the drive's no-load losses at the speeds it logs, where a spindle
+    within Palmgren's spread of its spec draws at most 3 times (the peer's no-load runs 0.24-
+    0.42: test_every_peer_run_keeps_the_power_balance). Fuzzing round 4 had it fitted to a
+    confident "unexplained"."""
+    run = read_bench(_edited(PEER_RUNS / "bench-runs" / "dev-06.csv", tmp_path / "run.csv",
+                             "speed_rpm", factor))
+    with pytest.raises(InputError) as info:
+        inputs(run, spec)
+    p = info.value.problem
+    assert p.field == "speed_rpm" and "too low for the power" in p.message, str(info.value)
+    assert unit in p.fix
+
+
+def test_a_loaded_run_whose_speed_reads_zero_is_refused(tmp_path, spec):
+    """dev2-07 with a speed column of zeros: at standstill it would draw a median 9 kW, more
+    than the drive loses holding its rated torque (4.03 kW), so it turned."""
+    run = read_bench(_edited(PEER_RUNS / "bench-runs-2" / "dev2-07.csv", tmp_path / "run.csv",
+                             "speed_rpm", 0.0))
+    with pytest.raises(InputError) as info:
+        inputs(run, spec)
+    p = info.value.problem
+    assert p.field == "speed_rpm" and "standstill" in p.message, str(info.value)
+
+
+def test_the_standstill_median_skips_the_intervals_next_to_a_start_or_a_stop():
+    """An interval at standstill beside a running one may hold a ramp's power: only those
+    whose neighbours stand too count (here the 9 kW beside the start is left out)."""
+    from spindle.bench_inputs import standstill_power
+
+    speed = np.array([0.0, 0.0, 0.0, 0.0, 3000.0, 3000.0])
+    power = np.array([0.0, 0.0, 0.0, 9.0, 2.0, 2.0])
+    assert standstill_power(speed, power) == (0.0, 2)
+
+
+def test_a_column_copied_into_another_is_refused(tmp_path):
+    """dev-06 with P1 pasted into T_stator (plus 20, so that it looks like a temperature):
+    two sensors never differ by one constant, so read_bench refuses it naming both columns
+    (fuzzing round 4 had fitted it as "base adequate")."""
+    src = PEER_RUNS / "bench-runs" / "dev-06.csv"
+    lines = src.read_text(encoding="utf-8").splitlines()
+    out, head = [], None
+    for line in lines:
+        if line.startswith("#"):
+            out.append(line)
+            continue
+        cells = line.split(",")
+        if head is None:
+            head = cells
+        else:
+            p1 = cells[head.index("P1_um")]
+            cells[head.index("T_stator_C")] = f"{float(p1) + 20.0:.6g}" if p1 else ""
+        out.append(",".join(cells))
+    csv = tmp_path / "run.csv"
+    csv.write_text("\n".join(out) + "\n", encoding="utf-8")
+    with pytest.raises(InputError) as info:
+        read_bench(csv)
+    p = info.value.problem
+    assert "copy of the other" in p.message and "T_stator_C" in p.message
+    assert "P1_um" in p.message and "channel mapping" in p.fix
+
+
+def test_the_room_and_the_coolant_may_be_one_sensor(tmp_path):
+    """An air-cooled spindle's coolant is the room's air: a bench may export one sensor as
+    both T_env_C and T_coolant_C, and the copy check leaves that pair alone."""
+    lines = [row(i * 60.0, speed="4300", env=f"{20 + 0.01 * i:.2f}",
+                 cool=f"{20 + 0.01 * i:.2f}", t2=f"{21.5 + 0.013 * i:.3f}",
+                 ts=f"{30 + 0.02 * i:.2f}", p1=f"{1.0 + 0.015 * i:.3f}") for i in range(61)]
+    run = read_bench(write(tmp_path, lines))
+    assert np.array_equal(run.columns["T_env_C"], run.columns["T_coolant_C"])

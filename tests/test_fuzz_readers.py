@@ -31,7 +31,7 @@ def _bench_text(n: int = 240) -> str:
         n_rpm = 0.0 if t < 600 else 3000.0
         warm = 0.0 if t < 600 else 1.0 - np.exp(-(t - 600) / 900)
         rows.append(f"{t:g},{n_rpm:g},{0.4 * (n_rpm > 0):.3f},20.0,19.8,{20 + 3 * warm:.2f},"
-                    f"{20 + 2 * warm:.2f},{20 + 4 * warm:.2f},{2 * warm:.2f}")
+                    f"{20 + 2 * warm:.2f},{20 + 4 * warm:.2f},{1.5 * warm:.2f}")
     return head + "\n".join(rows) + "\n"
 
 

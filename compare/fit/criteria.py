@@ -67,6 +67,8 @@ class Criteria:
     scan_null_tail: int
     competitor_masses: tuple[str, ...]
     speed_bin_rel: float
+    # input check
+    growth_unit_gain: float
     # base model
     at_bound_rel: float
     missing_path_W_K: float
