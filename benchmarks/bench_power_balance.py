@@ -28,11 +28,13 @@ from figures import ROOT, write_figures
 
 
 def growth_gain(run, raw, spec, drive) -> float | None:
-    """P1's gain on the growth the spec's own model predicts (compare.fit.growth_check), on
-    the fit's grid and inputs before gap switches are placed."""
+    """P1's gain on the growth the spec's own model predicts, beside the library's
+    instantaneous terms (compare.fit.growth_check), on the fit's grid and inputs before gap
+    switches are placed."""
     from compare.fit.criteria import Criteria
     from compare.fit.greybox import GreyBox
     from compare.fit.growth_check import growth_gain as gain_of
+    from compare.fit.growth_check import library_terms
     from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, default_theta
     from spindle.bench_inputs import logging_step_s, resample
 
@@ -42,7 +44,7 @@ def growth_gain(run, raw, spec, drive) -> float | None:
     measured = resample(t, y, raw.grid_s, Criteria().gap_min_steps, logging_step_s(run.time_s))
     gb = GreyBox(spec, drive, raw, 11, base_extra=tuple(DEFAULT_BASE_EXTRA))
     theta = default_theta(gb.parameters(), [*BASE_PARAMS, *DEFAULT_BASE_EXTRA])
-    found = gain_of(measured, gb.simulate(theta)["P1"])
+    found = gain_of(measured, gb.simulate(theta)["P1"], library_terms(raw))
     return None if found is None else found[0]
 
 

@@ -396,7 +396,8 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
             "times its spec's draws at most that: the speeds are too low for the power",
             "export speed_rpm in rpm (a speed in rad/s is 9.55 times too small, in Hz 60 "
             "times); if the spindle worked against a load, add the load_torque_Nm column the "
-            "bench logged (docs/bench.md)")
+            "bench logged (docs/bench.md); if both are right, check that the spec's "
+            "[power_balance] preset is this spindle's drive")
     rated = rated_torque_Nm(drive)
     P_still, n_still = standstill_power(speed_rpm, power_kW)
     if rated is not None and P_still > 0:

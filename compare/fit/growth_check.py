@@ -5,7 +5,9 @@ to within the calibration's freedom (a factor of about two: alpha_eff's prior). 
 whose gain on that prediction is negative, or a thousand times off, is a column the fit
 cannot represent: a sign flipped in the export, or a growth in nm or mm. :func:`check_growth`
 regresses P1 on the prediction (with an offset: P1 is zeroed at the run's start, the model
-at its own), weighs the gain's standard error by the residual's autocorrelation
+at its own; and beside the library's instantaneous P1 terms, the speed squared and the
+room's temperature, so that a strong centrifugal shortening is not read as a sign), weighs
+the gain's standard error by the residual's autocorrelation
 (compare.residuals.effective_samples) and refuses a gain whose interval at the fit's alpha
 lies below zero, or beyond Criteria.growth_unit_gain either way.
 """
@@ -21,33 +23,53 @@ from spindle.errors import InputError
 from spindle.tolerances import channel_tolerance
 
 
-def growth_gain(measured_m: np.ndarray, predicted_m: np.ndarray) -> tuple[float, float] | None:
+def library_terms(inputs) -> list[np.ndarray]:
+    """The library's instantaneous P1 terms at the grid points of ``inputs``
+    (spindle.bench_inputs.Inputs): the speed squared [rpm^2] (a centrifugal shortening) and
+    the room's temperature [K] (a fixture's expansion), each the value of the interval that
+    ends at the point."""
+    k = np.maximum(np.arange(len(inputs.grid_s)) - 1, 0)
+    return [np.asarray(inputs.speed_rpm, dtype=float)[k] ** 2,
+            np.asarray(inputs.T_env_K, dtype=float)[k]]
+
+
+def growth_gain(measured_m: np.ndarray, predicted_m: np.ndarray,
+                terms: list[np.ndarray] = ()) -> tuple[float, float] | None:
     """(gain, standard error) of P1 [m] on the model's P1 [m] over the grid points where both
-    are finite, the error inflated by n / n_eff for the residual's autocorrelation. None where
-    the prediction moves by less than P1's tolerance (the spec predicts too little growth
-    to tell a unit) or fewer than ten points are measured."""
+    are finite, fitted with an offset and the further ``terms`` (:func:`library_terms`: a
+    centrifugal shortening or a fixture's growth takes its own share, not the growth's), the
+    error inflated by n / n_eff for the residual's autocorrelation. None where the prediction
+    moves by less than P1's tolerance (the spec predicts too little growth to tell a unit) or
+    fewer than ten points are measured."""
     y, m = np.asarray(measured_m, dtype=float), np.asarray(predicted_m, dtype=float)
+    extra = [np.asarray(t, dtype=float) for t in terms]
     ok = np.isfinite(y) & np.isfinite(m)
+    for t in extra:
+        ok &= np.isfinite(t)
     y, m = y[ok], m[ok]
     if len(y) < 10 or np.ptp(m) < channel_tolerance("P1"):
         return None
-    dm = m - m.mean()
-    sxx = float(dm @ dm)
-    gain = float(dm @ (y - y.mean())) / sxx
-    e = y - y.mean() - gain * dm
-    n = len(e)
-    n_eff = max(effective_samples({"P1": e}), 3.0)
-    s2 = float(e @ e) / max(n - 2, 1) * (n / n_eff)
-    return gain, math.sqrt(s2 / sxx)
+    cols = [m] + [t[ok] for t in extra if np.ptp(t[ok]) > 0]
+    X = np.column_stack([np.ones(len(y))] + [(c - c.mean()) / np.ptp(c) for c in cols])
+    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+    e = y - X @ coef
+    n, p = X.shape
+    n_eff = max(effective_samples({"P1": e}), p + 1.0)
+    s2 = float(e @ e) / max(n - p, 1) * (n / n_eff)
+    cov = s2 * np.linalg.pinv(X.T @ X)
+    scale = np.ptp(m)  # the gain's column was divided by it
+    return float(coef[1]) / scale, math.sqrt(max(float(cov[1, 1]), 0.0)) / scale
 
 
-def check_growth(path: str, measured_m: np.ndarray, predicted_m: np.ndarray, criteria) -> None:
+def check_growth(path: str, measured_m: np.ndarray, predicted_m: np.ndarray, criteria,
+                 terms: list[np.ndarray] = ()) -> None:
     """Refuse (InputError on ``path``'s P1_um) a P1 [m] whose gain on the spec's predicted
-    P1 [m] is negative, or beyond ``criteria.growth_unit_gain`` either way, by more than its
-    interval at ``criteria.alpha`` (module docstring)."""
+    P1 [m] (beside ``terms``: :func:`growth_gain`) is negative, or beyond
+    ``criteria.growth_unit_gain`` either way, by more than its interval at ``criteria.alpha``
+    (module docstring)."""
     from scipy.stats import norm
 
-    found = growth_gain(measured_m, predicted_m)
+    found = growth_gain(measured_m, predicted_m, terms)
     if found is None:
         return
     gain, se = found

@@ -28,7 +28,7 @@ from compare.fit.effects import LIBRARY
 from compare.fit.effects import candidates as candidate_labels
 from compare.fit.gaps import unknown_input_spans
 from compare.fit.greybox import GreyBox
-from compare.fit.growth_check import check_growth
+from compare.fit.growth_check import check_growth, library_terms
 from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, default_theta
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
@@ -128,7 +128,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
     if "P1" in channels:  # a sign or unit slip the fit could not represent
         check_growth(str(run.path), measured.values["P1"],
-                     cal.gb.simulate(spec_values)["P1"], criteria)
+                     cal.gb.simulate(spec_values)["P1"], criteria, library_terms(inputs))
 
     def anchored(cal: Calibrator, start: dict[str, float]) -> tuple[object, Fit]:
         """The FEM anchor on ``cal``'s inputs, set on its grey box, and the base calibrated
