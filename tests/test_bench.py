@@ -570,13 +570,19 @@ def test_the_no_load_bound_is_the_drives_losses_at_its_rated_torque(tmp_path, sp
     # bound: the median rule (3 times the no-load losses) lets a few intervals through,
     # the loss bound judges each one
     usual_kW = no_load_W(4300.0) / 1e3
-    for factor, refused in ((0.99, False), (1.01, True)):
-        lines = [row(i * 60.0, speed="4300",
-                     power=f"{(factor * limit_kW if 20 <= i < 30 else usual_kW):.6f}")
+    _hour_at_4300(tmp_path, spec, lambda f, i: f * limit_kW if 20 <= i < 30 else usual_kW,
+                  ((0.99, False), (1.01, True)), "load_torque_Nm")
+
+
+def _hour_at_4300(tmp_path, spec, power_kW, cases, field: str) -> None:
+    """For each (factor, refused) of ``cases``, an hour at 4300 rpm without a load whose
+    interval i draws ``power_kW(factor, i)`` [kW]: refused naming ``field``, or read."""
+    for factor, refused in cases:
+        lines = [row(i * 60.0, speed="4300", power=f"{power_kW(factor, i):.6f}")
                  for i in range(61)]
         run = read_bench(write(tmp_path, lines, name=f"run-{factor}.csv"))
         if refused:
-            with pytest.raises(InputError, match="load_torque_Nm"):
+            with pytest.raises(InputError, match=field):
                 inputs(run, spec)
         else:
             inputs(run, spec)
@@ -589,15 +595,8 @@ def test_the_no_load_median_bound_is_three_times_the_drives_no_load_losses(tmp_p
     drive = drive_for(spec)
     no_load_kW = power_balance(drive.motor, drive.bearings, 4300.0, 0.0,
                                drive.T_winding_K).total_heat_W / 1e3
-    for factor, refused in ((2.9, False), (3.1, True)):
-        lines = [row(i * 60.0, speed="4300", power=f"{factor * no_load_kW:.6f}")
-                 for i in range(61)]
-        run = read_bench(write(tmp_path, lines, name=f"run-{factor}.csv"))
-        if refused:
-            with pytest.raises(InputError, match="speed_rpm"):
-                inputs(run, spec)
-        else:
-            inputs(run, spec)
+    _hour_at_4300(tmp_path, spec, lambda f, i: f * no_load_kW, ((2.9, False), (3.1, True)),
+                  "speed_rpm")
 
 
 def test_every_peer_run_keeps_the_power_balance():
@@ -608,15 +607,7 @@ def test_every_peer_run_keeps_the_power_balance():
     load takes a median 0.93-0.94 of the power, and read as if without a load they draw
     4.6-5.5 times the bound. Without a load, 21 of them draw a median 0.24-0.42 times the
     drive's no-load losses (bound 3), and at standstill none draws a watt."""
-    from spindle.bench_inputs import (
-        check_power_balance,
-        friction_share,
-        interval_inputs,
-        load_efficiency,
-        loss_excess,
-        no_load_share,
-        standstill_power,
-    )
+    import spindle.bench_inputs as bi
 
     spec = load_spec("spl2782")
     drive = drive_for(spec)
@@ -625,21 +616,21 @@ def test_every_peer_run_keeps_the_power_balance():
                                        "friction": [], "no_load": [], "standstill": []}
     for path in runs:
         run = read_bench(path)
-        raw = interval_inputs(run)
+        raw = bi.interval_inputs(run)
         n, P, M = raw.speed_rpm, raw.power_kW, raw.load_torque_Nm
-        check_power_balance(run, drive, raw.grid_s, n, P, M)
-        share = no_load_share(drive, n, P, M)[0]
+        bi.check_power_balance(run, drive, raw.grid_s, n, P, M)
+        share = bi.no_load_share(drive, n, P, M)[0]
         if np.isfinite(share):
             figures["no_load"].append(share)
-        figures["standstill"].append(abs(standstill_power(n, P)[0]))
-        ratio = loss_excess(drive, n, P, M).ratio
+        figures["standstill"].append(abs(bi.standstill_power(n, P)[0]))
+        ratio = bi.loss_excess(drive, n, P, M).ratio
         if not run.load_torque_measured:
             figures["no_torque"].append(ratio)
-            figures["friction"].append(friction_share(drive, n, P))
+            figures["friction"].append(bi.friction_share(drive, n, P))
             continue
         figures["loaded"].append(ratio)
-        figures["without"].append(loss_excess(drive, n, P, 0.0 * M).ratio)
-        figures["eta"].append(load_efficiency(n, P, M)[0])
+        figures["without"].append(bi.loss_excess(drive, n, P, 0.0 * M).ratio)
+        figures["eta"].append(bi.load_efficiency(n, P, M)[0])
     assert len(figures["no_torque"]) == 17 and len(figures["loaded"]) == 6
     for key, lo, hi in (("no_torque", 0.065, 0.145), ("loaded", 0.295, 0.345),
                         ("without", 4.6, 5.55), ("eta", 0.925, 0.945),
@@ -648,10 +639,11 @@ def test_every_peer_run_keeps_the_power_balance():
         assert lo <= min(figures[key]) and max(figures[key]) <= hi, (key, figures[key])
 
 
-def _edited(src: Path, dst: Path, column: str, factor: float = 1.0, swap: str | None = None
-            ) -> Path:
+def _edited(src: Path, dst: Path, column: str, factor: float = 1.0, swap: str | None = None,
+            copy_of: str | None = None, plus: float = 0.0) -> Path:
     """The peer's run ``src`` with ``column`` times ``factor``, or swapped with ``swap`` (its
-    header names exchanged): an export with a unit slip or a mislabelled column."""
+    header names exchanged), or replaced by the column ``copy_of`` plus ``plus``: an export
+    with a unit slip, a mislabelled column or one channel mapped twice."""
     lines = src.read_text(encoding="utf-8").splitlines()
     out, head = [], None
     for line in lines:
@@ -667,7 +659,10 @@ def _edited(src: Path, dst: Path, column: str, factor: float = 1.0, swap: str | 
             out.append(",".join(cells))
             continue
         k = head.index(column)
-        if cells[k] and factor != 1.0:
+        if copy_of:
+            v = cells[head.index(copy_of)]
+            cells[k] = f"{float(v) + plus:.6g}" if v else ""
+        elif cells[k] and factor != 1.0:
             cells[k] = f"{float(cells[k]) * factor:.6g}"
         out.append(",".join(cells))
     dst.write_text("\n".join(out) + "\n", encoding="utf-8")
@@ -846,22 +841,8 @@ def test_a_column_copied_into_another_is_refused(tmp_path):
     """dev-06 with P1 pasted into T_stator (plus 20, so that it looks like a temperature):
     two sensors never differ by one constant, so read_bench refuses it naming both columns
     (fuzzing round 4 had fitted it as "base adequate")."""
-    src = PEER_RUNS / "bench-runs" / "dev-06.csv"
-    lines = src.read_text(encoding="utf-8").splitlines()
-    out, head = [], None
-    for line in lines:
-        if line.startswith("#"):
-            out.append(line)
-            continue
-        cells = line.split(",")
-        if head is None:
-            head = cells
-        else:
-            p1 = cells[head.index("P1_um")]
-            cells[head.index("T_stator_C")] = f"{float(p1) + 20.0:.6g}" if p1 else ""
-        out.append(",".join(cells))
-    csv = tmp_path / "run.csv"
-    csv.write_text("\n".join(out) + "\n", encoding="utf-8")
+    csv = _edited(PEER_RUNS / "bench-runs" / "dev-06.csv", tmp_path / "run.csv", "T_stator_C",
+                  copy_of="P1_um", plus=20.0)
     with pytest.raises(InputError) as info:
         read_bench(csv)
     p = info.value.problem
