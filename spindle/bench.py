@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from spindle.errors import InputError
-from spindle.sensor_copies import check_not_copies
+from spindle.sensor_faults import check_not_copies
 from spindle.spec import Spec
 from spindle.units import CYCLE_MAX_S, POWER_MAX_KW, SPEED_MAX_RPM, TORQUE_MAX_NM, ZERO_C_K
 

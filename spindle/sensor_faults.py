@@ -1,10 +1,17 @@
-"""Two sensor columns of a bench run that are one column twice (spindle.bench.read_bench)."""
+"""A bench run's sensor columns that cannot be what a sensor read.
+
+- :func:`check_not_copies`: two columns that are one column twice (spindle.bench.read_bench
+  refuses the run);
+- :func:`spike_rows`: single samples that leave both neighbours and come back (compare.fit
+  leaves them out with a warning).
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
 import numpy as np
+from scipy.stats import norm
 
 from spindle.errors import InputError
 
@@ -48,3 +55,28 @@ def check_not_copies(columns: dict[str, np.ndarray],
                             "of the other",
                             "export each sensor's own column (check the export's channel "
                             "mapping)")
+
+
+def spike_rows(time_s: np.ndarray, y: np.ndarray, tolerance: float, alpha: float,
+               within_s: float) -> np.ndarray:
+    """Indices into ``y`` (one channel's column, NaN where not logged; ``time_s`` [s] its
+    rows' times) of single-sample spikes: a valid sample whose logged neighbours both lie
+    within ``within_s`` [s] of it (the model's grid step: a fit follows nothing faster), and
+    that departs from both, in the same direction, by more than both the channel's
+    ``tolerance`` (in its unit: a smaller excursion cannot move a verdict judged in
+    tolerances) and the largest step its noise makes among all the samples at level
+    ``alpha`` (the noise from the median absolute first difference, Bonferroni over the
+    samples). A thermal reading cannot leave its neighbours and return that fast; an
+    electrical spike can. A log sparser than ``within_s`` is not judged."""
+    valid = np.flatnonzero(~np.isnan(y))
+    v, t = y[valid], np.asarray(time_s, dtype=float)[valid]
+    if len(v) < 10:
+        return np.zeros(0, dtype=int)
+    d = np.diff(v)
+    noise_step = 1.4826 * float(np.median(np.abs(d - np.median(d))))
+    bound = max(float(norm.isf(alpha / (2 * len(v)))) * noise_step, tolerance)
+    up, down = d[:-1], -d[1:]
+    dt = np.diff(t)
+    close = (dt[:-1] <= within_s) & (dt[1:] <= within_s)
+    hit = close & (np.sign(up) == np.sign(down)) & (np.minimum(np.abs(up), np.abs(down)) > bound)
+    return valid[np.flatnonzero(hit) + 1]
