@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from spindle.errors import InputError
-from spindle.sensor_faults import check_not_copies
+from spindle.sensor_faults import check_not_copies, check_room_in_celsius
 from spindle.spec import Spec
 from spindle.units import CYCLE_MAX_S, POWER_MAX_KW, SPEED_MAX_RPM, TORQUE_MAX_NM, ZERO_C_K
 
@@ -348,6 +348,7 @@ def read_bench(path: str | Path) -> BenchRun:
     t = _read_time(table, seen["time_s"], error)
     columns = _read_known_columns(table, seen, error, name)
     _check_plausible(columns, line_no, error)
+    check_room_in_celsius(columns, line_no, error)
     extra = _read_unknown_columns(table, header)
     unknown = list(extra)
     for h in unknown:

@@ -292,6 +292,35 @@ def friction_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray) ->
     return float(np.median(shares)) if shares else float("nan")
 
 
+def below_friction_stretch(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
+                           load_torque_Nm: np.ndarray, loaded_Nm: float = LOAD_CELL_ZERO_NM
+                           ) -> tuple[int, int]:
+    """(first interval, length) of the longest stretch of consecutive running intervals
+    without a load (torque [N m] at most ``loaded_Nm``) whose power [kW] lies below the
+    bearings' friction at the speed [rpm] with their factors divided by
+    :data:`PALMGREN_SPREAD`. A speed step inside an interval can put it and its neighbour
+    there (the interval's speed is its middle's); three in a row cannot be a step: the
+    spindle did not turn at the speed the log holds. (0, 0) without one."""
+    low = {k: replace(b, f0=b.f0 / PALMGREN_SPREAD) for k, b in drive.bearings.items()}
+    cache: dict[int, float] = {}
+    best = (0, 0)
+    start = None
+    for i, (n, P, M) in enumerate(zip(speed_rpm, power_kW, load_torque_Nm, strict=True)):
+        below = False
+        if n >= STANDSTILL_RPM and abs(M) <= loaded_Nm and math.isfinite(P):
+            key = round(float(n))
+            if key not in cache:
+                cache[key] = sum(bearing_friction(b, float(key)).heat_W for b in low.values())
+            below = P * 1e3 < cache[key]
+        if below and start is None:
+            start = i
+        if not below:
+            start = None
+        elif i - start + 1 > best[1]:
+            best = (start, i - start + 1)
+    return best
+
+
 def no_load_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
                   load_torque_Nm: np.ndarray, loaded_Nm: float = LOAD_CELL_ZERO_NM
                   ) -> tuple[float, int]:
@@ -358,7 +387,9 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
       losses at the logged speed (:func:`no_load_share`): a speed in rad/s or Hz, or a load
       the run does not give;
     - at standstill, a median power above the drive's losses holding its rated torque
-      (:func:`standstill_power`): the spindle turned where the speed says it stood.
+      (:func:`standstill_power`): the spindle turned where the speed says it stood;
+    - three or more running intervals in a row without a load below the friction floor
+      (:func:`below_friction_stretch`): the spindle stood where the speed says it turned.
 
     The margins on runs this project did not make: docs/bench.md. InputError naming the
     column and the largest excess."""
@@ -386,6 +417,18 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
     ex = loss_excess(drive, speed_rpm, power_kW, load_torque_Nm)
     if ex is not None and ex.over > 0:
         _refuse_loss_excess(run, drive, grid_s, speed_rpm, power_kW, load_torque_Nm, ex)
+    first, length = below_friction_stretch(drive, speed_rpm, power_kW, load_torque_Nm,
+                                           loaded_Nm)
+    if length >= 3:
+        raise InputError(
+            path, "speed_rpm",
+            f"from t = {grid_s[first] / 3600:.2f} h for {length} intervals "
+            f"({length * float(np.median(np.diff(grid_s))) / 3600:.2f} h) the spindle draws "
+            "less than its bearings' friction alone at a third of the spec's friction factor "
+            f"while speed_rpm holds {float(speed_rpm[first]):.0f} rpm: it did not turn at the "
+            "speed the log holds",
+            "export the speed the bench logged in that stretch (a log on change still writes "
+            "the speed when it changes, and a heartbeat), or leave those rows out")
     share, n_free = no_load_share(drive, speed_rpm, power_kW, load_torque_Nm, loaded_Nm)
     if share > PALMGREN_SPREAD:
         raise InputError(

@@ -3,7 +3,9 @@
 - :func:`check_not_copies`: two columns that are one column twice (spindle.bench.read_bench
   refuses the run);
 - :func:`spike_rows`: single samples that leave both neighbours and come back (compare.fit
-  leaves them out with a warning).
+  leaves them out with a warning);
+- :func:`check_room_in_celsius`: a room far warmer than a machine tool may run in, as the
+  room's reading in °F is (read_bench refuses the run).
 """
 
 from __future__ import annotations
@@ -25,6 +27,9 @@ BOUNDARY_COLUMNS = ("T_env_C", "T_coolant_C")
 COPY_REL = 1e-9
 #: rows both columns must log before they can be said to be copies
 COPY_MIN_ROWS = 10
+#: a machine tool's electrical equipment works in a room of +5 to +40 °C (IEC 60204-1,
+#: 4.4.3); a room whose median is above this, with a margin, is not in °C: 20 °C is 68 °F
+ROOM_MAX_C = 50.0
 
 
 def check_not_copies(columns: dict[str, np.ndarray],
@@ -80,3 +85,20 @@ def spike_rows(time_s: np.ndarray, y: np.ndarray, tolerance: float, alpha: float
     close = (dt[:-1] <= within_s) & (dt[1:] <= within_s)
     hit = close & (np.sign(up) == np.sign(down)) & (np.minimum(np.abs(up), np.abs(down)) > bound)
     return valid[np.flatnonzero(hit) + 1]
+
+
+def check_room_in_celsius(columns: dict[str, np.ndarray], line_no: np.ndarray,
+                          error: Callable[[str, str, str], InputError]) -> None:
+    """Refuse a room temperature (T_env_C, °C) whose median is above :data:`ROOM_MAX_C`:
+    no machine tool runs there, and a room in °F reads 60-80. ``line_no``: each row's file
+    line; ``error(field, message, fix)`` makes the InputError."""
+    y = columns.get("T_env_C")
+    if y is None or np.isnan(y).all():
+        return
+    med = float(np.nanmedian(y))
+    if med > ROOM_MAX_C:
+        line = int(line_no[np.flatnonzero(y > ROOM_MAX_C)[0]])
+        raise error(f"T_env_C (line {line})", f"the room's median is {med:g} °C, above the "
+                    f"{ROOM_MAX_C:g} °C no machine tool runs in (IEC 60204-1: +5 to +40 °C): "
+                    "it looks like °F", "export °C (°C = (°F - 32) / 1.8) in every temperature "
+                    "column")

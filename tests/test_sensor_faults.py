@@ -78,3 +78,23 @@ def test_fit_leaves_spikes_out_and_says_so(tmp_path):
     T1 = ("validation", "T1", "rmse")
     before = base["error_before"][T1[0]][T1[1]][T1[2]]
     assert doc["error_before"][T1[0]][T1[1]][T1[2]] == pytest.approx(before, abs=0.05)
+
+
+def test_a_room_in_fahrenheit_is_refused(tmp_path):
+    """dev-06 with every temperature in °F under its _C name (fuzzing round 5 had fitted it
+    as "unexplained"): its room's median is 68-72, above the 50 °C no machine tool runs in
+    (IEC 60204-1 specifies +5 to +40 °C). A warm shop at 38 °C is read."""
+    from spindle.bench import read_bench
+    from spindle.errors import InputError
+    from tests.test_bench import _edited
+
+    src = PEER_RUNS / "bench-runs" / "dev-06.csv"
+    csv = src
+    for k, col in enumerate(("T_env_C", "T_coolant_C", "T1_C", "T2_C", "T_stator_C")):
+        csv = _edited(csv, tmp_path / f"f{k}.csv", col, 1.8)
+        csv = _edited(csv, tmp_path / f"g{k}.csv", col, copy_of=col, plus=32.0)
+    with pytest.raises(InputError) as info:
+        read_bench(csv)
+    assert info.value.problem.field.startswith("T_env_C") and "°F" in info.value.problem.message
+    warm = _edited(src, tmp_path / "warm.csv", "T_env_C", copy_of="T_env_C", plus=16.0)
+    read_bench(warm)

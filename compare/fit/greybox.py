@@ -60,11 +60,16 @@ class GreyBox:
     #: speed rounded to a geometric grid of this relative step (0: exactly); the heat
     #: sources always at the exact speed (compare.fit.criteria.Criteria.speed_bin_rel)
     speed_bin_rel: float = 0.0
+    #: the time [s] the P1 column was zeroed at (its first valid sample, the format's
+    #: reference) where it is later than the grid's first interval: P1 is then the growth
+    #: since that time, not since the run's start (None: since the start)
+    p1_reference_s: float | None = None
 
     def variant(self, effects: tuple[str, ...]) -> GreyBox:
         """The same model with another effect set (sharing caches and discrepancy)."""
         return GreyBox(self.spec, self.drive, self.inputs, self.nodes, tuple(effects),
-                       self._cache, self.discrepancy, self.base_extra, self.speed_bin_rel)
+                       self._cache, self.discrepancy, self.base_extra, self.speed_bin_rel,
+                       self.p1_reference_s)
 
     def plain(self) -> GreyBox:
         """The spec's lumped model on the same inputs: no effects, no base extras, no
@@ -371,6 +376,8 @@ class GreyBox:
                 out[c] = out[c] + d
         for e, channel in effects:
             out = e.as_measured(out, th, inp, channel)
+        if "P1" in out and self.p1_reference_s is not None:
+            out["P1"] = out["P1"] - np.interp(self.p1_reference_s, inp.grid_s, out["P1"])
         return out
 
 

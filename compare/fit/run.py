@@ -122,9 +122,12 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     inputs, switches = _place_gap_switches(run, spec, drive, raw, measured, channels, nodes,
                                            base_extra, say, criteria)
 
+    p1_reference = _late_p1_reference(run, channels, raw.grid_s)
+
     def calibrator(on: Inputs) -> Calibrator:
         return Calibrator(GreyBox(spec, drive, on, nodes, base_extra=base_extra,
-                                  speed_bin_rel=criteria.speed_bin_rel), measured,
+                                  speed_bin_rel=criteria.speed_bin_rel,
+                                  p1_reference_s=p1_reference), measured,
                           channels, progress=say, tol=criteria.optimizer_tol, workers=workers)
 
     cal = calibrator(inputs)
@@ -168,6 +171,17 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                 anchor, base = anchored(cal, base.theta)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
                            switches, placed_by, left_out)
+
+
+def _late_p1_reference(run: BenchRun, channels: list[str], grid_s: np.ndarray
+                       ) -> float | None:
+    """The time [s] of P1's first valid sample, where the format zeroes it, if that is after
+    the grid's first interval (a sensor connected late: the model's growth must then be
+    counted from there too); else None."""
+    if "P1" not in channels:
+        return None
+    t1 = float(run.channel("P1")[0][0])
+    return t1 if t1 > float(grid_s[1]) else None
 
 
 def _without_stuck(run: BenchRun, channels: list[str]) -> list[str]:
