@@ -54,11 +54,13 @@ def measure(paths: list[Path]) -> dict[str, list[float]]:
     ratio of runs with one), "loaded_without_torque" (the same runs' ratio with the torque
     taken as 0) and "efficiency" (their median M omega / P_el); of every run,
     "no_load_share" (the median power without a load against the drive's no-load losses),
-    "standstill_kW" (the median power at standstill) and "growth_gain" (P1 on the spec's
-    predicted growth)."""
+    "standstill_kW" (the median power at standstill), "growth_gain" (P1 on the spec's
+    predicted growth) and "below_friction_run" (the most running intervals in a row below
+    the friction floor)."""
     from spindle import load_spec
     from spindle.bench import read_bench
     from spindle.bench_inputs import (
+        below_friction_stretch,
         friction_share,
         interval_inputs,
         load_efficiency,
@@ -72,7 +74,8 @@ def measure(paths: list[Path]) -> dict[str, list[float]]:
     drive = drive_for(spec)
     out: dict[str, list[float]] = {"no_torque": [], "friction_share": [], "loaded": [],
                                    "loaded_without_torque": [], "efficiency": [],
-                                   "no_load_share": [], "standstill_kW": [], "growth_gain": []}
+                                   "no_load_share": [], "standstill_kW": [], "growth_gain": [],
+                                   "below_friction_run": []}
     for i, path in enumerate(paths, 1):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -81,7 +84,10 @@ def measure(paths: list[Path]) -> dict[str, list[float]]:
         share = no_load_share(drive, raw.speed_rpm, raw.power_kW, raw.load_torque_Nm)[0]
         still = standstill_power(raw.speed_rpm, raw.power_kW)[0]
         gain = growth_gain(run, raw, spec, drive)
-        for key, v in (("no_load_share", share), ("standstill_kW", still), ("growth_gain", gain)):
+        stretch = below_friction_stretch(drive, raw.speed_rpm, raw.power_kW,
+                                         raw.load_torque_Nm)[1]
+        for key, v in (("no_load_share", share), ("standstill_kW", still), ("growth_gain", gain),
+                       ("below_friction_run", stretch)):
             if v is not None and np.isfinite(v):
                 out[key].append(v)
         ex = loss_excess(drive, raw.speed_rpm, raw.power_kW, raw.load_torque_Nm)

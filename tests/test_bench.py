@@ -612,14 +612,16 @@ def test_every_peer_run_keeps_the_power_balance():
     third of its factor; the 6 loaded ones lose 0.30-0.34 of theirs, their
     load takes a median 0.93-0.94 of the power, and read as if without a load they draw
     4.6-5.5 times the bound. Without a load, 21 of them draw a median 0.24-0.42 times the
-    drive's no-load losses (bound 3), and at standstill none draws a watt."""
+    drive's no-load losses (bound 3), at standstill none draws a watt, and none has more
+    than one running interval in a row below the friction floor (bound 3)."""
     import spindle.bench_inputs as bi
 
     spec = load_spec("spl2782")
     drive = drive_for(spec)
     runs = sorted(PEER_RUNS.glob("bench-runs*/*.csv"))
     figures: dict[str, list[float]] = {"no_torque": [], "loaded": [], "without": [], "eta": [],
-                                       "friction": [], "no_load": [], "standstill": []}
+                                       "friction": [], "no_load": [], "standstill": [],
+                                       "stretch": []}
     for path in runs:
         run = read_bench(path)
         raw = bi.interval_inputs(run)
@@ -629,6 +631,7 @@ def test_every_peer_run_keeps_the_power_balance():
         if np.isfinite(share):
             figures["no_load"].append(share)
         figures["standstill"].append(abs(bi.standstill_power(n, P)[0]))
+        figures["stretch"].append(bi.below_friction_stretch(drive, n, P, M)[1])
         ratio = bi.loss_excess(drive, n, P, M).ratio
         if not run.load_torque_measured:
             figures["no_torque"].append(ratio)
@@ -641,7 +644,7 @@ def test_every_peer_run_keeps_the_power_balance():
     for key, lo, hi in (("no_torque", 0.065, 0.145), ("loaded", 0.295, 0.345),
                         ("without", 4.6, 5.55), ("eta", 0.925, 0.945),
                         ("friction", 6.0, 10.5), ("no_load", 0.235, 0.425),
-                        ("standstill", 0.0, 0.001)):
+                        ("standstill", 0.0, 0.001), ("stretch", 0, 1)):
         assert lo <= min(figures[key]) and max(figures[key]) <= hi, (key, figures[key])
 
 

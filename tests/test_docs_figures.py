@@ -273,7 +273,9 @@ def power_balance_text(doc: dict) -> str:
                ("no_load_share", "median P_el / the drive's no-load losses, without a load",
                 "below 3"),
                ("standstill_kW", "median P_el at standstill [kW]", "below 4.03"),
-               ("growth_gain", "P1 / the spec's predicted growth", "0.0316 to 31.6"))
+               ("growth_gain", "P1 / the spec's predicted growth", "0.0316 to 31.6"),
+               ("below_friction_run", "running intervals in a row below the friction floor",
+                "below 3"))
     rows = [f"Measured {doc['date']} at commit {doc['commit']}. Each figure must stay within "
             "its bound; the rows read without torque show what the loss bound catches.", "",
             "| runs | figure | bound | runs | min | median | max |",
