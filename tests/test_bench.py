@@ -770,19 +770,19 @@ def test_a_sensor_that_reads_one_value_throughout_is_left_out_with_a_warning(tmp
     (fuzzing round 4). A sensor on a spindle shows at least its noise, so fit leaves such a
     channel out with a BenchWarning naming it; with every channel stuck, nothing is left to
     fit: InputError."""
-    from compare.fit.run import _without_stuck
     from spindle.bench import stuck_channels
+    from spindle.bench_clean import without_stuck
 
     lines = [row(i * 60.0, speed="4300" if i == 0 else "", t2=f"{21.5 + 0.01 * i:.2f}",
                  ts=f"{30 + 0.02 * i:.2f}", p1=f"{1.0 + 0.015 * i:.2f}") for i in range(61)]
     run = read_bench(write(tmp_path, lines))
     assert stuck_channels(run, run.channels) == ["T1"]
     with pytest.warns(BenchWarning, match="T1_C: reads 22 in each of its 61 samples.*left out"):
-        assert _without_stuck(run, run.channels) == ["T2", "T_stator", "P1"]
+        assert without_stuck(run, run.channels) == ["T2", "T_stator", "P1"]
     flat = read_bench(write(tmp_path, good_rows(), name="flat.csv"))
     with pytest.raises(InputError, match="every measured channel reads one value"):
         with pytest.warns(BenchWarning):
-            _without_stuck(flat, flat.channels)
+            without_stuck(flat, flat.channels)
 
 
 def test_a_stuck_channel_is_named_in_the_fits_report(tmp_path):

@@ -88,6 +88,51 @@ def test_a_strong_centrifugal_shortening_is_not_read_as_a_sign():
     check_growth("run.csv", y, m, Criteria(), [speed ** 2])
 
 
+def test_the_models_growth_counts_from_the_p1_reference():
+    """Two hours at 4000 rpm: with the P1 reference at 30 min, the model's P1 is its growth
+    since then (compare.fit.greybox.GreyBox.p1_reference_s), the same trajectory shifted
+    by its value there (exact: the reference lies on a grid point)."""
+    from compare.fit.greybox import GreyBox
+    from spindle.bench_inputs import Inputs
+    from spindle.drive import drive_for
+    from spindle.spec_reader import load_spec
+
+    spec = load_spec("spl2782")
+    grid = np.arange(0.0, 7200.0 + 1.0, 60.0)
+    n = len(grid) - 1
+    inputs = Inputs(grid, np.full(n, 4000.0), np.full(n, 2.0), np.zeros(n),
+                    np.full(n, 293.15), np.full(n, 293.15))
+    cold = GreyBox(spec, drive_for(spec), inputs).simulate({})["P1"]
+    late = GreyBox(spec, drive_for(spec), inputs, p1_reference_s=1800.0).simulate({})["P1"]
+    assert np.ptp(cold) > 1e-6  # it grows by micrometres
+    np.testing.assert_allclose(late, cold - cold[30], rtol=0, atol=1e-12)
+
+
+def test_the_p1_reference_is_its_first_sample_where_that_is_late(tmp_path):
+    """compare.fit.run._late_p1_reference: P1 logged from the first row has none (the
+    model's growth counts from the start); P1 first logged at 2 h has that time."""
+    from compare.fit.run import _late_p1_reference
+    from spindle.bench import read_bench
+
+    src = (PEER_RUNS / "bench-runs" / "dev-06.csv").read_text(encoding="utf-8").splitlines()
+    head = next(i for i, ln in enumerate(src) if ln.startswith("time_s"))
+    k = src[head].split(",").index("P1_um")
+    rows = [ln.split(",") for ln in src[head + 1:]]
+    for cells in rows:
+        if float(cells[0]) < 7200.0:
+            cells[k] = ""
+    late = tmp_path / "late.csv"
+    late.write_text("\n".join(src[:head + 1] + [",".join(c) for c in rows]) + "\n",
+                    encoding="utf-8")
+    grid = np.arange(0.0, 16 * 3600.0, 60.0)
+    full = read_bench(PEER_RUNS / "bench-runs" / "dev-06.csv")
+    assert _late_p1_reference(full, full.channels, grid) is None
+    run = read_bench(late)
+    t1 = _late_p1_reference(run, run.channels, grid)
+    assert t1 is not None and 7200.0 <= t1 < 7300.0
+
+
+@pytest.mark.slow  # ~10 s: the two tests above cover the reference's path
 def test_a_p1_sensor_connected_late_is_compared_from_its_first_sample(tmp_path):
     """The format zeroes P1 at its first valid sample. The peer's clean control dev-06 with
     P1 empty for the first 2 h is zeroed on a warm shaft, so the model's growth must be

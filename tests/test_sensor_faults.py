@@ -47,6 +47,33 @@ def test_what_the_rule_does_not_judge(size):
     assert len(spike_rows(t2, y2, 1.0, 0.01, 60.0)) == 0
 
 
+def test_spikes_are_left_out_of_the_run_and_said(tmp_path):
+    """spindle.bench_clean.without_spikes: the spiked samples become empty cells, the
+    others stay, and the BenchWarning and the report's line name the column and the count."""
+    from spindle.bench import read_bench
+    from spindle.bench_clean import without_spikes
+
+    src = (PEER_RUNS / "bench-runs" / "dev-06.csv").read_text(encoding="utf-8").splitlines()
+    head = next(i for i, ln in enumerate(src) if ln.startswith("time_s"))
+    k = src[head].split(",").index("T1_C")
+    rows = [ln.split(",") for ln in src[head + 1:head + 1 + 700]]
+    spiked = [i for i in (100, 300, 500) if rows[i][k]]
+    for i in spiked:
+        rows[i][k] = f"{float(rows[i][k]) + 50.0:.2f}"
+    path = tmp_path / "run.csv"
+    path.write_text("\n".join(src[:head + 1] + [",".join(c) for c in rows]) + "\n",
+                    encoding="utf-8")
+    run = read_bench(path)
+    with pytest.warns(BenchWarning, match=rf"T1_C: {len(spiked)} single-sample spikes"):
+        clean, said = without_spikes(run, run.channels, 0.01, 60.0)
+    y0, y1 = run.columns["T1_C"], clean.columns["T1_C"]
+    assert np.isnan(y1[spiked]).all() and not np.isnan(y0[spiked]).any()
+    others = np.setdiff1d(np.flatnonzero(~np.isnan(y0)), spiked)
+    assert np.array_equal(y1[others], y0[others])
+    assert len(said) == 1 and said[0].startswith("T1_C:")
+
+
+@pytest.mark.slow  # two fits: the test above and test_a_stuck_channel_is_named_in_the_fits_report
 def test_fit_leaves_spikes_out_and_says_so(tmp_path):
     """The peer's dev-06, its first 2 h, with eight +50 K spikes on T1 (fuzzing round 4: the
     whole run had been fitted as "unexplained", T1 off by 2.6 K): fit warns, its report says

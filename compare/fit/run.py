@@ -17,7 +17,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -35,11 +35,10 @@ from compare.fit.signatures import Context, EventTest
 from spindle.bench import (
     CHANNEL_COLUMNS,
     BenchRun,
-    BenchWarning,
     check_against_spec,
     read_bench,
-    stuck_channels,
 )
+from spindle.bench_clean import without_spikes, without_stuck
 from spindle.bench_inputs import (
     Inputs,
     check_power_balance,
@@ -52,7 +51,6 @@ from spindle.drive import drive_for
 from spindle.errors import InputError, SolverError
 from spindle.results import check_plausible
 from spindle.spec import Spec
-from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
 
 
 def _check_base_extra(base_extra: tuple[str, ...]) -> None:
@@ -106,10 +104,10 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         warnings.simplefilter("ignore")
         channels = check_against_spec(run, spec)
     measured_channels = list(channels)
-    channels = _without_stuck(run, channels)
+    channels = without_stuck(run, channels)
     left_out = [f"{CHANNEL_COLUMNS[c]} reads one value in every row (a stuck or disconnected "
                 "sensor) and is left out" for c in measured_channels if c not in channels]
-    run, spikes = _without_spikes(run, channels, criteria.alpha, grid_s)
+    run, spikes = without_spikes(run, channels, criteria.alpha, grid_s)
     left_out += spikes
     drive = drive_for(spec)
     if drive is None:
@@ -182,60 +180,6 @@ def _late_p1_reference(run: BenchRun, channels: list[str], grid_s: np.ndarray
         return None
     t1 = float(run.channel("P1")[0][0])
     return t1 if t1 > float(grid_s[1]) else None
-
-
-def _without_stuck(run: BenchRun, channels: list[str]) -> list[str]:
-    """``channels`` less those whose sensor reads one value throughout
-    (spindle.bench.stuck_channels), each left out with a BenchWarning; InputError where
-    none is left."""
-    stuck = stuck_channels(run, channels)
-    for c in stuck:
-        col = CHANNEL_COLUMNS[c]
-        y = run.columns[col]
-        warnings.warn(BenchWarning(
-            f"{run.path}: {col}: reads {float(y[~np.isnan(y)][0]):g} in each of its "
-            f"{int(np.sum(~np.isnan(y)))} samples: a sensor on a spindle shows at least its "
-            "noise, so it is stuck or not connected; the channel is left out (fix: check the "
-            "sensor, or drop the column)"), stacklevel=3)
-    kept = [c for c in channels if c not in stuck]
-    if not kept:
-        raise InputError(str(run.path), ", ".join(CHANNEL_COLUMNS[c] for c in channels),
-                         "every measured channel reads one value throughout: no sensor "
-                         "measured the spindle", "check the sensors and their export")
-    return kept
-
-
-def _without_spikes(run: BenchRun, channels: list[str], alpha: float, grid_s: float
-                    ) -> tuple[BenchRun, list[str]]:
-    """``run`` with each channel's single-sample spikes (spindle.sensor_faults.spike_rows,
-    within a grid step ``grid_s`` [s]) left out, each channel's with a BenchWarning, and the
-    report's lines saying so."""
-    from spindle.sensor_faults import spike_rows
-
-    columns, said = dict(run.columns), []
-    for c in channels:
-        col = CHANNEL_COLUMNS[c]
-        y = columns[col]
-        unit_tol = channel_tolerance(c) * edge_scale(c)  # the file's unit (µm, K)
-        rows = spike_rows(run.time_s, y, unit_tol, alpha, grid_s)
-        if not len(rows):
-            continue
-        valid = np.flatnonzero(~np.isnan(y))
-        at = np.searchsorted(valid, rows)
-        sizes = [y[r] - 0.5 * (y[valid[k - 1]] + y[valid[k + 1]]) for r, k in zip(rows, at, strict=True)]
-        big = max(sizes, key=abs)
-        unit = edge_unit(c, ascii=True)
-        where = f", the first on line {run.lines[rows[0]]}" if len(run.lines) else ""
-        text = (f"{col}: {len(rows)} single-sample spikes (up to {big:+.3g} {unit} off the "
-                f"neighbours{where}) are left out: a thermal reading cannot leave its "
-                f"neighbours by a tolerance and return within {grid_s:g} s")
-        warnings.warn(BenchWarning(f"{run.path}: {text} (fix: check the sensor's wiring and "
-                                   "shielding)"), stacklevel=3)
-        said.append(text)
-        y = y.copy()
-        y[rows] = np.nan
-        columns[col] = y
-    return (replace(run, columns=columns) if said else run), said
 
 
 def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measured: Measured,
