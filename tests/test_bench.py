@@ -648,6 +648,24 @@ def test_every_peer_run_keeps_the_power_balance():
         assert lo <= min(figures[key]) and max(figures[key]) <= hi, (key, figures[key])
 
 
+def _cells_edited(src: Path, dst: Path, column: str, edit, until_s: float = float("inf")
+                  ) -> Path:
+    """The peer's run ``src``, its rows up to ``until_s`` [s], with each cell of ``column``
+    replaced by ``edit(time_s, cell)`` (strings as in the file)."""
+    lines = src.read_text(encoding="utf-8").splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
+    k = lines[head].split(",").index(column)
+    out = lines[:head + 1]
+    for ln in lines[head + 1:]:
+        cells = ln.split(",")
+        if float(cells[0]) > until_s:
+            break
+        cells[k] = edit(float(cells[0]), cells[k])
+        out.append(",".join(cells))
+    dst.write_text("\n".join(out) + "\n", encoding="utf-8")
+    return dst
+
+
 def _edited(src: Path, dst: Path, column: str, factor: float = 1.0, swap: str | None = None,
             copy_of: str | None = None, plus: float = 0.0) -> Path:
     """The peer's run ``src`` with ``column`` times ``factor``, or swapped with ``swap`` (its
@@ -790,18 +808,8 @@ def test_a_stuck_channel_is_named_in_the_fits_report(tmp_path):
     its first 2 h, with T1 at 20.00 in every row."""
     from compare.fit.run import run_fit
 
-    lines = (PEER_RUNS / "bench-runs" / "dev-06.csv").read_text(encoding="utf-8").splitlines()
-    head = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
-    k = lines[head].split(",").index("T1_C")
-    out = lines[:head + 1]
-    for ln in lines[head + 1:]:
-        cells = ln.split(",")
-        if float(cells[0]) > 7200.0:
-            break
-        cells[k] = "20.00"
-        out.append(",".join(cells))
-    path = tmp_path / "dev-06-T1-stuck.csv"
-    path.write_text("\n".join(out) + "\n", encoding="utf-8")
+    path = _cells_edited(PEER_RUNS / "bench-runs" / "dev-06.csv",
+                         tmp_path / "dev-06-T1-stuck.csv", "T1_C", lambda t, v: "20.00", 7200.0)
     with pytest.warns(BenchWarning, match="T1_C: reads 20"):
         rep = run_fit(path, load_spec("spl2782"))
     doc = rep.to_dict()

@@ -10,7 +10,7 @@ import pytest
 from compare.fit.criteria import Criteria
 from compare.fit.growth_check import check_growth, growth_gain
 from spindle.errors import InputError
-from tests.test_bench import PEER_RUNS, _edited
+from tests.test_bench import PEER_RUNS, _cells_edited, _edited
 
 
 def _ramp(n: int = 600, gain: float = 0.8, noise_m: float = 0.1e-6, seed: int = 0):
@@ -114,16 +114,8 @@ def test_the_p1_reference_is_its_first_sample_where_that_is_late(tmp_path):
     from compare.fit.run import _late_p1_reference
     from spindle.bench import read_bench
 
-    src = (PEER_RUNS / "bench-runs" / "dev-06.csv").read_text(encoding="utf-8").splitlines()
-    head = next(i for i, ln in enumerate(src) if ln.startswith("time_s"))
-    k = src[head].split(",").index("P1_um")
-    rows = [ln.split(",") for ln in src[head + 1:]]
-    for cells in rows:
-        if float(cells[0]) < 7200.0:
-            cells[k] = ""
-    late = tmp_path / "late.csv"
-    late.write_text("\n".join(src[:head + 1] + [",".join(c) for c in rows]) + "\n",
-                    encoding="utf-8")
+    late = _cells_edited(PEER_RUNS / "bench-runs" / "dev-06.csv", tmp_path / "late.csv",
+                         "P1_um", lambda t, v: "" if t < 7200.0 else v)
     grid = np.arange(0.0, 16 * 3600.0, 60.0)
     full = read_bench(PEER_RUNS / "bench-runs" / "dev-06.csv")
     assert _late_p1_reference(full, full.channels, grid) is None
@@ -143,17 +135,8 @@ def test_a_p1_sensor_connected_late_is_compared_from_its_first_sample(tmp_path):
     from compare.fit.run import run_fit
     from spindle.spec_reader import load_spec
 
-    lines = (PEER_RUNS / "bench-runs" / "dev-06.csv").read_text(encoding="utf-8").splitlines()
-    head = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
-    k = lines[head].split(",").index("P1_um")
-    late = lines[:head + 1]
-    for ln in lines[head + 1:]:
-        cells = ln.split(",")
-        if float(cells[0]) < 2 * 3600.0:
-            cells[k] = ""
-        late.append(",".join(cells))
-    path = tmp_path / "dev-06-P1-late.csv"
-    path.write_text("\n".join(late) + "\n", encoding="utf-8")
+    path = _cells_edited(PEER_RUNS / "bench-runs" / "dev-06.csv", tmp_path / "late.csv",
+                         "P1_um", lambda t, v: "" if t < 7200.0 else v)
     doc = run_fit(path, load_spec("spl2782")).to_dict()
     assert doc["verdict"]["kind"] == "base adequate"
     assert doc["error_before"]["validation"]["P1"]["rmse"] < 1.5
