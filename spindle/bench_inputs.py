@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -273,22 +274,35 @@ def loss_excess(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
 PALMGREN_SPREAD = 3.0
 
 
+def _per_rpm(watts: Callable[[float], float]) -> Callable[[float], float]:
+    """``watts`` [W] of a speed [rpm], evaluated at the speed rounded to 1 rpm and once per
+    such speed: a run's intervals repeat a few speeds."""
+    cache: dict[int, float] = {}
+
+    def at(speed_rpm: float) -> float:
+        key = round(float(speed_rpm))
+        if key not in cache:
+            cache[key] = watts(float(key))
+        return cache[key]
+    return at
+
+
+def friction_floor_W(drive: Drive) -> Callable[[float], float]:
+    """The bearings' friction [W] at a speed [rpm] with their friction factors divided by
+    :data:`PALMGREN_SPREAD`: the least a spindle turning at that speed draws."""
+    low = [replace(b, f0=b.f0 / PALMGREN_SPREAD) for b in drive.bearings.values()]
+    return _per_rpm(lambda n: sum(bearing_friction(b, n).heat_W for b in low))
+
+
 def friction_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray) -> float:
     """The median, over the running intervals with a measured power, of the power [kW]
     against the bearings' friction at the speed [rpm] with their friction factors divided by
     :data:`PALMGREN_SPREAD` [-]: a spindle turning without a load draws at least that, its
     motor's losses aside (the peer's no-load runs draw 6 times it and more: docs/bench.md).
     nan without such an interval."""
-    low = {k: replace(b, f0=b.f0 / PALMGREN_SPREAD) for k, b in drive.bearings.items()}
-    cache: dict[int, float] = {}
-    shares = []
-    for n, P in zip(speed_rpm, power_kW, strict=True):
-        if n < STANDSTILL_RPM or math.isnan(P):
-            continue
-        key = round(float(n))
-        if key not in cache:
-            cache[key] = sum(bearing_friction(b, float(key)).heat_W for b in low.values())
-        shares.append(P * 1e3 / cache[key])
+    floor = friction_floor_W(drive)
+    shares = [P * 1e3 / floor(n) for n, P in zip(speed_rpm, power_kW, strict=True)
+              if n >= STANDSTILL_RPM and not math.isnan(P)]
     return float(np.median(shares)) if shares else float("nan")
 
 
@@ -301,17 +315,12 @@ def below_friction_stretch(drive: Drive, speed_rpm: np.ndarray, power_kW: np.nda
     :data:`PALMGREN_SPREAD`. A speed step inside an interval can put it and its neighbour
     there (the interval's speed is its middle's); three in a row cannot be a step: the
     spindle did not turn at the speed the log holds. (0, 0) without one."""
-    low = {k: replace(b, f0=b.f0 / PALMGREN_SPREAD) for k, b in drive.bearings.items()}
-    cache: dict[int, float] = {}
+    floor = friction_floor_W(drive)
     best = (0, 0)
     start = None
     for i, (n, P, M) in enumerate(zip(speed_rpm, power_kW, load_torque_Nm, strict=True)):
-        below = False
-        if n >= STANDSTILL_RPM and abs(M) <= loaded_Nm and math.isfinite(P):
-            key = round(float(n))
-            if key not in cache:
-                cache[key] = sum(bearing_friction(b, float(key)).heat_W for b in low.values())
-            below = P * 1e3 < cache[key]
+        below = (n >= STANDSTILL_RPM and abs(M) <= loaded_Nm and math.isfinite(P)
+                 and P * 1e3 < floor(n))
         if below and start is None:
             start = i
         if not below:
@@ -329,15 +338,10 @@ def no_load_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
     [rpm]: all such power is loss, and a spindle's losses lie within a few times its spec's
     (:data:`PALMGREN_SPREAD`), so a median far above it says the speeds are too low for the
     power. nan without such an interval."""
-    cache: dict[int, float] = {}
-    shares = []
-    for n, P, M in zip(speed_rpm, power_kW, load_torque_Nm, strict=True):
-        if n < STANDSTILL_RPM or abs(M) > loaded_Nm or not math.isfinite(P):
-            continue
-        key = round(float(n))
-        if key not in cache:
-            cache[key] = sum(drive.heat_W(float(key), 0.0, None).values())
-        shares.append(P * 1e3 / cache[key])
+    no_load = _per_rpm(lambda n: sum(drive.heat_W(n, 0.0, None).values()))
+    shares = [P * 1e3 / no_load(n)
+              for n, P, M in zip(speed_rpm, power_kW, load_torque_Nm, strict=True)
+              if n >= STANDSTILL_RPM and abs(M) <= loaded_Nm and math.isfinite(P)]
     return (float(np.median(shares)) if shares else float("nan")), len(shares)
 
 
