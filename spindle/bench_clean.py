@@ -15,10 +15,10 @@ from spindle.sensor_faults import spike_rows
 from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
 
 
-def without_stuck(run: BenchRun, channels: list[str]) -> list[str]:
+def without_stuck(run: BenchRun, channels: list[str]) -> tuple[list[str], list[str]]:
     """``channels`` less those whose sensor reads one value throughout
-    (spindle.bench.stuck_channels), each left out with a BenchWarning; InputError where
-    none is left."""
+    (spindle.bench.stuck_channels), each left out with a BenchWarning, and the report's
+    lines saying so; InputError where none is left."""
     stuck = stuck_channels(run, channels)
     for c in stuck:
         col = CHANNEL_COLUMNS[c]
@@ -33,7 +33,8 @@ def without_stuck(run: BenchRun, channels: list[str]) -> list[str]:
         raise InputError(str(run.path), ", ".join(CHANNEL_COLUMNS[c] for c in channels),
                          "every measured channel reads one value throughout: no sensor "
                          "measured the spindle", "check the sensors and their export")
-    return kept
+    return kept, [f"{CHANNEL_COLUMNS[c]} reads one value in every row (a stuck or "
+                  "disconnected sensor) and is left out" for c in stuck]
 
 
 def without_spikes(run: BenchRun, channels: list[str], alpha: float, grid_s: float

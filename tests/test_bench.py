@@ -796,7 +796,7 @@ def test_a_sensor_that_reads_one_value_throughout_is_left_out_with_a_warning(tmp
     run = read_bench(write(tmp_path, lines))
     assert stuck_channels(run, run.channels) == ["T1"]
     with pytest.warns(BenchWarning, match="T1_C: reads 22 in each of its 61 samples.*left out"):
-        assert without_stuck(run, run.channels) == ["T2", "T_stator", "P1"]
+        assert without_stuck(run, run.channels)[0] == ["T2", "T_stator", "P1"]
     flat = read_bench(write(tmp_path, good_rows(), name="flat.csv"))
     with pytest.raises(InputError, match="every measured channel reads one value"):
         with pytest.warns(BenchWarning):

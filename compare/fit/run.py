@@ -33,7 +33,6 @@ from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAM
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
 from spindle.bench import (
-    CHANNEL_COLUMNS,
     BenchRun,
     check_against_spec,
     read_bench,
@@ -103,10 +102,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         channels = check_against_spec(run, spec)
-    measured_channels = list(channels)
-    channels = without_stuck(run, channels)
-    left_out = [f"{CHANNEL_COLUMNS[c]} reads one value in every row (a stuck or disconnected "
-                "sensor) and is left out" for c in measured_channels if c not in channels]
+    channels, left_out = without_stuck(run, channels)
     run, spikes = without_spikes(run, channels, criteria.alpha, grid_s)
     left_out += spikes
     drive = drive_for(spec)
