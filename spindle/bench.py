@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from spindle.bench_text import decoded, hint_for
 from spindle.errors import InputError
 from spindle.sensor_faults import check_not_copies, check_room_in_celsius
 from spindle.spec import Spec
@@ -158,35 +159,6 @@ class BenchRun:
 
 
 # ============================================================================ reading
-
-
-def _split_unit(column: str) -> tuple[str, str]:
-    """(quantity, unit) of a column name: the unit follows the LAST underscore."""
-    q, sep, u = column.rpartition("_")
-    return (q, u) if sep else (column, "")
-
-
-def _hint_for(column: str, header: list[str]) -> str:
-    """A hint when the header has the quantity of ``column`` under another unit or spelling."""
-    q, u = _split_unit(column)
-    for h in header:
-        hq, hu = _split_unit(h)
-        if h != column and (hq.lower() == q.lower() or h.lower() == column.lower()):
-            return f" (the header has '{h}'{f' with unit {hu!r}' if hu != u else ''}: the format " \
-                   f"wants '{column}')"
-    return ""
-
-
-def _decode(raw: bytes, name: str) -> str:
-    try:
-        return raw.decode("utf-8-sig")  # a byte-order mark (spreadsheet exports) is dropped
-    except UnicodeDecodeError as exc:
-        line = raw.count(b"\n", 0, exc.start) + 1
-        col = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
-        bad = raw[exc.start:exc.start + 1].hex()
-        raise InputError(name, f"line {line}", f"is not UTF-8 text (byte 0x{bad} at character {col})",
-                         "export the file as UTF-8 (a '°' or 'µ' saved as Latin-1/Windows-1252 "
-                         "does this)") from None
 
 
 def _parse_floats(cells: tuple[str, ...] | list[str]) -> tuple[np.ndarray | None, int]:
@@ -352,7 +324,7 @@ def read_bench(path: str | Path) -> BenchRun:
     extra = _read_unknown_columns(table, header)
     unknown = list(extra)
     for h in unknown:
-        hint = next((_hint_for(k, [h]) for k in KNOWN_COLUMNS if _hint_for(k, [h])), "")
+        hint = next((hint_for(k, [h]) for k in KNOWN_COLUMNS if hint_for(k, [h])), "")
         if hint:
             warnings.warn(BenchWarning(f"{name}: {h}: kept as an unknown column{hint}"), stacklevel=2)
 
@@ -377,7 +349,7 @@ def _read_lines(path: Path, error: _ErrorFor) -> list[str]:
                     "check the path of the bench export") from None
     if not raw.strip():
         raise error("file", "is empty", "export the bench run again (a header row and data rows)")
-    return _decode(raw, str(path)).split("\n")
+    return decoded(raw, str(path)).split("\n")
 
 
 def _comments_before_header(lines: list[str], error: _ErrorFor) -> tuple[dict[str, str], int]:
@@ -426,10 +398,10 @@ def _read_header(lines: list[str], header_idx: int,
     for col in REQUIRED_COLUMNS:
         if col not in seen:
             raise error(col, f"required column is missing from the header (line {hline})"
-                        + _hint_for(col, header),
+                        + hint_for(col, header),
                         f"export a '{col}' column (required: {', '.join(REQUIRED_COLUMNS)})")
     if not any(col in seen for col in CHANNEL_COLUMNS.values()):
-        hints = "".join(_hint_for(c, header) for c in CHANNEL_COLUMNS.values())
+        hints = "".join(hint_for(c, header) for c in CHANNEL_COLUMNS.values())
         raise error(f"header (line {hline})", "no measured channel: the run has none of the columns "
                     f"{', '.join(CHANNEL_COLUMNS.values())}{hints}",
                     "export at least one of the sensor columns the model is checked against")

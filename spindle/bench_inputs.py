@@ -589,6 +589,9 @@ class Inputs:
     T_env_K: np.ndarray
     T_coolant_K: np.ndarray
     T_start_K: float | None = None  # uniform initial temperature [K] (default: T_env_K[0])
+    #: the first interval's inputs held for this long [s] before grid[0], from T_start_K:
+    #: where the run starts (compare.fit.start; 0: at T_start_K, uniform)
+    prehistory_s: float = 0.0
 
 
 def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOLD_STEPS

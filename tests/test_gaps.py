@@ -122,7 +122,7 @@ def test_the_calibrated_model_places_the_switch_where_the_spec_model_cannot():
     measured = _measured(run, channels, inputs.grid_s, 0.6, 1, Criteria())
 
     def place(th):
-        return _place_gap_switches(run, spec, drive, inputs, measured, channels, 11, (),
+        return _place_gap_switches(run, GreyBox(spec, drive, inputs), measured, channels,
                                    lambda _m: None, Criteria(), th)[1][0].switch_s
 
     assert abs(place(None) - true_switch_s) > 120.0  # the spec's model: off

@@ -76,6 +76,8 @@ class Criteria:
     refit_nfev: int
     # input timing
     gap_min_steps: float = HOLD_STEPS
+    start_within_tolerances: float
+    prehistory_max_s: float
     gap_judge_s: float
     gap_level_s: float
     # signatures: steps

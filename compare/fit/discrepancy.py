@@ -73,6 +73,8 @@ def fem_readings(ref, spec: Spec, inputs: Inputs, sources_W: dict[str, np.ndarra
     t_rel = inputs.grid_s - inputs.grid_s[0]
     T0 = inputs.T_start_K if inputs.T_start_K is not None else float(inputs.T_env_K[0])
     dt = float(np.median(np.diff(t_rel)))
+    if inputs.prehistory_s > 0:
+        T0 = _after_prehistory(ref, spec, inputs, sources_W, T0, dt)
     res = ref.transient(case, dt, T0=T0)
     out = {}
     for c in channels:
@@ -86,6 +88,22 @@ def fem_readings(ref, spec: Spec, inputs: Inputs, sources_W: dict[str, np.ndarra
             continue
         out[c] = np.interp(t_rel, res.times_s, y)
     return out
+
+
+#: steps of the FEM's prehistory at the most (backward Euler; the grey box's is exact): the
+#: run's own step up to 400 of them, longer steps beyond (the settled part of a long soak)
+PREHISTORY_STEPS = 400
+
+
+def _after_prehistory(ref, spec: Spec, inputs: Inputs, sources_W: dict[str, np.ndarray],
+                      T0: float, dt_s: float) -> np.ndarray:
+    """The FEM's field [K] after the first interval's inputs held for
+    ``inputs.prehistory_s`` from the uniform ``T0`` (compare.fit.start)."""
+    tau = float(inputs.prehistory_s)
+    first = Inputs(np.array([0.0, tau]), inputs.speed_rpm[:1], inputs.power_kW[:1],
+                   inputs.load_torque_Nm[:1], inputs.T_env_K[:1], inputs.T_coolant_K[:1])
+    case = load_case_from_inputs(spec, first, {k: v[:1] for k, v in sources_W.items()})
+    return ref.transient(case, max(dt_s, tau / PREHISTORY_STEPS), T0=T0).fields_K[-1]
 
 
 def reference_channels(gb: GreyBox, channels: tuple[str, ...] | list[str], level: int = 0

@@ -313,6 +313,53 @@ class GreyBox:
         modes at every speed level of the run."""
         return (*_K_PARAMS, *(k for e, _ in self._effects() for k in e.in_conductance))
 
+    def _input_matrix(self, th: dict[str, float], sys) -> np.ndarray:
+        """The network's inputs per interval: the heat sources [W] (with the effects'),
+        then the room and the coolant [K]."""
+        inp = self.inputs
+        src = self.sources(th["f0"], th["rotor_share"], th.get("friction_exponent", 0.0))
+        for e, _ in self._effects():
+            src = e.heat(src, th, inp)
+        n_int = len(inp.grid_s) - 1
+        return np.column_stack([src[n] if n in src else np.zeros(n_int)
+                                for n in sys.source_names]
+                               + [inp.T_env_K if f == "ambient" else inp.T_coolant_K
+                                  for f in sys.fixed_sources])
+
+    def _start(self, sys, u0: np.ndarray, speed_rpm: float, prehistory_s: float
+               ) -> np.ndarray:
+        """The state at grid[0] [K]: uniform at the inputs' start temperature, then the first
+        interval's inputs ``u0`` (at ``speed_rpm``) held for ``prehistory_s`` [s], exact."""
+        inp = self.inputs
+        x = np.full(sys.n_states, inp.T_start_K if inp.T_start_K is not None
+                    else inp.T_env_K[0])
+        if prehistory_s <= 0:
+            return x
+        modal = None if sys.temperature_dependent else sys.modes(prehistory_s, speed_rpm)
+        if modal is not None:
+            a, Bm, to_modal, from_modal = modal
+            return from_modal @ (a * (to_modal @ x) + Bm @ u0)
+        Phi, Gam = sys.discretize(prehistory_s, speed_rpm,
+                                  self._binned(u0[:len(sys.source_names)]))
+        return Phi @ x + Gam @ u0
+
+    def start_readings(self, theta: dict[str, float]):
+        """The temperature sensors' readings at grid[0] [K] as a function of the prehistory
+        [s] (:meth:`_start`), for the parameters ``theta``."""
+        th = self.full_theta(theta)
+        model = self._model(th)
+        sys = model.system
+        u0 = self._input_matrix(th, sys)[0]
+        speed = float(self.conductance_speeds()[0])
+        rows = {n: model.S[model.sensor_names.index(n)] for n in model.sensor_names
+                if n in CHANNELS and n != "P1"}
+
+        def readings(prehistory_s: float) -> dict[str, float]:
+            x = self._start(sys, u0, speed, prehistory_s)
+            return {n: float(r @ x) for n, r in rows.items()}
+
+        return readings
+
     def simulate(self, theta: dict[str, float], x0_K: float | None = None,
                  extra_rows: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
         """Channel values at the grid points [K; m for P1] for parameters ``theta`` (missing
@@ -323,17 +370,13 @@ class GreyBox:
         model = self._model(th)
         sys = model.system
         inp = self.inputs
-        src = self.sources(th["f0"], th["rotor_share"], th.get("friction_exponent", 0.0))
         n_int = len(inp.grid_s) - 1
         effects = self._effects()
-        for e, _ in effects:
-            src = e.heat(src, th, inp)
-        U = np.column_stack([src[n] if n in src else np.zeros(n_int) for n in sys.source_names]
-                            + [inp.T_env_K if f == "ambient" else inp.T_coolant_K
-                               for f in sys.fixed_sources])
+        U = self._input_matrix(th, sys)
         m = len(sys.source_names)
-        start = inp.T_start_K if inp.T_start_K is not None else inp.T_env_K[0]
-        x = np.full(sys.n_states, start if x0_K is None else x0_K)
+        n_K = self.conductance_speeds()
+        x = (self._start(sys, U[0], float(n_K[0]), inp.prehistory_s) if x0_K is None
+             else np.full(sys.n_states, x0_K))
         names = [n for n in model.sensor_names if n in CHANNELS]
         rows = [model.S[model.sensor_names.index(n)] for n in names]
         has_p1 = "P1" in model.chain.rows
@@ -345,7 +388,6 @@ class GreyBox:
         Y = np.empty((n_int + 1, len(rows)))
         Y[0] = readout @ x
         dts = np.diff(inp.grid_s)
-        n_K = self.conductance_speeds()
         # runs of equal (dt, speed): one set of modes and one modal recursion each
         first = np.flatnonzero(np.r_[True, (dts[1:] != dts[:-1]) | (n_K[1:] != n_K[:-1])]
                                )[:n_int]

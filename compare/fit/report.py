@@ -269,6 +269,7 @@ def report_dict(rep) -> dict:
         "base_adequacy": rep.base_adequacy,
         "warnings": rep.warnings,
         "gap_switches": [asdict(g) for g in rep.gap_switches],
+        "start": None if rep.start is None else rep.start.to_dict(),
         "parameters": parameters_table(final),
         "parameters_before": parameters_table(sel.base),
         "parameters_prior_z": rep.prior_z,

@@ -17,7 +17,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +32,7 @@ from compare.fit.growth_check import check_growth, library_terms
 from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, default_theta
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
+from compare.fit.start import Start, first_samples, run_start
 from spindle.bench import (
     BenchRun,
     check_against_spec,
@@ -79,6 +80,8 @@ class BaseCalibration:
     switches_placed_by: str = "the spec's model"
     #: channels left out before the fit, each with why (a sensor that reads one value)
     left_out: list[str] = field(default_factory=list)
+    #: where the run starts (compare.fit.start)
+    start: Start | None = None
 
 
 def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, nodes: int = 11,
@@ -113,16 +116,18 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     check_power_balance(run, drive, raw.grid_s, raw.speed_rpm, raw.power_kW,
                         raw.load_torque_Nm, criteria.no_load_Nm)
     measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks, criteria)
-    inputs, switches = _place_gap_switches(run, spec, drive, raw, measured, channels, nodes,
-                                           base_extra, say, criteria)
-
-    p1_reference = _late_p1_reference(run, channels, raw.grid_s)
+    plain = GreyBox(spec, drive, raw, nodes, speed_bin_rel=criteria.speed_bin_rel)
+    begins = run_start(plain, default_theta(plain.parameters()),
+                       first_samples(run, channels, raw.grid_s), criteria)
+    raw = replace(raw, prehistory_s=begins.prehistory_s)
+    spec_model = GreyBox(spec, drive, raw, nodes, base_extra=base_extra,
+                         speed_bin_rel=criteria.speed_bin_rel,
+                         p1_reference_s=_late_p1_reference(run, channels, raw.grid_s))
+    inputs, switches = _place_gap_switches(run, spec_model, measured, channels, say, criteria)
 
     def calibrator(on: Inputs) -> Calibrator:
-        return Calibrator(GreyBox(spec, drive, on, nodes, base_extra=base_extra,
-                                  speed_bin_rel=criteria.speed_bin_rel,
-                                  p1_reference_s=p1_reference), measured,
-                          channels, progress=say, tol=criteria.optimizer_tol, workers=workers)
+        return Calibrator(replace(spec_model, inputs=on, _cache={}), measured, channels,
+                          progress=say, tol=criteria.optimizer_tol, workers=workers)
 
     cal = calibrator(inputs)
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
@@ -155,16 +160,15 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
             # placed by the spec's model, whose level on a spindle the spec only approximates
             # can be kelvins off after the gap and pull the switch to the gap's edge; placed
             # again by the calibrated model, and the base recalibrated on those inputs
-            again, moved = _place_gap_switches(run, spec, drive, raw, measured, channels,
-                                               nodes, base_extra, say, criteria, base.theta,
-                                               cal.gb.discrepancy)
+            again, moved = _place_gap_switches(run, replace(cal.gb, inputs=raw), measured,
+                                               channels, say, criteria, base.theta)
             placed_by = "the calibrated model"
             if [m.switch_s for m in moved] != [w.switch_s for w in switches]:
                 inputs, switches = again, moved
                 cal = calibrator(inputs)
                 anchor, base = anchored(cal, base.theta)
     return BaseCalibration(run, channels, inputs, measured, cal, base, spec_values, anchor,
-                           switches, placed_by, left_out)
+                           switches, placed_by, left_out, begins)
 
 
 def _late_p1_reference(run: BenchRun, channels: list[str], grid_s: np.ndarray
@@ -178,19 +182,17 @@ def _late_p1_reference(run: BenchRun, channels: list[str], grid_s: np.ndarray
     return t1 if t1 > float(grid_s[1]) else None
 
 
-def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measured: Measured,
-                        channels: list[str], nodes: int, base_extra: tuple[str, ...],
-                        say: Callable[[str], None], criteria: Criteria,
-                        theta: dict[str, float] | None = None,
-                        discrepancy: dict[str, np.ndarray] | None = None
-                        ) -> tuple[Inputs, list]:
-    """compare.fit.gaps.place_switches with the model's misfit over the hour after each gap:
-    the lumped grey box at ``theta`` (default: the spec's values, no anchor, before the FEM
-    runs) with the FEM anchor's ``discrepancy`` if given."""
+def _place_gap_switches(run: BenchRun, model: GreyBox, measured: Measured,
+                        channels: list[str], say: Callable[[str], None], criteria: Criteria,
+                        theta: dict[str, float] | None = None) -> tuple[Inputs, list]:
+    """compare.fit.gaps.place_switches on ``model``'s inputs with the misfit over the hour
+    after each gap of ``model`` (its extras, FEM anchor and P1 reference) at ``theta``
+    (default: the spec's values, before the FEM runs)."""
     from compare.fit.gaps import gaps_with_change, place_switches
 
     t_n, n = valid_samples(run, "speed_rpm")
     torque = valid_samples(run, "load_torque_Nm") if run.load_torque_measured else None
+    inputs = model.inputs
     if not gaps_with_change(run.time_s, t_n, n, inputs.grid_s, criteria=criteria,
                             torque=torque):
         return inputs, []
@@ -200,8 +202,7 @@ def _place_gap_switches(run: BenchRun, spec: Spec, drive, inputs: Inputs, measur
     def misfit(trial: Inputs, end_s: float) -> float:
         for k in [k for k in cache if isinstance(k, tuple) and k[:1] == ("src",)]:
             del cache[k]  # the heat sources depend on the inputs, the network does not
-        gb = GreyBox(spec, drive, trial, nodes, base_extra=base_extra, _cache=cache,
-                     discrepancy=discrepancy, speed_bin_rel=criteria.speed_bin_rel)
+        gb = replace(model, inputs=trial, _cache=cache)
         y = gb.simulate(default_theta(gb.parameters()) if theta is None else theta)
         window = (trial.grid_s >= end_s) & (trial.grid_s <= end_s + criteria.gap_judge_s)
         total = 0.0
@@ -251,6 +252,8 @@ class FitReport:
     #: spans (start, end) [s] whose inputs are not known, where something else is not looked
     #: for (compare.fit.gaps.unknown_input_spans)
     unknown_inputs: list = field(default_factory=list)
+    #: where the run starts (compare.fit.start)
+    start: Start | None = None
 
     def to_dict(self) -> dict:
         from compare.fit.report import report_dict
@@ -327,7 +330,8 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
     adequacy["with_effects"] = base_adequacy(final.errors, final.theta, prep.spec_values,
                                              cal.prior_z(final), ranges, criteria,
                                              final.partners)
-    warns = list(prep.left_out)
+    warns = list(prep.left_out) + [t for t in [prep.start.text(), _other_spindle(run, spec)]
+                                   if t]
     warns += extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
                                     measured.fit_points())
     warns += [f"{g.text()} inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} h); the change "
@@ -343,7 +347,17 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
     return FitReport(run, spec, channels, measured, inputs, sel, sig, diag_b, diag_a,
                      time.perf_counter() - t0, criteria, prep.anchor, cal.floor,
                      cal.prior_z(final) or None, adequacy, warns, cv, prep.gap_switches,
-                     unknown)
+                     unknown, prep.start)
+
+
+def _other_spindle(run: BenchRun, spec: Spec) -> str:
+    """A warning where the run's ``# spindle:`` line does not name the spec it is fitted
+    with ("" where it does, or has none)."""
+    named = run.metadata.get("spindle", "").strip()
+    if not named or spec.name.lower() in named.lower():
+        return ""
+    return (f"the run's header names the spindle '{named}' and it is fitted with the spec "
+            f"'{spec.name}': check that --spec describes this spindle")
 
 
 def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fraction: float,

@@ -1,0 +1,184 @@
+"""Runs that do not start at the room's temperature: ``fit`` with its start read from the
+first samples (compare.fit.start) against the uniform start, on drawn runs.
+
+    python benchmarks/bench_start.py [--runs 40] [--workers 2] [--json OUT.json]
+                                     [--summary FILE] [--rows ROWS.json]
+
+Each run is a family run of bench_families.py (one its cache holds as a regular log, with
+its truth) with its first hours cut off: a logger started on a spindle that was already
+running, as a bench that is not the lab's often is. The cut is drawn from 1 to 4 h, the
+family (effect, clean, outside, two, in turn), the run and the cut from a stream of their
+own. Every cut run is fitted twice: with the table's ``start_within_tolerances`` (the start
+read from the first samples where the uniform start misses them) and with it at 100 (always
+the uniform start, the code before). Prints, per
+arm, the issue's rates with 95 % Wilson intervals, and the runs whose verdict changed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from bench_families import FAMILIES, wilson
+from verdicts import fit_outcome, judge_verdict, run_verdicts
+
+import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
+
+ROOT = Path(__file__).resolve().parents[1]
+CACHE = ROOT / "benchmarks" / ".families-cache"
+#: the drawn cut [h]: from an hour (the bearings warm) to four (the housing too)
+CUT_H = (1.0, 4.0)
+ARMS = {"read": (), "uniform": (("start_within_tolerances", 100.0),)}
+
+
+def cut_run(src: Path, dst: Path, cut_s: float) -> None:
+    """``src`` without its rows before ``cut_s`` [s], its clock restarted at the first row
+    kept (the format zeroes P1 there itself)."""
+    lines = src.read_text(encoding="utf-8").splitlines()
+    head = [ln for ln in lines if ln.startswith("#") and not ln.startswith("# rows:")]
+    rows = [ln for ln in lines if not ln.startswith("#")]
+    header, data = rows[0], rows[1:]
+    kept = [ln for ln in data if float(ln.split(",", 1)[0]) >= cut_s]
+    t0 = float(kept[0].split(",", 1)[0])
+    out = [f"{float(ln.split(',', 1)[0]) - t0:.2f},{ln.split(',', 1)[1]}" for ln in kept]
+    dst.write_text("\n".join([*head, header, *out]) + "\n", encoding="utf-8")
+
+
+@dataclass(frozen=True)
+class Job:
+    family: str
+    seed: int  # one of the 50 the family benchmark draws
+    cut_s: float
+    arm: str = "read"
+
+    @property
+    def label(self) -> str:
+        return f"{self.family}-{self.seed} cut {self.cut_s / 3600:.2f} h, {self.arm}"
+
+
+def cases(n: int) -> list[Job]:
+    """The drawn cut runs: the family in turn, a run of it the cache holds (a regular log
+    with its truth; main and held-out seeds alike) and the cut, from a stream of their own."""
+    import numpy as np
+
+    rng = np.random.default_rng([2026, 11, 29])
+    held = {f: sorted(int(p.stem.rsplit("-", 1)[1]) for p in CACHE.glob(f"{f}-*.csv")
+                      if p.stem.rsplit("-", 1)[1].isdigit()
+                      and p.with_suffix(".truth.json").exists()) for f in FAMILIES}
+    families = [f for f in FAMILIES if held[f]]
+    return [Job(f, int(rng.choice(held[f])), float(rng.uniform(*CUT_H) * 3600))
+            for i in range(n) for f in [families[i % len(families)]]]
+
+
+def cut_path(job: Job) -> Path:
+    return CACHE / "cut" / f"{job.family}-{job.seed}-cut{job.cut_s / 3600:.2f}h.csv"
+
+
+def one(job: Job) -> dict:
+    from compare.fit.criteria import Criteria
+    from compare.fit.run import run_fit
+    from spindle.spec_reader import load_spec
+
+    case = asdict(job)
+    src = CACHE / f"{job.family}-{job.seed}.csv"
+    truth_doc = json.loads(src.with_suffix(".truth.json").read_text(encoding="utf-8"))
+    dst = cut_path(job)
+    truth = truth_doc["effect"]
+    truth = ("unexplained" if job.family == "outside" else
+             None if truth == "clean" else truth)
+    rep = run_fit(dst, load_spec("spl2782"),
+                  criteria=Criteria().with_options(**dict(ARMS[job.arm])))
+    doc = rep.to_dict()
+    out = fit_outcome(doc)
+    from spindle.tolerances import channel_tolerance, edge_scale
+
+    return {**case, "run": dst.stem, "truth": truth, "named": out["named"],
+            "verdict": out["verdict"],
+            **judge_verdict(truth, out["named_plain"], out["unexplained"]),
+            "rms_within_tolerance": all(v <= channel_tolerance(c) * edge_scale(c)
+                                        for c, v in out["validation_rmse"].items()),
+            "validation_rmse": out["validation_rmse"],
+            "prehistory_s": (doc.get("start") or {}).get("prehistory_s"), "fit_s": rep.runtime_s}
+
+
+def rates(rows: list[dict]) -> list[str]:
+    def line(label: str, hit, of) -> str:
+        sel = [r for r in rows if of(r)]
+        k = sum(bool(hit(r)) for r in sel)
+        p, lo, hi = wilson(k, len(sel))
+        return (f"  {label:<44} {k:3d} of {len(sel):3d}  {100 * p:5.1f} %  "
+                f"[{100 * lo:5.1f}, {100 * hi:5.1f}]")
+
+    effect = lambda r: r["kind"] in ("effect", "effects")  # noqa: E731
+    return [line("true effect named first", lambda r: r["first"], effect),
+            line("clean: nothing named", lambda r: r["right"], lambda r: r["kind"] == "control"),
+            line("outside: unexplained, nothing named", lambda r: r["right"],
+                 lambda r: r["kind"] == "outside"),
+            line("wrong effect named (any run)", lambda r: r["wrong"], lambda r: True),
+            line("right verdict as a whole", lambda r: r["right"], lambda r: True),
+            line("validation RMS within tolerances (named or adequate)",
+                 lambda r: r["rms_within_tolerance"],
+                 lambda r: r["verdict"] in ("named", "base adequate"))]
+
+
+def summary(rows: list[dict]) -> list[str]:
+    out = [f"runs: {len({r['run'] for r in rows})} cut runs, each fitted with both starts"]
+    for arm in ARMS:
+        sub = [r for r in rows if r["arm"] == arm]
+        moved = sum((r["prehistory_s"] or 0) > 0 for r in sub)
+        out += [f"start {arm!r}" + (f" (moved on {moved} runs):" if arm == "read" else ":"),
+                *rates(sub)]
+    by = {(r["run"], r["arm"]): r for r in rows}
+    changed = [(run, by[run, "uniform"], by[run, "read"]) for run, arm in by
+               if arm == "read" and (run, "uniform") in by
+               and by[run, "uniform"]["named"] != by[run, "read"]["named"]
+               or arm == "read" and (run, "uniform") in by
+               and by[run, "uniform"]["verdict"] != by[run, "read"]["verdict"]]
+    out.append(f"verdicts changed ({len(changed)}): run, truth: uniform -> read")
+    for run, u, r in changed:
+        def said(x: dict) -> str:
+            return f"{x['verdict']} {','.join(x['named'])}".strip() + (" (right)" if x["right"]
+                                                                         else "")
+        out.append(f"  {run}, {r['truth']}: {said(u)} -> {said(r)}")
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=40)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--json", type=Path, help="write the rows to this JSON file")
+    ap.add_argument("--rows", type=Path, help="summarise these rows (no fitting)")
+    ap.add_argument("--summary", type=Path, help="also write the summary to this file")
+    args = ap.parse_args(argv)
+    if args.rows:
+        rows = json.loads(args.rows.read_text(encoding="utf-8"))
+    else:
+        if not cases(args.runs):
+            sys.exit(f"bench_start: no family runs in {CACHE}; run "
+                     "python benchmarks/bench_families.py --synth-only first")
+        from dataclasses import replace
+
+        for c in cases(args.runs):  # made here once, read by both arms' workers
+            if not cut_path(c).exists():
+                cut_path(c).parent.mkdir(exist_ok=True)
+                cut_run(CACHE / f"{c.family}-{c.seed}.csv", cut_path(c), c.cut_s)
+        jobs = [replace(c, arm=arm) for c in cases(args.runs) for arm in ARMS]
+        rows = run_verdicts(
+            one, jobs, workers=args.workers, header="cut run, start: truth -> verdict",
+            line=lambda r: f"  {r['run']}, {r['arm']}: {r['truth']} -> {r['verdict']} "
+                           f"{','.join(r['named'])}", group=lambda r: r["arm"],
+            json_path=args.json)
+    text = "\n".join(summary(rows))
+    print(text)
+    if args.summary:
+        from spindle.outputs import atomic_write
+
+        atomic_write(args.summary, lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,118 @@
+"""Where a bench run starts: the spindle's state at the log's first sample.
+
+The grey box starts at the room's temperature, uniform: a spindle that stood in the room
+long enough. A log can start elsewhere: warm from running before the logger was started, or
+soaked by a chiller that holds the coolant below the room. Its first samples then contradict
+that start. Where one of them misses it by more than ``Criteria.start_within_tolerances``,
+the model starts instead from the run's first operating point (speed, power, room and
+coolant of its first interval) held for a time tau before the log, from the room's
+temperature. tau = 0 is the uniform start; a long tau is that point's steady state (a soak at
+rest, or a spindle that ran there). tau is the one value that best reproduces the first
+samples of the temperature channels, with the spec's model (docs/fit.md, step 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from compare.fit.calibrate import TOLERANCE
+from compare.fit.criteria import Criteria
+from compare.fit.greybox import GreyBox
+from spindle.bench import BenchRun
+
+#: the tried prehistories per decade between the grid's step and Criteria.prehistory_max_s,
+#: before the best is refined between its neighbours
+_PER_DECADE = 12
+
+
+@dataclass(frozen=True)
+class Start:
+    """A run's start: the first samples [K] of the temperature channels that log one in
+    the grid's first interval, the uniform start's misfit and the chosen start's [tolerances]
+    per channel, and the prehistory [s] (0: the uniform start)."""
+
+    first_K: dict[str, float]
+    uniform_misfit: dict[str, float]
+    misfit: dict[str, float]
+    prehistory_s: float
+    #: Criteria.start_within_tolerances of the fit
+    within: float = 1.0
+
+    def text(self) -> str:
+        """The warning for a start off the uniform one ("" where the first samples agree)."""
+        if all(abs(v) <= self.within for v in self.uniform_misfit.values()):
+            return ""
+        worst = max(self.uniform_misfit, key=lambda c: abs(self.uniform_misfit[c]))
+        text = (f"the run does not start at the room's temperature: {worst}'s first sample is "
+                f"{self.uniform_misfit[worst] * TOLERANCE[worst]:+.1f} K from a uniform start")
+        if self.prehistory_s > 0:
+            text += (", so the model starts from the run's first operating point held for "
+                     f"{self.prehistory_s / 3600:.2f} h before the log, which leaves "
+                     + ", ".join(f"{c} {v * TOLERANCE[c]:+.2f} K"
+                                 for c, v in self.misfit.items()) + " at the first samples")
+        if not self.reached:
+            text += ("; no time at the run's first operating point reaches the logged start, "
+                     "so part of the first hours' misfit is the start's")
+        return text + " (compare.fit.start)"
+
+    @property
+    def reached(self) -> bool:
+        """Whether the chosen start meets every first sample within ``within``."""
+        return all(abs(v) <= self.within for v in self.misfit.values())
+
+    def to_dict(self) -> dict:
+        return {"prehistory_s": self.prehistory_s, "reached": self.reached,
+                "first_K": self.first_K,
+                "uniform_misfit_tolerances": self.uniform_misfit,
+                "misfit_tolerances": self.misfit}
+
+
+def first_samples(run: BenchRun, channels: list[str], grid_s: np.ndarray) -> dict[str, float]:
+    """The first sample [K] of each temperature channel of ``channels`` logged in the grid's
+    first interval: the state at the start (a median over the interval would blur it where
+    the coolant acts within the first minute, as on the peer's dev-03)."""
+    out = {}
+    for c in channels:
+        if c == "P1":
+            continue
+        t, y = run.channel(c)
+        if len(t) and t[0] <= grid_s[1]:
+            out[c] = float(y[0])
+    return out
+
+
+def run_start(gb: GreyBox, theta: dict[str, float], first_K: dict[str, float],
+              criteria: Criteria) -> Start:
+    """The start of a run whose first samples are ``first_K``, for the grey box ``gb`` at
+    ``theta`` (the spec's values: module docstring)."""
+    readings = gb.start_readings(theta)
+
+    def misfit(tau: float) -> dict[str, float]:
+        y = readings(tau)
+        return {c: (v - y[c]) / TOLERANCE[c] for c, v in first_K.items() if c in y}
+
+    def cost(tau: float) -> float:
+        return float(sum(v * v for v in misfit(tau).values()))
+
+    uniform = misfit(0.0)
+    if not uniform or max(abs(v) for v in uniform.values()) <= criteria.start_within_tolerances:
+        return Start(first_K, uniform, uniform, 0.0, criteria.start_within_tolerances)
+    step = float(np.median(np.diff(gb.inputs.grid_s)))
+    decades = np.log10(criteria.prehistory_max_s / step)
+    taus = np.r_[0.0, np.geomspace(step, criteria.prehistory_max_s,
+                                   max(int(decades * _PER_DECADE), 2))]
+    costs = [cost(t) for t in taus]
+    i = int(np.argmin(costs))
+    if costs[i] >= costs[0] * (1.0 - 1e-9):  # no gain beyond rounding: the uniform start
+        i = 0
+    best = float(taus[i])
+    if 0 < i < len(taus) - 1:  # refined in log tau between the neighbours
+        res = minimize_scalar(lambda u: cost(float(np.exp(u))),
+                              bounds=(np.log(max(taus[i - 1], step)), np.log(taus[i + 1])),
+                              method="bounded", options={"xatol": 1e-3})
+        if res.fun < costs[i]:
+            best = float(np.exp(res.x))
+    return Start(first_K, uniform, misfit(best), best, criteria.start_within_tolerances)

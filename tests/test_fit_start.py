@@ -1,0 +1,149 @@
+"""Where a bench run starts (compare.fit.start): the grey box and the FEM start from the
+first operating point held for a prehistory where the first samples contradict a uniform
+start at the room's temperature. And what the run's header says of the spindle."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from compare.fit.criteria import Criteria
+from compare.fit.greybox import GreyBox
+from compare.fit.params import default_theta
+from compare.fit.start import first_samples, run_start
+from spindle.bench import read_bench
+from spindle.bench_inputs import Inputs, interval_inputs
+from spindle.drive import drive_for
+from spindle.spec_reader import load_spec
+from tests.test_bench import PEER_RUNS
+
+SPEC = load_spec("spl2782")
+
+
+def _inputs(n: int = 120, speed_rpm: float = 4000.0, T_cool_K: float = 291.15) -> Inputs:
+    """Two hours at ``speed_rpm`` in a 20 °C room, the coolant at ``T_cool_K``."""
+    grid = np.arange(0.0, 60.0 * n + 1.0, 60.0)
+    return Inputs(grid, np.full(n, speed_rpm), np.full(n, 2.0), np.zeros(n),
+                  np.full(n, 293.15), np.full(n, T_cool_K))
+
+
+@pytest.mark.parametrize("speed_rpm", [0.0, 4000.0])
+def test_the_prehistory_is_the_first_interval_held_that_long(speed_rpm):
+    """The grey box on inputs with a prehistory of 3 h reads what the same model reads on
+    a run that begins with the first interval held for 3 h, from that run's 3 h on: the
+    ordinary step recursion, an independent path to the exact modal step of
+    GreyBox._start. Exact to rounding (1e-9 K, 1e-12 m)."""
+    tau = 3 * 3600.0
+    inputs = _inputs(speed_rpm=speed_rpm)
+    n = len(inputs.grid_s) - 1
+
+    def first(x: np.ndarray) -> np.ndarray:
+        return np.r_[x[0], x]
+
+    longer = Inputs(np.r_[-tau, inputs.grid_s], *(first(getattr(inputs, k)) for k in (
+        "speed_rpm", "power_kW", "load_torque_Nm", "T_env_K", "T_coolant_K")))
+    drive = drive_for(SPEC)
+    held = GreyBox(SPEC, drive, replace(inputs, prehistory_s=tau)).simulate({})
+    ref = GreyBox(SPEC, drive, longer).simulate({})
+    for c in ("T1", "T2", "T_stator"):
+        np.testing.assert_allclose(held[c], ref[c][1:], rtol=0, atol=1e-9)
+        assert abs(held[c][0] - 293.15) > 0.5  # it did move the start
+    np.testing.assert_allclose(held["P1"], ref["P1"][1:] - ref["P1"][1], rtol=0, atol=1e-12)
+    assert len(held["T1"]) == n + 1
+
+
+def test_no_prehistory_is_the_uniform_start():
+    """prehistory_s = 0 starts every mass at the room's first temperature."""
+    gb = GreyBox(SPEC, drive_for(SPEC), _inputs())
+    y = gb.simulate({})
+    assert all(y[c][0] == 293.15 for c in ("T1", "T2", "T_stator"))
+
+
+def _start(path):
+    run = read_bench(path)
+    inputs = interval_inputs(run, 60.0)
+    gb = GreyBox(SPEC, drive_for(SPEC), inputs)
+    return run_start(gb, default_theta(gb.parameters()),
+                     first_samples(run, run.channels, inputs.grid_s), Criteria())
+
+
+def test_a_run_soaked_by_its_coolant_starts_from_the_soak():
+    """The peer's dev2-06 starts with every sensor 1.7-2.0 K below the room, at the
+    coolant's temperature (chilled overnight): beyond the tolerance of 1 K
+    (Criteria.start_within_tolerances) from a uniform start. The start read from its first
+    samples leaves each channel within 0.5 K: the spec's model at rest with that coolant,
+    half a tolerance being the material_peak of the criteria table."""
+    start = _start(PEER_RUNS / "bench-runs-2" / "dev2-06.csv")
+    assert min(start.uniform_misfit.values()) < -1.0
+    assert start.prehistory_s > 3600.0
+    assert max(abs(v) for v in start.misfit.values()) < 0.5
+    assert "does not start at the room's temperature" in start.text()
+
+
+def test_a_run_whose_first_samples_agree_keeps_the_uniform_start():
+    """dev-03's coolant starts 2.9 K below the room but its sensors within 0.6 K of it (the
+    coolant not yet flowing): the uniform start agrees with the samples within the
+    tolerance, and is kept (the soak would miss them by 2.3 K)."""
+    start = _start(PEER_RUNS / "bench-runs" / "dev-03.csv")
+    assert start.prehistory_s == 0.0 and start.text() == ""
+    assert max(abs(v) for v in start.uniform_misfit.values()) <= 1.0
+
+
+def test_the_fem_starts_from_the_same_prehistory():
+    """compare.fit.discrepancy.fem_readings with a prehistory of 2 h reads what the FEM
+    reads on the run that begins with the first interval held for 2 h, from 2 h on: the
+    same backward Euler steps of 60 s either way (below discrepancy.PREHISTORY_STEPS), so
+    equal to the factorisation's rounding (1e-8 K)."""
+    from compare.fit.discrepancy import fem_readings
+    from reference import ReferenceModel
+
+    tau = 7200.0
+    inputs = _inputs(n=20, speed_rpm=4000.0)
+    gb = GreyBox(SPEC, drive_for(SPEC), inputs)
+    src = gb.sources(1.0, 0.5)
+
+    def first(x: np.ndarray) -> np.ndarray:
+        return np.r_[np.full(120, x[0]), x]
+
+    longer = Inputs(np.r_[np.arange(-tau, 0.0, 60.0), inputs.grid_s],
+                    *(first(getattr(inputs, k)) for k in ("speed_rpm", "power_kW",
+                                                          "load_torque_Nm", "T_env_K",
+                                                          "T_coolant_K")))
+    ref = ReferenceModel(SPEC, 0)
+    held = fem_readings(ref, SPEC, replace(inputs, prehistory_s=tau),
+                        {k: v for k, v in src.items()}, ["T1", "T_stator"])
+    whole = fem_readings(ref, SPEC, longer, {k: first(v) for k, v in src.items()},
+                         ["T1", "T_stator"])
+    for c in ("T1", "T_stator"):
+        np.testing.assert_allclose(held[c], whole[c][120:], rtol=0, atol=1e-8)
+        assert held[c][0] - 293.15 > 0.5
+
+
+def test_a_start_no_prehistory_reaches_is_said():
+    """A log begun at rest on a spindle 5 K above a room the coolant matches (stopped after
+    a run: cooling): at rest the first operating point holds every mass at the room, so no
+    prehistory reaches the samples; the start stays uniform and the warning says the first
+    hours' misfit is partly the start's."""
+    inputs = _inputs(speed_rpm=0.0, T_cool_K=293.15)
+    gb = GreyBox(SPEC, drive_for(SPEC), replace(inputs, power_kW=np.zeros(120)))
+    start = run_start(gb, default_theta(gb.parameters()),
+                      {"T1": 298.15, "T2": 298.15, "T_stator": 298.15}, Criteria())
+    assert not start.reached and start.prehistory_s == 0.0
+    assert "no time at the run's first operating point reaches" in start.text()
+
+
+def test_a_run_of_another_spindle_is_warned_of():
+    """A run whose ``# spindle:`` line names another spindle than the spec it is fitted with
+    gets a warning (fuzzing round 5 found none); one naming the spec, or a peer's "SPL2782-
+    family spindle (not identical to the shipped spl2782 spec)", gets none."""
+    from compare.fit.run import _other_spindle
+
+    def run(named):
+        return replace(read_bench(PEER_RUNS / "bench-runs-2" / "dev2-06.csv"),
+                       metadata={"spindle": named} if named else {})
+
+    assert "names the spindle 'spl9999'" in _other_spindle(run("spl9999"), SPEC)
+    assert _other_spindle(run("SPL2782"), SPEC) == ""
+    assert _other_spindle(run("SPL2782-family spindle (not identical to the shipped spl2782 "
+                              "spec)"), SPEC) == ""
+    assert _other_spindle(run(None), SPEC) == ""
