@@ -153,6 +153,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--json", type=Path, help="write the rows to this JSON file")
     ap.add_argument("--rows", type=Path, help="summarise these rows (no fitting)")
     ap.add_argument("--summary", type=Path, help="also write the summary to this file")
+    ap.add_argument("--arms", nargs="+", choices=list(ARMS), default=list(ARMS),
+                    help="fit these starts only (default: both)")
     args = ap.parse_args(argv)
     if args.rows:
         rows = json.loads(args.rows.read_text(encoding="utf-8"))
@@ -166,7 +168,7 @@ def main(argv: list[str] | None = None) -> None:
             if not cut_path(c).exists():
                 cut_path(c).parent.mkdir(exist_ok=True)
                 cut_run(CACHE / f"{c.family}-{c.seed}.csv", cut_path(c), c.cut_s)
-        jobs = [replace(c, arm=arm) for c in cases(args.runs) for arm in ARMS]
+        jobs = [replace(c, arm=arm) for c in cases(args.runs) for arm in args.arms]
         rows = run_verdicts(
             one, jobs, workers=args.workers, header="cut run, start: truth -> verdict",
             line=lambda r: f"  {r['run']}, {r['arm']}: {r['truth']} -> {r['verdict']} "

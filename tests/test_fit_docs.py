@@ -54,7 +54,8 @@ def test_the_criteria_rows_are_the_table_the_fit_runs_with():
 
 @pytest.mark.parametrize("block, name", [("families", "fit-families.txt"),
                                          ("held-out", "fit-families-held-out.txt"),
-                                         ("perturb", "perturb-peers.txt")])
+                                         ("perturb", "perturb-peers.txt"),
+                                         ("start", "fit-start.txt")])
 def test_the_generalisation_figures_are_the_benchmarks_file(block, name):
     generated = (ROOT / "docs" / "figures" / name).read_text(encoding="utf-8")
     block = _block(block).strip()

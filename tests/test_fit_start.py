@@ -147,3 +147,20 @@ def test_a_run_of_another_spindle_is_warned_of():
     assert _other_spindle(run("SPL2782-family spindle (not identical to the shipped spl2782 "
                               "spec)"), SPEC) == ""
     assert _other_spindle(run(None), SPEC) == ""
+
+
+def test_a_moved_start_is_calibrated_from_its_estimate():
+    """A moved start's prehistory is a parameter of the grey box (compare.fit.params.PREHISTORY,
+    in hours, without a prior), calibrated with the base from the first samples' estimate:
+    its default is that estimate, and a value set in theta is the prehistory simulated. A
+    uniform start has no such parameter."""
+    from compare.fit.params import PREHISTORY
+
+    inputs = _inputs()
+    drive = drive_for(SPEC)
+    assert PREHISTORY.name not in GreyBox(SPEC, drive, inputs).parameters()
+    moved = GreyBox(SPEC, drive, replace(inputs, prehistory_s=7200.0))
+    p = moved.parameters()[PREHISTORY.name]
+    assert p.default == 2.0 and p.prior_sd is None and p.unit == "h"
+    three = GreyBox(SPEC, drive, replace(inputs, prehistory_s=3 * 3600.0)).simulate({})
+    np.testing.assert_array_equal(moved.simulate({PREHISTORY.name: 3.0})["T1"], three["T1"])

@@ -36,7 +36,7 @@ import numpy as np
 
 from compare.fit.effects import LIBRARY, effect_of
 from compare.fit.greybox import GreyBox
-from compare.fit.params import BASE_PARAMS, EXTRA_BASE_PARAMS, Param
+from compare.fit.params import BASE_PARAMS, EXTRA_BASE_PARAMS, PREHISTORY, Param
 from compare.forked import ForkedColumns
 from compare.residuals import effective_samples
 from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
@@ -397,7 +397,7 @@ def at_bound(fit: Fit, effect_label: str, rel: float) -> list[str]:
 
 
 def parameters_table(fit: Fit) -> list[dict]:
-    params = {**BASE_PARAMS, **EXTRA_BASE_PARAMS,
+    params = {**BASE_PARAMS, **EXTRA_BASE_PARAMS, PREHISTORY.name: PREHISTORY,
               **{p.name: p for e in LIBRARY.values() for p in e.params}}
     rows = []
     for k in fit.free:

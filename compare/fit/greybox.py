@@ -11,11 +11,12 @@ its sensor reads). Labels name the effects, with the channel of a per-channel on
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from dataclasses import replace as dc_replace
 
 import numpy as np
 
 from compare.fit.effects import effect_of, parse_label
-from compare.fit.params import EXTRA_BASE_PARAMS, Param, base_params
+from compare.fit.params import EXTRA_BASE_PARAMS, PREHISTORY, Param, base_params
 from lumped.blocks import Convection, FixedTemperature, varies_with_speed
 from lumped.build import build_network
 from lumped.simulation import LumpedModel
@@ -111,6 +112,9 @@ class GreyBox:
     def parameters(self) -> dict[str, Param]:
         out = base_params(self.drive)
         out.update({k: EXTRA_BASE_PARAMS[k] for k in self.base_extra})
+        if self.inputs.prehistory_s > 0:  # a moved start (compare.fit.start)
+            out[PREHISTORY.name] = dc_replace(PREHISTORY, default=min(max(
+                self.inputs.prehistory_s / 3600.0, PREHISTORY.lo), PREHISTORY.hi))
         for e, _ in self._effects():
             for p in e.params:
                 out[p.name] = p
@@ -259,7 +263,6 @@ class GreyBox:
     def _model(self, theta: dict[str, float]) -> LumpedModel:
         """The structure's model with this parameter set's conductances (a new
         ThermalSystem over the same network; nothing is rebuilt)."""
-        from dataclasses import replace as dc_replace
 
         model, edge_group, handles = self._structure()
         base = model.system
@@ -375,7 +378,9 @@ class GreyBox:
         U = self._input_matrix(th, sys)
         m = len(sys.source_names)
         n_K = self.conductance_speeds()
-        x = (self._start(sys, U[0], float(n_K[0]), inp.prehistory_s) if x0_K is None
+        prehistory_s = (3600.0 * th[PREHISTORY.name] if PREHISTORY.name in th
+                        else inp.prehistory_s)
+        x = (self._start(sys, U[0], float(n_K[0]), prehistory_s) if x0_K is None
              else np.full(sys.n_states, x0_K))
         names = [n for n in model.sensor_names if n in CHANNELS]
         rows = [model.S[model.sensor_names.index(n)] for n in names]

@@ -16,11 +16,13 @@ name                    meaning                                                b
 ``heat_capacity``       factor on every heat capacity of the network           0.1 .. 3
 ``friction_exponent``   bearing friction x (n / 3000 rpm)^e                    -1 .. 1
 ``axial_scale``         the spindle's axial lengths x (default on)             0.8 .. 1.25
+``prehistory_h``        a moved start's prehistory [h] (compare.fit.start)     1/60 .. 48
 ======================  =====================================================  ===========
 
-The last four are extras (``fit --base-extra``); G_seat_W_K, axial_scale and
-friction_exponent are calibrated by default (:data:`DEFAULT_BASE_EXTRA`). An effect's own
-parameters are declared by the effect (compare.fit.effects).
+``heat_capacity`` to ``axial_scale`` are extras (``fit --base-extra``); G_seat_W_K,
+axial_scale and friction_exponent are calibrated by default (:data:`DEFAULT_BASE_EXTRA`).
+``prehistory_h`` is calibrated on a run whose start moved (:data:`PREHISTORY`). An effect's
+own parameters are declared by the effect (compare.fit.effects).
 """
 
 from __future__ import annotations
@@ -98,6 +100,14 @@ EXTRA_BASE_PARAMS: dict[str, Param] = {p.name: p for p in (
           "capacities x s, the growth chain x s", prior_sd=0.15, source="lengths a designer "
           "reconstructs from CAD drawings (bearing spacing, motor and housing) to 10-20 %"),
 )}
+
+#: the start of a run whose first samples moved it (compare.fit.start): its prehistory,
+#: calibrated with the base from the first samples' estimate (GreyBox.parameters gives that
+#: as the default); the upper bound is Criteria.prehistory_max_s's default
+PREHISTORY = Param("prehistory_h", "h", 1.0, 1.0 / 60.0, 48.0, "the run's first operating "
+                   "point held this long before the log, from the room's temperature",
+                   source="the first samples' estimate (compare.fit.start) as its start, no "
+                   "prior: the run's first hours decide")
 
 #: the extras calibrated by default (``fit`` without ``--base-extra``). heat_capacity is not:
 #: it takes up part of a bearing preload and, on a peer's runs, lowered the validation error

@@ -7,8 +7,11 @@ that start. Where one of them misses it by more than ``Criteria.start_within_tol
 the model starts instead from the run's first operating point (speed, power, room and
 coolant of its first interval) held for a time tau before the log, from the room's
 temperature. tau = 0 is the uniform start; a long tau is that point's steady state (a soak at
-rest, or a spindle that ran there). tau is the one value that best reproduces the first
-samples of the temperature channels, with the spec's model (docs/fit.md, step 1).
+rest, or a spindle that ran there). tau is first the one value that best reproduces the first
+samples of the temperature channels with the spec's model; the FEM anchor starts from it, and
+the grey box calibrates it with the base parameters from there (compare.fit.params.PREHISTORY):
+the first hours' relaxation says more of the unsensed slow masses than three first samples
+(docs/fit.md, step 1; docs/fit-history.md, "2026-11-29 (17)").
 """
 
 from __future__ import annotations
