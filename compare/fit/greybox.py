@@ -363,7 +363,7 @@ class GreyBox:
 
         return readings
 
-    def simulate(self, theta: dict[str, float], x0_K: float | None = None,
+    def simulate(self, theta: dict[str, float],
                  extra_rows: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
         """Channel values at the grid points [K; m for P1] for parameters ``theta`` (missing
         names take their defaults). Zero-order hold over each interval, exact.
@@ -380,8 +380,7 @@ class GreyBox:
         n_K = self.conductance_speeds()
         prehistory_s = (3600.0 * th[PREHISTORY.name] if PREHISTORY.name in th
                         else inp.prehistory_s)
-        x = (self._start(sys, U[0], float(n_K[0]), prehistory_s) if x0_K is None
-             else np.full(sys.n_states, x0_K))
+        x = self._start(sys, U[0], float(n_K[0]), prehistory_s)
         names = [n for n in model.sensor_names if n in CHANNELS]
         rows = [model.S[model.sensor_names.index(n)] for n in names]
         has_p1 = "P1" in model.chain.rows
