@@ -255,6 +255,12 @@ def test_resample_leaves_gaps_empty():
     np.testing.assert_allclose(r[g <= 540], g[g <= 540] * 0.01)
 
 
+# slow: about 21 s. The default run keeps the same synthetic run (fixture_expansion, seed 2)
+# fitted with the same two candidates by tests/test_examples.py::
+# test_ex03_fit_bench_run_two_candidates, and the command line's fit by
+# tests/test_adequacy.py; this one adds the command line's synth, the hidden truth and the
+# report's windows
+@pytest.mark.slow
 def test_synth_then_fit_end_to_end(tmp_path, capsys):
     """A FEM (level 0) run with fixture_expansion, in the bench format, fitted by the command
     line: the report names the effect; the truth sidecar is never read by fit."""
