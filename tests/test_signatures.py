@@ -629,6 +629,9 @@ def test_ramped_cycle_ramps_within_each_speed_step():
     assert all(s.load_torque_Nm == 0.0 for s in plain.steps)
 
 
+# slow: about 14 s, two base calibrations. The default run keeps the same test on synthetic
+# loaded runs (the tests above and below); tests/test_peer_runs.py fits these two runs whole
+@pytest.mark.slow
 def test_coolant_signature_on_the_peer_loaded_runs():
     """The peer's loaded pair: the coolant run's rings follow the motor's loss beyond the
     rotor's path (significant at 1 %), the control's do not (its base-structure bias, R

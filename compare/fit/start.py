@@ -53,9 +53,11 @@ class Start:
                 f"{self.uniform_misfit[worst] * TOLERANCE[worst]:+.1f} K from a uniform start")
         if self.prehistory_s > 0:
             text += (", so the model starts from the run's first operating point held for "
-                     f"{self.prehistory_s / 3600:.2f} h before the log, which leaves "
+                     "a prehistory before the log: read from the first samples as "
+                     f"{self.prehistory_s / 3600:.2f} h, which leaves "
                      + ", ".join(f"{c} {v * TOLERANCE[c]:+.2f} K"
-                                 for c, v in self.misfit.items()) + " at the first samples")
+                                 for c, v in self.misfit.items())
+                     + " there, and calibrated with the base from it (prehistory_h)")
         if not self.reached:
             text += ("; no time at the run's first operating point reaches the logged start, "
                      "so part of the first hours' misfit is the start's")
