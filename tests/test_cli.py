@@ -86,14 +86,16 @@ def test_solve_cycle(tmp_path, capsys):
     ("time_s,Q1_rear_bearing_A_W\n0,-5000\n10,0\n", "-5000 W is outside 0..1e+06 W"),
     ("time_s,Q1_rear_bearing_A_W\n0,1e300\n10,0\n", "1e+300 W is outside 0..1e+06 W"),
 ])
-def test_bad_cycle_exits_2(tmp_path, content, words):
+def test_bad_cycle_exits_2(tmp_path, capsys, content, words):
+    # in-process (compare.cli.main, as the command runs it): a Python process a case cost
+    # 2 s each; the command's own process is the other tests' run()
     cycle = tmp_path / "bad.csv"
     cycle.write_text(content)
-    r = run("solve", "fin-shaft", "--level", "0", "--cycle", str(cycle), "--out",
-            str(tmp_path / "o"))
-    assert r.returncode == 2
-    assert words in r.stderr and "Traceback" not in r.stderr
-    assert "bad.csv" in r.stderr and "fix:" in r.stderr
+    assert main(["solve", "fin-shaft", "--level", "0", "--cycle", str(cycle), "--out",
+                 str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert words in err and "Traceback" not in err
+    assert "bad.csv" in err and "fix:" in err
     assert not (tmp_path / "o").exists()
 
 
@@ -118,11 +120,12 @@ def test_bad_option_exits_2(tmp_path):
     (["none", "G_seat_W_K"], "none with other parameters"),
     (["seat"], "invalid choice"),
 ])
-def test_fit_bad_base_extra_exits_2(tmp_path, extra, words):
-    r = run("fit", str(tmp_path / "run.csv"), "--base-extra", *extra, "--out",
-            str(tmp_path / "o"))
-    assert r.returncode == 2 and "--base-extra" in r.stderr and words in r.stderr
-    assert "Traceback" not in r.stderr and not (tmp_path / "o").exists()
+def test_fit_bad_base_extra_exits_2(tmp_path, capsys, extra, words):
+    assert main(["fit", str(tmp_path / "run.csv"), "--base-extra", *extra, "--out",
+                 str(tmp_path / "o")]) == 2  # in-process, as test_bad_cycle_exits_2
+    err = capsys.readouterr().err
+    assert "--base-extra" in err and words in err
+    assert "Traceback" not in err and not (tmp_path / "o").exists()
 
 
 def test_fit_refuses_a_loaded_run_without_its_torque_before_any_fitting(tmp_path):
