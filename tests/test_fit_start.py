@@ -164,3 +164,33 @@ def test_a_moved_start_is_calibrated_from_its_estimate():
     assert p.default == 2.0 and p.prior_sd is None and p.unit == "h"
     three = GreyBox(SPEC, drive, replace(inputs, prehistory_s=3 * 3600.0)).simulate({})
     np.testing.assert_array_equal(moved.simulate({PREHISTORY.name: 3.0})["T1"], three["T1"])
+
+
+def test_a_moved_start_is_said_to_be_one():
+    """Start.moved: a first sample beyond Criteria.start_within_tolerances of the uniform
+    start, and only then a warning."""
+    from compare.fit.start import Start
+
+    assert Start({}, {"T1": -1.2}, {"T1": 0.1}, 3600.0).moved
+    quiet = Start({}, {"T1": 0.9, "T2": -0.5}, {"T1": 0.9, "T2": -0.5}, 0.0)
+    assert not quiet.moved and quiet.text() == ""
+
+
+@pytest.mark.slow  # about 15 s; the tests above cover the start's pieces
+def test_a_control_logged_on_a_running_spindle_fits_as_its_unedited_run(tmp_path):
+    """The peer's clean control dev-06 without its first 2 h (fuzzing round 5's c36: the
+    bearings 1.9 K warm at 3000 rpm) was "unexplained" with the uniform start; with the start
+    read it is "base adequate", as the unedited run (measured 2026-11-29: P1's validation
+    RMS 0.47 um)."""
+    import sys
+
+    from compare.fit.run import run_fit
+
+    sys.path.insert(0, str(PEER_RUNS.parents[2] / "benchmarks"))
+    from bench_start import cut_run
+
+    cut = tmp_path / "dev-06-cut.csv"
+    cut_run(PEER_RUNS / "bench-runs" / "dev-06.csv", cut, 7200.0)
+    doc = run_fit(cut, SPEC).to_dict()
+    assert doc["start"]["prehistory_s"] > 0
+    assert doc["verdict"]["kind"] == "base adequate", doc["verdict"]

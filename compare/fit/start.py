@@ -46,7 +46,7 @@ class Start:
 
     def text(self) -> str:
         """The warning for a start off the uniform one ("" where the first samples agree)."""
-        if all(abs(v) <= self.within for v in self.uniform_misfit.values()):
+        if not self.moved:
             return ""
         worst = max(self.uniform_misfit, key=lambda c: abs(self.uniform_misfit[c]))
         text = (f"the run does not start at the room's temperature: {worst}'s first sample is "
@@ -62,6 +62,11 @@ class Start:
             text += ("; no time at the run's first operating point reaches the logged start, "
                      "so part of the first hours' misfit is the start's")
         return text + " (compare.fit.start)"
+
+    @property
+    def moved(self) -> bool:
+        """Whether the first samples contradict the uniform start (beyond ``within``)."""
+        return any(abs(v) > self.within for v in self.uniform_misfit.values())
 
     @property
     def reached(self) -> bool:
