@@ -197,11 +197,12 @@ def test_solve_lumped_steady_and_cycle(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("nodes", ["1", "paper7"])
-def test_bad_node_count_exits_2(tmp_path, nodes):
-    r = run("solve", "fin-shaft", "--model", "lumped", "--nodes", nodes, "--out",
-            str(tmp_path / "x"))
-    assert r.returncode == 2 and "--nodes" in r.stderr and "fix:" in r.stderr
-    assert "Traceback" not in r.stderr and not (tmp_path / "x").exists()
+def test_bad_node_count_exits_2(tmp_path, capsys, nodes):
+    assert main(["solve", "fin-shaft", "--model", "lumped", "--nodes", nodes, "--out",
+                 str(tmp_path / "x")]) == 2  # in-process, as test_bad_cycle_exits_2
+    err = capsys.readouterr().err
+    assert "--nodes" in err and "fix:" in err
+    assert "Traceback" not in err and not (tmp_path / "x").exists()
 
 
 def test_crosscheck_is_a_command():
@@ -317,22 +318,24 @@ def test_the_lumped_model_refuses_a_surface_that_selects_nothing_as_the_fem_does
 
 
 @pytest.mark.parametrize("option", ["--out", "--cycle", "--case"])
-def test_an_empty_option_is_refused_not_taken_for_its_default(tmp_path, option):
+def test_an_empty_option_is_refused_not_taken_for_its_default(tmp_path, capsys, option):
     """`--out "$DIR"` with DIR unset wrote into the default folder; an empty --cycle or --case
-    was ignored: each is named, exit 2."""
-    r = run("solve", "fin-shaft", "--model", "lumped", option, "")
-    assert r.returncode == 2 and f"{option}: is empty" in r.stderr and "fix:" in r.stderr
+    was ignored: each is named, exit 2 (in-process, as test_bad_cycle_exits_2)."""
+    assert main(["solve", "fin-shaft", "--model", "lumped", option, ""]) == 2
+    err = capsys.readouterr().err
+    assert f"{option}: is empty" in err and "fix:" in err
 
 
 @pytest.mark.parametrize("spec, option, value", [("fin-shaft", "--cycle", "spl-16h"),
                                                  ("spl2782", "--case", "nominal")])
-def test_a_speed_beside_a_cycle_is_refused_not_ignored(tmp_path, spec, option, value):
+def test_a_speed_beside_a_cycle_is_refused_not_ignored(tmp_path, capsys, spec, option, value):
     """`solve --cycle C --speed N` ran the cycle at its own speeds and said nothing of N;
     `solve spl2782 --case nominal --speed 1000` solved at 1000 rpm with the 5146 W of the
-    nominal 4300 rpm (found by fuzzing)."""
-    r = run("solve", spec, "--model", "lumped", option, value, "--speed", "1000",
-            "--out", str(tmp_path / "o"))
-    assert r.returncode == 2 and "--speed:" in r.stderr and "drop --speed" in r.stderr
+    nominal 4300 rpm (found by fuzzing). In-process, as test_bad_cycle_exits_2."""
+    assert main(["solve", spec, "--model", "lumped", option, value, "--speed", "1000",
+                 "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "--speed:" in err and "drop --speed" in err
     assert not (tmp_path / "o").exists()
 
 
