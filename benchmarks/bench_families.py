@@ -47,7 +47,14 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from verdicts import fit_outcome, judge_verdict, missed_by, named_text, run_verdicts
+from verdicts import (
+    fit_outcome,
+    judge_verdict,
+    missed_by,
+    named_text,
+    run_verdicts,
+    within_tolerances,
+)
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
@@ -134,7 +141,6 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
     from compare.fit.run import run_fit
     from compare.synth.bench import synth
     from spindle.spec_reader import load_spec
-    from spindle.tolerances import channel_tolerance, edge_scale
 
     spec = load_spec(case.spec)
     data_spec = spec
@@ -185,8 +191,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
                                                 encoding="utf-8"))
     out = fit_outcome(doc)
     verdict = judge_verdict(truth, out["named_plain"], out["unexplained"])
-    rms_ok = all(v <= channel_tolerance(c) * edge_scale(c)
-                 for c, v in out["validation_rmse"].items())
+    rms_ok = within_tolerances(out["validation_rmse"])
     return {"family": case.family, "run": case.label, "truth": truth,
             "named": out["named"], "verdict": out["verdict"],
             "unexplained": out["unexplained"], **verdict,

@@ -22,8 +22,8 @@ import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from bench_families import FAMILIES, wilson
-from verdicts import fit_outcome, judge_verdict, run_verdicts
+from bench_families import FAMILIES, rate_line
+from verdicts import fit_outcome, judge_verdict, run_verdicts, within_tolerances
 
 import compare.entry  # noqa: F401  (one BLAS thread, as the spindle-verify command runs)
 
@@ -41,9 +41,9 @@ def cut_run(src: Path, dst: Path, cut_s: float) -> None:
     head = [ln for ln in lines if ln.startswith("#") and not ln.startswith("# rows:")]
     rows = [ln for ln in lines if not ln.startswith("#")]
     header, data = rows[0], rows[1:]
-    kept = [ln for ln in data if float(ln.split(",", 1)[0]) >= cut_s]
-    t0 = float(kept[0].split(",", 1)[0])
-    out = [f"{float(ln.split(',', 1)[0]) - t0:.2f},{ln.split(',', 1)[1]}" for ln in kept]
+    rows = [(float(t), rest) for t, rest in (ln.split(",", 1) for ln in data)]
+    kept = [(t, rest) for t, rest in rows if t >= cut_s]
+    out = [f"{t - kept[0][0]:.2f},{rest}" for t, rest in kept]
     dst.write_text("\n".join([*head, header, *out]) + "\n", encoding="utf-8")
 
 
@@ -93,24 +93,17 @@ def one(job: Job) -> dict:
                   criteria=Criteria().with_options(**dict(ARMS[job.arm])))
     doc = rep.to_dict()
     out = fit_outcome(doc)
-    from spindle.tolerances import channel_tolerance, edge_scale
-
     return {**case, "run": dst.stem, "truth": truth, "named": out["named"],
             "verdict": out["verdict"],
             **judge_verdict(truth, out["named_plain"], out["unexplained"]),
-            "rms_within_tolerance": all(v <= channel_tolerance(c) * edge_scale(c)
-                                        for c, v in out["validation_rmse"].items()),
+            "rms_within_tolerance": within_tolerances(out["validation_rmse"]),
             "validation_rmse": out["validation_rmse"],
             "prehistory_s": (doc.get("start") or {}).get("prehistory_s"), "fit_s": rep.runtime_s}
 
 
 def rates(rows: list[dict]) -> list[str]:
     def line(label: str, hit, of) -> str:
-        sel = [r for r in rows if of(r)]
-        k = sum(bool(hit(r)) for r in sel)
-        p, lo, hi = wilson(k, len(sel))
-        return (f"  {label:<44} {k:3d} of {len(sel):3d}  {100 * p:5.1f} %  "
-                f"[{100 * lo:5.1f}, {100 * hi:5.1f}]")
+        return rate_line(label, rows, hit, of)
 
     effect = lambda r: r["kind"] in ("effect", "effects")  # noqa: E731
     return [line("true effect named first", lambda r: r["first"], effect),
@@ -124,6 +117,12 @@ def rates(rows: list[dict]) -> list[str]:
                  lambda r: r["verdict"] in ("named", "base adequate"))]
 
 
+def _said(row: dict) -> str:
+    """A fit's verdict and names, and whether it was right."""
+    return (f"{row['verdict']} {','.join(row['named'])}".strip()
+            + (" (right)" if row["right"] else ""))
+
+
 def summary(rows: list[dict]) -> list[str]:
     out = [f"runs: {len({r['run'] for r in rows})} cut runs, each fitted with both starts"]
     for arm in ARMS:
@@ -132,17 +131,11 @@ def summary(rows: list[dict]) -> list[str]:
         out += [f"start {arm!r}" + (f" (moved on {moved} runs):" if arm == "read" else ":"),
                 *rates(sub)]
     by = {(r["run"], r["arm"]): r for r in rows}
-    changed = [(run, by[run, "uniform"], by[run, "read"]) for run, arm in by
+    changed = [(run, by[run, "uniform"], r) for (run, arm), r in by.items()
                if arm == "read" and (run, "uniform") in by
-               and by[run, "uniform"]["named"] != by[run, "read"]["named"]
-               or arm == "read" and (run, "uniform") in by
-               and by[run, "uniform"]["verdict"] != by[run, "read"]["verdict"]]
+               and _said(by[run, "uniform"]) != _said(r)]
     out.append(f"verdicts changed ({len(changed)}): run, truth: uniform -> read")
-    for run, u, r in changed:
-        def said(x: dict) -> str:
-            return f"{x['verdict']} {','.join(x['named'])}".strip() + (" (right)" if x["right"]
-                                                                         else "")
-        out.append(f"  {run}, {r['truth']}: {said(u)} -> {said(r)}")
+    out += [f"  {run}, {r['truth']}: {_said(u)} -> {_said(r)}" for run, u, r in changed]
     return out
 
 

@@ -39,6 +39,13 @@ def fit_outcome(doc: dict) -> dict:
                                 .items()}}
 
 
+def within_tolerances(rmse: dict[str, float]) -> bool:
+    """Whether every channel's RMS [K; µm for P1] is within its tolerance."""
+    from spindle.tolerances import channel_tolerance, edge_scale
+
+    return all(v <= channel_tolerance(c) * edge_scale(c) for c, v in rmse.items())
+
+
 def judge_verdict(truth, named: list[str], unexplained: bool) -> dict:
     """How a fit's verdict compares with a run's truth: ``truth`` is None or "none" (a
     control), "unexplained" or the name of a cause outside the library, an effect's name, or

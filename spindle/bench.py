@@ -324,7 +324,7 @@ def read_bench(path: str | Path) -> BenchRun:
     extra = _read_unknown_columns(table, header)
     unknown = list(extra)
     for h in unknown:
-        hint = next((hint_for(k, [h]) for k in KNOWN_COLUMNS if hint_for(k, [h])), "")
+        hint = next((x for k in KNOWN_COLUMNS if (x := hint_for(k, [h]))), "")
         if hint:
             warnings.warn(BenchWarning(f"{name}: {h}: kept as an unknown column{hint}"), stacklevel=2)
 

@@ -378,9 +378,8 @@ class GreyBox:
         U = self._input_matrix(th, sys)
         m = len(sys.source_names)
         n_K = self.conductance_speeds()
-        prehistory_s = (3600.0 * th[PREHISTORY.name] if PREHISTORY.name in th
-                        else inp.prehistory_s)
-        x = self._start(sys, U[0], float(n_K[0]), prehistory_s)
+        # a moved start's prehistory is a parameter (parameters()); else there is none
+        x = self._start(sys, U[0], float(n_K[0]), 3600.0 * th.get(PREHISTORY.name, 0.0))
         names = [n for n in model.sensor_names if n in CHANNELS]
         rows = [model.S[model.sensor_names.index(n)] for n in names]
         has_p1 = "P1" in model.chain.rows

@@ -160,8 +160,9 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
             # placed by the spec's model, whose level on a spindle the spec only approximates
             # can be kelvins off after the gap and pull the switch to the gap's edge; placed
             # again by the calibrated model, and the base recalibrated on those inputs
-            again, moved = _place_gap_switches(run, replace(cal.gb, inputs=raw, _cache={}), measured,
-                                               channels, say, criteria, base.theta)
+            calibrated = replace(cal.gb, inputs=raw, _cache={})
+            again, moved = _place_gap_switches(run, calibrated, measured, channels, say,
+                                               criteria, base.theta)
             placed_by = "the calibrated model"
             if [m.switch_s for m in moved] != [w.switch_s for w in switches]:
                 inputs, switches = again, moved
