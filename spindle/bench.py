@@ -298,8 +298,9 @@ def read_bench(path: str | Path) -> BenchRun:
 
     Checks the structure (header, duplicate columns, required columns, one cell per column),
     every cell of the known columns (numbers, finite), ``time_s`` (present in every row,
-    >= 0, strictly increasing), plausibility (°C not kelvin, >= -60 °C; speed 0..100 000 rpm;
-    power within ±1000 kW), no required column all empty (an optional one all empty was not
+    >= 0, strictly increasing), plausibility (°C not kelvin, >= -60 °C; |speed| up to
+    100 000 rpm, a negative one read as the spindle turning in reverse; power within
+    ±1000 kW), no required column all empty (an optional one all empty was not
     measured: left out with a BenchWarning), and that there is enough data to fit
     (>= 50 rows with a measured channel over >= 30 min). Raises InputError naming the file,
     the column and/or the file line, and the fix.
@@ -319,6 +320,7 @@ def read_bench(path: str | Path) -> BenchRun:
     line_no = table.line_no
     t = _read_time(table, seen["time_s"], error)
     columns = _read_known_columns(table, seen, error, name)
+    _read_reversed(columns, name)
     _check_plausible(columns, line_no, error)
     check_room_in_celsius(columns, line_no, error)
     extra = _read_unknown_columns(table, header)
@@ -526,6 +528,27 @@ def _read_unknown_columns(table: _Table, header: list[str]) -> dict[str, np.ndar
     return extra
 
 
+def _read_reversed(columns: dict[str, np.ndarray], name: str) -> None:
+    """A drive logs its speed signed: a spindle turning in reverse (M04), or a drive that counts
+    the other direction as positive, reads negative. The losses follow |n|, and the process's
+    power M n is the same in either sign convention, so the speed is read as |n| and, where
+    it was negative, the load torque's sign turns with it (in place), with a warning."""
+    n = columns["speed_rpm"]
+    back = n < 0  # NaN (not measured) is not negative
+    if not back.any():
+        return
+    columns["speed_rpm"] = np.abs(n)
+    m = columns.get("load_torque_Nm")
+    if m is not None:
+        columns["load_torque_Nm"] = np.where(back, -m, m)
+    warnings.warn(BenchWarning(
+        f"{name}: speed_rpm: negative in {int(back.sum())} of {int(np.sum(~np.isnan(n)))} "
+        "samples: the spindle turned in reverse there (or the drive counts the other direction "
+        "as positive); its speed is read as |n|"
+        + (", and the load torque's sign turned with it (the process's power M n unchanged)"
+           if m is not None else "")), stacklevel=3)
+
+
 def _zero_P1(columns: dict[str, np.ndarray]) -> float | None:
     """Zero P1_um at its first valid sample (in place); returns that raw reading."""
     if "P1_um" not in columns:
@@ -593,10 +616,7 @@ def _check_plausible(columns: dict[str, np.ndarray], line_no: np.ndarray, error:
         if v.min() < T_MIN_C:
             raise error(f"{col} (line {first(y < T_MIN_C)})", f"{v.min():g} °C is below "
                         f"{T_MIN_C:g} °C", "check the sensor and export temperatures in °C")
-    n = columns["speed_rpm"]
-    if (n < 0).any():
-        raise error(f"speed_rpm (line {first(n < 0)})", f"{n[n < 0][0]:g} rpm is negative",
-                    "export the speed magnitude |n| [rpm]")
+    n = columns["speed_rpm"]  # |n|: _read_reversed
     if (n > SPEED_MAX_RPM).any():
         raise error(f"speed_rpm (line {first(n > SPEED_MAX_RPM)})", f"{n[n > SPEED_MAX_RPM][0]:g} "
                     f"rpm is above {SPEED_MAX_RPM:g} rpm", "export the speed in rpm (1/min); check "

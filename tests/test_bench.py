@@ -202,8 +202,8 @@ ERRORS = [
      "-80 °C is below -60 °C"),
     ("speed high", HEADER, lambda ls: ls[:7] + [row(420, speed="258000")] + ls[8:], "speed_rpm (line 9)",
      "above 100000 rpm"),
-    ("speed negative", HEADER, lambda ls: ls[:7] + [row(420, speed="-4300")] + ls[8:],
-     "speed_rpm (line 9)", "is negative"),
+    ("speed negative and high", HEADER, lambda ls: ls[:7] + [row(420, speed="-258000")] + ls[8:],
+     "speed_rpm (line 9)", "above 100000 rpm"),
     ("power in W", HEADER, lambda ls: ls[:7] + [row(420, power="1200")] + ls[8:], "power_kW (line 9)",
      "outside ±1000 kW"),
     ("power very negative", HEADER, lambda ls: ls[:7] + [row(420, power="-1500")] + ls[8:],
@@ -890,3 +890,56 @@ def test_three_running_intervals_below_the_friction_floor_are_refused(tmp_path, 
     _hour_at_4300(tmp_path, spec,
                   lambda k, i: 0.5 * floor_kW if 20 <= i < 20 + k else usual_kW,
                   ((2, False), (3, True)), "speed_rpm")
+
+
+PEER_LOADED = Path(__file__).resolve().parents[2] / "shared" / "bench-runs" / "dev-08.csv"
+
+
+def _reversed_copy(src: Path, dst: Path, torque_too: bool) -> int:
+    """``src`` with its speed negated from the middle row on (a drive that logs M04 as
+    negative), its load torque too where ``torque_too`` (a torque flange whose sign follows
+    the direction); returns the number of negative speed samples written."""
+    lines = src.read_text().splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
+    cols = lines[head].split(",")
+    js, jm = cols.index("speed_rpm"), cols.index("load_torque_Nm")
+    body = lines[head + 1:]
+    out, turned = [], 0
+    for k, ln in enumerate(body):
+        cells = ln.split(",")
+        if k >= len(body) // 2:
+            for j in (js, jm) if torque_too else (js,):
+                if cells[j] and float(cells[j]) != 0.0:
+                    turned += j == js
+                    cells[j] = repr(-float(cells[j]))
+        out.append(",".join(cells))
+    dst.write_text("\n".join(lines[:head + 1] + out) + "\n")
+    return turned
+
+
+@pytest.mark.skipif(not PEER_LOADED.exists(), reason="the peer's bench runs are not here")
+def test_a_spindle_turning_in_reverse_is_read_as_its_speed_magnitude(tmp_path, spec):
+    """A drive logs M04 as a negative speed: the format asks for the drive's speed, and a user
+    should not have to edit the export. The losses follow |n| and the process's power M n is
+    the same in either sign convention, so a run reversed half-way (speed and load torque
+    negated, as a torque flange reads) gives the original run's inputs exactly, with a
+    warning that counts the samples."""
+    back = tmp_path / "reversed.csv"
+    turned = _reversed_copy(PEER_LOADED, back, torque_too=True)
+    assert turned > 100
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        run = read_bench(back)
+    said = [str(w.message) for w in caught if issubclass(w.category, BenchWarning)]
+    assert any(f"negative in {turned} of" in m and "reverse" in m and "torque" in m
+               for m in said), said
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref = read_bench(PEER_LOADED)
+    for col in ("speed_rpm", "load_torque_Nm"):
+        np.testing.assert_array_equal(run.columns[col], ref.columns[col])
+    case, grid = inputs(run, spec)
+    case_ref, grid_ref = inputs(ref, spec)
+    np.testing.assert_array_equal(grid, grid_ref)
+    for k in case_ref.sources:
+        np.testing.assert_array_equal(case.sources[k].values, case_ref.sources[k].values)
