@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from spindle.bench_text import decoded, hint_for
+from spindle.bench_text import hint_for, text_lines
 from spindle.errors import InputError
 from spindle.sensor_faults import check_not_copies, check_room_in_celsius
 from spindle.spec import Spec
@@ -307,6 +307,9 @@ def read_bench(path: str | Path) -> BenchRun:
     """
     if not isinstance(path, str | Path):
         raise TypeError(f"a bench run is the path of its CSV file, not {type(path).__name__}")
+    if not str(path).strip():
+        raise InputError("(no file)", "run", "the path of the bench run is empty",
+                         "give the path of the run's CSV file")
     path = Path(path)
     name = str(path)
 
@@ -351,7 +354,7 @@ def _read_lines(path: Path, error: _ErrorFor) -> list[str]:
                     "check the path of the bench export") from None
     if not raw.strip():
         raise error("file", "is empty", "export the bench run again (a header row and data rows)")
-    return decoded(raw, str(path)).split("\n")
+    return text_lines(raw, str(path))
 
 
 def _comments_before_header(lines: list[str], error: _ErrorFor) -> tuple[dict[str, str], int]:
@@ -361,6 +364,8 @@ def _comments_before_header(lines: list[str], error: _ErrorFor) -> tuple[dict[st
     for k, line in enumerate(lines):
         s = line.strip()
         if not s:
+            continue
+        if s.lower().startswith("sep=") and len(s) <= 5:  # a spreadsheet's separator hint
             continue
         if s.startswith("#"):
             key, sep, value = s[1:].partition(":")
@@ -393,7 +398,9 @@ def _read_header(lines: list[str], header_idx: int,
                     "names", "put the header row (e.g. 'time_s,speed_rpm,...') before the data")
     seen: dict[str, int] = {}
     for j, h in enumerate(header):
-        if h and h in seen:
+        if h and h in seen and h not in KNOWN_COLUMNS:  # unknown columns are never an error
+            header[j] = h = f"{h} (column {j + 1})"
+        elif h and h in seen:
             raise error(f"{h} (line {hline})", f"column name appears twice (columns {seen[h] + 1} "
                         f"and {j + 1})", "keep one of the two columns or rename one")
         seen[h] = j

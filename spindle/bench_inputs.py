@@ -18,7 +18,7 @@ import numpy as np
 
 from spindle.bench import DEFAULT_GRID_S, STANDSTILL_RPM, BenchRun, BenchWarning
 from spindle.checks import omega_rad_s
-from spindle.drive import Drive, drive_for
+from spindle.drive import Drive, check_drive_feeds, drive_for
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
 from spindle.power import bearing_friction, power_balance
@@ -554,12 +554,8 @@ def inputs(run: BenchRun, spec: Spec, drive: Drive | None = None,
             f"t = {clipped[0]:g} s) the mean electrical power is below the mechanical power of the "
             "bearing friction and load torque at the held speed; the motor losses are 0 there"),
             stacklevel=2)
+    check_drive_feeds(spec, drive)
     names = [h.name for h in spec.heat_sources]
-    missing = sorted(set(heats[0]) - set(names))
-    if missing:
-        raise InputError(spec.path, "heat_sources", f"the power balance feeds sources {missing} "
-                         "that the spec does not have",
-                         "name the spec's heat sources stator, rotor, front_bearing, rear_bearing")
     rel = grid - grid[0]
     starts = tuple(float(x) for x in rel[:-1])
     sources = {k: TimeSeries.constant(0.0) for k in names}

@@ -50,3 +50,14 @@ def decoded(raw: bytes, name: str) -> str:
         raise InputError(name, f"line {line}", f"is not UTF-8 text (byte 0x{bad} at character "
                          f"{col})", "export the file as UTF-8 (a '°' or 'µ' saved as "
                          "Latin-1/Windows-1252 does this)") from None
+
+
+def text_lines(raw: bytes, name: str) -> list[str]:
+    """The lines of the file ``raw`` (:func:`decoded`): a file whose lines end in a carriage
+    return alone (a classic Mac "CSV (Macintosh)" export) is split there too, and a
+    byte-order mark at a line's start (an export with its mark appended to comments) is
+    dropped: it is no character of a name or a number."""
+    text = decoded(raw, name)
+    if "\n" not in text:
+        text = text.replace("\r", "\n")
+    return [ln[1:] if ln.startswith("\ufeff") else ln for ln in text.split("\n")]

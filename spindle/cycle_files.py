@@ -363,8 +363,7 @@ def check_cycle_limits(cycle: Cycle, file: str) -> Cycle:
     for k, s in enumerate(cycle.steps):
         if s.duration_s < STEP_MIN_S:
             raise InputError(file, f"steps[{k}].duration_s", f"{s.duration_s:g} s is shorter "
-                             f"than {STEP_MIN_S:g} s", "give step durations in seconds "
-                             "(duration_s) or hours (duration_h)")
+                             f"than {STEP_MIN_S:g} s", _durations_fix(file))
         if s.speed_rpm > SPEED_MAX_RPM:
             raise InputError(file, f"steps[{k}].speed_rpm", f"{s.speed_rpm:g} rpm is above "
                              f"{SPEED_MAX_RPM:g} rpm, faster than any motor spindle",
@@ -379,9 +378,16 @@ def check_cycle_limits(cycle: Cycle, file: str) -> Cycle:
                              "in W is 1000 times too large)")
     if cycle.duration_s > CYCLE_MAX_S:
         raise InputError(file, "duration_s", f"the steps last {cycle.duration_s / 3600:.4g} h, "
-                         f"more than {CYCLE_MAX_S / 3600:g} h", "give step durations in seconds "
-                         "(duration_s) or hours (duration_h) for a run of hours to days")
+                         f"more than {CYCLE_MAX_S / 3600:g} h",
+                         _durations_fix(file) + " for a run of hours to days")
     return cycle
+
+
+def _durations_fix(file: str) -> str:
+    """How to give a step's duration in ``file``: a step table (CSV) has duration_s only."""
+    if str(file).lower().endswith(".csv"):
+        return "give step durations in seconds (the duration_s column)"
+    return "give step durations in seconds (duration_s) or hours (duration_h)"
 
 
 def shipped_cycles() -> dict[str, Path]:

@@ -66,14 +66,24 @@ def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None,
             raise InputError(where or f"cycle {cycle.name}", f"steps[{i}]", str(exc),
                              "give the step a power_kW above its mechanical power M omega, or "
                              "leave power_kW out (the motor model then gives the losses)") from None
-    names = {h.name for h in spec.heat_sources}
-    missing = set(heats[0]) - names
-    if missing:
-        raise InputError(spec.path, "heat_sources", f"the power balance feeds sources "
-                         f"{sorted(missing)} that the spec does not have",
-                         f"name the spec's heat sources {', '.join(heats[0])}")
+    check_drive_feeds(spec, drive)
     sources = {k: TimeSeries(starts, tuple(h[k] for h in heats), "previous") for k in heats[0]}
     return cycle.to_load_case(spec, sources, others="zero")
+
+
+def check_drive_feeds(spec: Spec, drive: Drive) -> list[str]:
+    """InputError where the drive's power balance feeds a heat source the spec does not have
+    (a source renamed or left out: its watts would heat nothing); returns the spec's heat
+    sources the drive does not feed, which get 0 W (a source of the spec's own)."""
+    fed = list(drive.heat_W(0.0, 0.0, None))
+    names = [h.name for h in spec.heat_sources]
+    missing = [k for k in fed if k not in names]
+    if missing:
+        raise InputError(spec.path, "heat_sources", f"the power balance of the drive "
+                         f"'{drive.name}' feeds sources {missing} that the spec does not have",
+                         f"name the spec's heat sources {', '.join(fed)}, as the drive's "
+                         "motor and bearing sets are named")
+    return [k for k in names if k not in fed]
 
 
 def as_load_case(spec: Spec, case: LoadCase | str | Path | None) -> LoadCase:

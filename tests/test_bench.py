@@ -943,3 +943,38 @@ def test_a_spindle_turning_in_reverse_is_read_as_its_speed_magnitude(tmp_path, s
     np.testing.assert_array_equal(grid, grid_ref)
     for k in case_ref.sources:
         np.testing.assert_array_equal(case.sources[k].values, case_ref.sources[k].values)
+
+
+@pytest.mark.parametrize("name, edit", [
+    # classic Mac "CSV (Macintosh)": lines end in a carriage return alone
+    ("CR line ends", lambda text: text.replace("\n", "\r")),
+    # an export with its byte-order mark, appended to comment lines written before it
+    ("mark after comments", lambda text: "# bench: 2\n\ufeff" + text),
+    # the separator hint a spreadsheet writes as the first line
+    ("sep= line", lambda text: "sep=,\n" + text),
+])
+def test_spreadsheet_dialects_read_as_the_plain_file(tmp_path, name, edit):
+    """Three ways spreadsheets write a CSV that the format's reader had refused with a
+    misleading message ("no header row", "time_s is missing"; fuzzing round 6): each reads
+    as the plain file."""
+    plain = write(tmp_path, good_rows(), name="plain.csv")
+    other = tmp_path / "other.csv"
+    other.write_bytes(edit(plain.read_text(encoding="utf-8")).encode("utf-8"))
+    a, b = read_bench(plain), read_bench(other)
+    np.testing.assert_array_equal(a.time_s, b.time_s)
+    assert a.columns.keys() == b.columns.keys()
+    for k in a.columns:
+        np.testing.assert_array_equal(a.columns[k], b.columns[k])
+
+
+def test_an_unknown_column_twice_is_kept_twice(tmp_path):
+    """The format: unknown columns are kept and reported, never an error; a name twice is
+    kept as both, the second named by its column. A known column twice stays an error (which
+    one holds the measurement is not known)."""
+    lines = [f"{ln},{i},{2 * i}" for i, ln in enumerate(good_rows())]
+    run = read_bench(write(tmp_path, lines, header=HEADER + ",aux_V,aux_V"))
+    assert run.unknown_columns == ["aux_V", "aux_V (column 11)"]
+    assert run.extra["aux_V (column 11)"][3] == 6.0
+    lines = [f"{ln},1.0" for ln in good_rows()]
+    fld, message, _ = problem(write(tmp_path, lines, name="t1.csv", header=HEADER + ",T1_C"))
+    assert fld == "T1_C (line 1)" and "appears twice" in message

@@ -241,6 +241,24 @@ def test_an_internal_error_is_one_line_with_the_traceback_in_a_file(tmp_path, mo
     assert not out.exists()
 
 
+def test_running_out_of_memory_is_the_problems_size_not_a_bug(tmp_path, monkeypatch, capsys):
+    """A mesh level the machine cannot hold ran into MemoryError, reported as an internal
+    error (fuzzing round 6: level 3 of a spec with h0_m = 0.6 mm under a 2.5 GB limit). It
+    is the size asked for: one line naming what to make smaller, exit 2, no output."""
+    import compare.fit.run
+
+    def too_big(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(compare.fit.run, "run_fit", too_big)
+    run_csv = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs" / "dev-01.csv"
+    out = tmp_path / "o"
+    assert main(["fit", str(run_csv), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "ran out of memory" in err and "fix: a coarser --level" in err
+    assert "internal error" not in err and not out.exists()
+
+
 def test_synth_on_a_spec_without_a_drive_or_p1_names_what_it_needs(tmp_path):
     """synth writes a bench run: its power column needs the spec's drive (fin-shaft has none);
     it was an internal error (a KeyError or an AttributeError) before."""
@@ -531,3 +549,19 @@ def test_a_mesh_level_beyond_the_machine_is_refused_before_it_is_made(tmp_path, 
     err = capsys.readouterr().err
     assert "level: level 6 of this spec would have" in err and "fix: give a level of at most" \
         in err and not out.exists()
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["fit", ""], "the path of the bench run is empty"),
+    (["fit", "RUN", "--criteria", "missing.toml"], "--criteria: cannot be read (No such file"),
+])
+def test_an_empty_run_path_or_a_missing_criteria_file_says_so(tmp_path, capsys, argv, words):
+    """Fuzzing round 6: an empty run path was reported as the folder '.', and a missing
+    criteria file as a file that 'cannot be read as TOML', with the fix to write TOML."""
+    run_csv = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs" / "dev-01.csv"
+    argv = [str(run_csv) if a == "RUN" else str(tmp_path / a) if a.endswith(".toml") else a
+            for a in argv]
+    out = tmp_path / "o"
+    assert main([*argv, "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert words in err and err.count("\n") == 1 and not out.exists()

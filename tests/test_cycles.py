@@ -389,3 +389,12 @@ def test_nominal_load_case_is_constant():
     assert case.duration_s == 12 * H
     assert case.speed_rpm(0.0) == case.speed_rpm(11 * H) == 4300.0
     np.testing.assert_array_equal(case.breakpoints(), [0.0])
+
+
+def test_a_step_table_too_long_asks_for_its_own_column(tmp_path):
+    """A CSV step table has duration_s only: its fix must not offer duration_h, which the
+    table refuses as "not a step column" (fuzzing round 6); a TOML cycle may use either."""
+    p = write(tmp_path, "long.csv", "speed_rpm,duration_s\n1000,1e12\n")
+    with pytest.raises(InputError) as exc:
+        load_cycle(str(p))
+    assert "duration_s column" in exc.value.problem.fix and "duration_h" not in str(exc.value)

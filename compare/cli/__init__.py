@@ -147,6 +147,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"spindle-verify: error: {what}: {exc.strerror or exc}; fix: check the path (its "
               "length, its folder's permissions) and the free disk space", file=sys.stderr)
         return 2
+    except MemoryError:  # the problem asked for is larger than the machine: no bug
+        print("spindle-verify: error: memory: this machine ran out of memory for the problem "
+              "asked (the mesh level and mesh.h0_m, the node count, the run's length); fix: "
+              "a coarser --level or mesh.h0_m, fewer --nodes, or a machine with more free "
+              "memory", file=sys.stderr)
+        return 2
     except Exception as exc:  # a bug, not the user's input: one line, the traceback in a file
         print(f"spindle-verify: internal error: {type(exc).__name__}: {exc}; this is a bug, "
               f"not your input: please report it with the command and {_crash_file(exc, argv)}",

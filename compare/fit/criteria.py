@@ -166,7 +166,10 @@ class Criteria:
         InputError naming the file and the entry."""
         try:
             given = tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
+        except OSError as err:
+            raise InputError(str(path), "--criteria", f"cannot be read ({err.strerror or err})",
+                             "check the path of the criteria file") from None
+        except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
             raise InputError(str(path), "-", f"cannot be read as TOML ({err})",
                              "give a TOML file of name = value lines") from None
         hints = typing.get_type_hints(Criteria)

@@ -47,7 +47,7 @@ from spindle.bench_inputs import (
     resample,
     valid_samples,
 )
-from spindle.drive import drive_for
+from spindle.drive import check_drive_feeds, drive_for
 from spindle.errors import InputError, SolverError
 from spindle.results import check_plausible
 from spindle.spec import Spec
@@ -112,6 +112,11 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     if drive is None:
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
                          "add [power_balance] preset to the spec")
+    unfed = check_drive_feeds(spec, drive)
+    if unfed:
+        left_out.append(f"the drive '{drive.name}' feeds no heat to the spec's heat source(s) "
+                        f"{', '.join(unfed)}: 0 W there (the power balance names its motor "
+                        "and bearing sets as the drive file does)")
     raw = interval_inputs(run, grid_s, criteria.gap_min_steps)
     check_power_balance(run, drive, raw.grid_s, raw.speed_rpm, raw.power_kW,
                         raw.load_torque_Nm, criteria.no_load_Nm)

@@ -172,20 +172,21 @@ def ring_drag_W(gb, theta: dict[str, float]) -> dict[str, np.ndarray]:
     (the interval's heat held), the extra friction a preload of 1/K would add."""
     model = gb.structure_model()
     net = model.net
+    th = gb.full_theta(theta)
+    heat = gb.sources(th["f0"], th["rotor_share"], th.get("friction_exponent", 0.0))
     rows, names = {}, []
     for src in gb.spec.heat_sources:
-        if src.part is not None and net.parts[src.part].ring:
+        # a source the drive does not feed has no heat, so no drag (spindle.drive)
+        if src.part is not None and net.parts[src.part].ring and src.name in heat:
             inner, outer = net.parts[src.part].masses
             r = np.zeros(model.system.n_states)
             r[inner.index], r[outer.index] = 1.0, -1.0
             rows[f"ring:{src.name}"] = r
             names.append(src.name)
     out = gb.simulate(theta, extra_rows=rows)
-    th = gb.full_theta(theta)
-    src = gb.sources(th["f0"], th["rotor_share"], th.get("friction_exponent", 0.0))
     res = {}
     for n in names:
-        q = np.concatenate([src[n][:1], src[n]])  # the heat of the interval ending here
+        q = np.concatenate([heat[n][:1], heat[n]])  # the heat of the interval ending here
         res[n] = q * out[f"ring:{n}"]
     return res
 
