@@ -396,7 +396,8 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
       (:func:`below_friction_stretch`): the spindle stood where the speed says it turned.
 
     The margins on runs this project did not make: docs/bench.md. InputError naming the
-    column and the largest excess."""
+    column and the largest excess; and a power column that reads one value in every row
+    while the speed changes (:func:`check_power_moves`)."""
     path = str(run.path)
     if run.load_torque_measured:
         eta, n_loaded = load_efficiency(speed_rpm, power_kW, load_torque_Nm, loaded_Nm)
@@ -418,6 +419,7 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
                 f"{share:.3g} of it), which no turning spindle can",
                 "export the drive's electrical power in kW (a power in MW is 1000 times too "
                 "small; a column of zeros was not logged)")
+    check_power_moves(run)
     ex = loss_excess(drive, speed_rpm, power_kW, load_torque_Nm)
     if ex is not None and ex.over > 0:
         _refuse_loss_excess(run, drive, grid_s, speed_rpm, power_kW, load_torque_Nm, ex)
@@ -459,6 +461,24 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
                 "so it turned while speed_rpm says it stood",
                 "export speed_rpm as the bench logged it (a column of zeros, or another "
                 "channel mapped to it)")
+
+
+def check_power_moves(run: BenchRun) -> None:
+    """InputError where ``run``'s power_kW holds one value in every logged row while its
+    speed takes more than one: the bearings' friction and the motor's losses follow the
+    speed, so a drive's measured power moves with it; one value throughout is a setpoint or
+    a placeholder, not the measurement the losses are made of."""
+    P = run.columns["power_kW"]
+    P = P[~np.isnan(P)]
+    n = run.columns["speed_rpm"]
+    levels = np.unique(n[~np.isnan(n)])
+    if len(P) > 1 and float(P.min()) == float(P.max()) and len(levels) > 1:
+        raise InputError(str(run.path), "power_kW",
+                         f"reads {P[0]:g} kW in every row while speed_rpm takes {len(levels)} "
+                         f"values from {levels.min():g} to {levels.max():g} rpm: a measured "
+                         "power moves with the speed (friction and motor losses)",
+                         "export the drive's measured electrical power (a setpoint or a "
+                         "placeholder column holds one value)")
 
 
 def _refuse_loss_excess(run: BenchRun, drive: Drive, grid_s: np.ndarray,

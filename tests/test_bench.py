@@ -361,6 +361,8 @@ def test_speed_is_held_and_leading_gaps_take_the_first_value(tmp_path, spec):
     lines[2] = row(90 + 30, speed="2000")  # at 120 s
     lines[10] = row(600, speed="4300")
     lines[40] = row(2400, speed="0")
+    # a measured power moves with the speed (check_power_moves): it stands from 2400 s
+    lines[41:] = [row(60.0 * i, power="0.01") for i in range(41, len(lines))]
     run = read_bench(write(tmp_path, lines))
     case, grid = inputs(run, spec)
     speed = np.array([case.speed_rpm(t) for t in grid])
@@ -978,3 +980,17 @@ def test_an_unknown_column_twice_is_kept_twice(tmp_path):
     lines = [f"{ln},1.0" for ln in good_rows()]
     fld, message, _ = problem(write(tmp_path, lines, name="t1.csv", header=HEADER + ",T1_C"))
     assert fld == "T1_C (line 1)" and "appears twice" in message
+
+
+def test_a_power_that_reads_one_value_while_the_speed_changes_is_refused(tmp_path, spec):
+    """The peer's dev-06 with its power column a constant 0.15 kW (fuzzing round 6: a
+    control then ended "unexplained"). Friction and motor losses follow the speed, so a
+    measured power moves with it; one value throughout is no measurement."""
+    src = PEER_RUNS / "bench-runs" / "dev-06.csv"
+    run = read_bench(_edited(src, tmp_path / "run.csv", "power_kW", 0.0))
+    run.columns["power_kW"][:] = 0.15
+    with pytest.raises(InputError) as info:
+        inputs(run, spec)
+    p = info.value.problem
+    assert p.field == "power_kW" and "reads 0.15 kW in every row" in p.message
+    assert "measured electrical power" in p.fix
