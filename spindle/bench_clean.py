@@ -66,3 +66,21 @@ def without_spikes(run: BenchRun, channels: list[str], alpha: float, grid_s: flo
         y[rows] = np.nan
         columns[col] = y
     return (replace(run, columns=columns) if said else run), said
+
+
+def coolant_as_room(run: BenchRun, spec) -> str | None:
+    """A warning where the spec cools the spindle with a liquid (a surface with T_ref =
+    "coolant") but ``run``'s coolant reads the room's value in every row that logs both: two
+    sensors carry their own noise, and a chiller's supply is regulated apart from the
+    room, so that is the room's column twice (an air-cooled spindle's coolant is the room's
+    air, which check_not_copies lets pass). None otherwise."""
+    if not any(getattr(s, "T_ref", None) == "coolant" for s in spec.surfaces):
+        return None
+    env, cool = run.columns["T_env_C"], run.columns["T_coolant_C"]
+    both = ~np.isnan(env) & ~np.isnan(cool)
+    if np.count_nonzero(both) < 2 or not np.array_equal(env[both], cool[both]):
+        return None
+    return ("T_coolant_C reads T_env_C's value in every row that logs both, while the spec "
+            f"'{spec.name}' cools the spindle with a liquid (surfaces with T_ref = "
+            "\"coolant\"): the coolant column looks like the room's, copied; it is fitted as "
+            "logged (fix: export the coolant's supply temperature)")

@@ -58,6 +58,11 @@ def text_lines(raw: bytes, name: str) -> list[str]:
     byte-order mark at a line's start (an export with its mark appended to comments) is
     dropped: it is no character of a name or a number."""
     text = decoded(raw, name)
+    nul = text.find("\x00")
+    if nul >= 0:  # no text holds them: a logger that lost power pads its file with zeros
+        raise InputError(name, f"line {text.count(chr(10), 0, nul) + 1}", "holds NUL bytes "
+                         "(zero bytes, no text): the file is damaged there",
+                         "export the run again, or cut the damaged lines from a copy")
     if "\n" not in text:
         text = text.replace("\r", "\n")
     return [ln[1:] if ln.startswith("\ufeff") else ln for ln in text.split("\n")]

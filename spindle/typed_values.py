@@ -22,7 +22,10 @@ def conform(value, hint, where: tuple[str, str]):
     origin, args = typing.get_origin(hint), typing.get_args(hint)
     if origin is tuple:
         kinds = [args[0]] * len(value) if Ellipsis in args and isinstance(value, list) else args
-        if not isinstance(value, list) or not value or len(value) != len(kinds):
+        if isinstance(value, list) and not value:
+            raise InputError(*where, "is an empty array", "give at least one value" if
+                             Ellipsis in args else f"give {len(args)} values")
+        if not isinstance(value, list) or len(value) != len(kinds):
             raise InputError(*where, f"is {value!r}, not an array" + (
                 " of values" if Ellipsis in args else f" of {len(args)} values"), FIX)
         out = tuple(conform(v, kind, where) for v, kind in zip(value, kinds, strict=True))

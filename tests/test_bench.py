@@ -994,3 +994,30 @@ def test_a_power_that_reads_one_value_while_the_speed_changes_is_refused(tmp_pat
     p = info.value.problem
     assert p.field == "power_kW" and "reads 0.15 kW in every row" in p.message
     assert "measured electrical power" in p.fix
+
+
+def test_a_file_with_nul_bytes_names_the_line_without_echoing_them(tmp_path):
+    """A logger that lost power pads its file with zero bytes; the message had echoed a
+    cell of 200 of them to the terminal (fuzzing round 6)."""
+    path = write(tmp_path, good_rows())
+    lines = path.read_bytes().split(b"\n")
+    path.write_bytes(b"\n".join(lines[:10] + [b"\x00" * 200] + lines[10:]))
+    fld, message, fix = problem(path)
+    assert fld == "line 11" and "NUL bytes" in message and "\x00" not in message + fix
+
+
+def test_a_coolant_that_reads_the_room_on_a_water_cooled_spec_is_said(tmp_path, spec):
+    """Fuzzing round 6: the peer's dev-01 with its coolant column the room's named a lag at
+    its bound without a word. A chiller's supply is regulated apart from the room, and two
+    sensors carry their own noise, so the same value in every row is the room's column
+    twice; on a spec without coolant films (fin-shaft) the room's air is the coolant."""
+    from spindle.bench_clean import coolant_as_room
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = read_bench(PEER_RUNS / "bench-runs" / "dev-01.csv")
+    assert coolant_as_room(run, spec) is None
+    run.columns["T_coolant_C"] = run.columns["T_env_C"].copy()
+    said = coolant_as_room(run, spec)
+    assert said and "looks like the room's" in said and "fix:" in said
+    assert coolant_as_room(run, load_spec("fin-shaft")) is None

@@ -124,14 +124,16 @@ def test_a_users_file_sets_its_entries_and_leaves_the_rest(tmp_path):
     ("[alpha]\nvalue = 0.7\n", "alpha", "outside 0.001..0.5"),  # in the table's form too
     # values that passed the types and then stopped fit with an internal error (exit 1) or ran
     # on as nonsense (found by fuzzing the command line)
-    ("lag_grid_s = []\n", "lag_grid_s", "not an array of values"),  # an IndexError
+    ("lag_grid_s = []\n", "lag_grid_s", "is an empty array"),  # an IndexError
     ("lag_grid_s = [0.0, -60.0]\n", "lag_grid_s", "outside 0..inf"),
     ("competitor_step_s = 0.0\n", "competitor_step_s", "outside 600.0..14400.0"),  # / 0
     ("competitor_step_s = 0.001\n", "competitor_step_s", "outside"),  # 1.6 TiB asked for
     ("scan_null_tail = 0\n", "scan_null_tail", "outside 1..20"),  # an IndexError
     ("scan_null_tail = 100000000\n", "scan_null_tail", "outside 1..20"),  # 74 GiB
     ('competitor_masses = ["propeller"]\n', "competitor_masses", "unknown role"),  # dropped
-    ("competitor_masses = []\n", "competitor_masses", "not an array of values"),
+    ("competitor_masses = []\n", "competitor_masses", "is an empty array"),
+    # a misspelt key of the table's form was shown as a Python dict (fuzzing round 6)
+    ("[alpha]\nvalu = 0.05\n", "alpha", "is a table with the keys valu, which an entry"),
     ("jump_before_s = [-10.0, -180.0]\n", "jump_before_s", "does not increase"),
     ('onset_scales = [{name = "x", before_s = [-10.0, -300.0], early_s = [10.0, 120.0], '
      'late_s = [120.0, 360.0]}]\n', "onset_scales", "does not increase"),

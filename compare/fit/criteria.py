@@ -180,7 +180,12 @@ class Criteria:
                 raise InputError(str(path), name, "is no criterion",
                                  f"use the names of compare/fit/criteria.toml, e.g. "
                                  f"{', '.join(list(hints)[:3])}")
-            if isinstance(v, dict) and _ENTRY_KEYS >= set(v):  # the table's form
+            if isinstance(v, dict) and not _ENTRY_KEYS >= set(v):
+                raise InputError(str(path), name, "is a table with the keys "
+                                 f"{', '.join(sorted(set(v) - _ENTRY_KEYS))}, which an entry "
+                                 "does not have", f"write {name} = VALUE, or the entry's "
+                                 f"table with {', '.join(sorted(_ENTRY_KEYS))}")
+            if isinstance(v, dict):  # the table's form
                 if v.get("unit", units[name]) != units[name]:
                     raise InputError(str(path), f"{name}.unit", f"is {v['unit']!r}",
                                      f"give the value in {units[name]!r}, the table's unit")

@@ -38,7 +38,7 @@ from spindle.bench import (
     check_against_spec,
     read_bench,
 )
-from spindle.bench_clean import without_spikes, without_stuck
+from spindle.bench_clean import coolant_as_room, without_spikes, without_stuck
 from spindle.bench_inputs import (
     Inputs,
     check_power_balance,
@@ -108,6 +108,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     channels, left_out = without_stuck(run, channels)
     run, spikes = without_spikes(run, channels, criteria.alpha, grid_s)
     left_out += spikes
+    left_out += [w for w in [coolant_as_room(run, spec)] if w]
     drive = drive_for(spec)
     if drive is None:
         raise InputError(spec.path, "power_balance.preset", "the spec names no drive",
