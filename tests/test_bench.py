@@ -894,7 +894,7 @@ def test_three_running_intervals_below_the_friction_floor_are_refused(tmp_path, 
                   ((2, False), (3, True)), "speed_rpm")
 
 
-PEER_LOADED = Path(__file__).resolve().parents[2] / "shared" / "bench-runs" / "dev-08.csv"
+PEER_LOADED = PEER_RUNS / "bench-runs" / "dev-08.csv"
 
 
 def _reversed_copy(src: Path, dst: Path, torque_too: bool) -> int:
@@ -919,7 +919,6 @@ def _reversed_copy(src: Path, dst: Path, torque_too: bool) -> int:
     return turned
 
 
-@pytest.mark.skipif(not PEER_LOADED.exists(), reason="the peer's bench runs are not here")
 def test_a_spindle_turning_in_reverse_is_read_as_its_speed_magnitude(tmp_path, spec):
     """A drive logs M04 as a negative speed: the format asks for the drive's speed, and a user
     should not have to edit the export. The losses follow |n| and the process's power M n is
