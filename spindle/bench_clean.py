@@ -9,9 +9,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from spindle.bench import CHANNEL_COLUMNS, BenchRun, BenchWarning, stuck_channels
+from spindle.bench import CHANNEL_COLUMNS, STANDSTILL_RPM, BenchRun, BenchWarning, stuck_channels
+from spindle.bench_inputs import HOLD_STEPS, SPEED_BAND_REL
 from spindle.errors import InputError
-from spindle.sensor_faults import spike_rows
+from spindle.sensor_faults import first_sample_glitch, spike_rows
 from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
 
 
@@ -40,13 +41,34 @@ def without_stuck(run: BenchRun, channels: list[str]) -> tuple[list[str], list[s
 def without_spikes(run: BenchRun, channels: list[str], alpha: float, grid_s: float
                     ) -> tuple[BenchRun, list[str]]:
     """``run`` with each channel's single-sample spikes (spindle.sensor_faults.spike_rows,
-    within a grid step ``grid_s`` [s]) left out, each channel's with a BenchWarning, and the
-    report's lines saying so."""
+    within a grid step ``grid_s`` [s]) and a glitch on its first sample
+    (spindle.sensor_faults.first_sample_glitch, judged by the samples of the hold's two
+    steps after it; P1 then zeroed at the next one, as the format zeroes it at its first)
+    left out, each channel's with a BenchWarning, and the report's lines saying so."""
     columns, said = dict(run.columns), []
+    p1_ref = run.P1_reference_um
     for c in channels:
         col = CHANNEL_COLUMNS[c]
         y = columns[col]
         unit_tol = channel_tolerance(c) * edge_scale(c)  # the file's unit (µm, K)
+        first = first_sample_glitch(run.time_s, y, run.columns["speed_rpm"], unit_tol, alpha,
+                                    HOLD_STEPS * grid_s, SPEED_BAND_REL, STANDSTILL_RPM)
+        if first is not None:
+            y = y.copy()
+            y[first] = np.nan
+            nxt = np.flatnonzero(~np.isnan(y))[0]
+            off = float(run.columns[col][first] - y[nxt])
+            text = (f"{col}: its first sample (line {run.lines[first] if len(run.lines) else '?'})"
+                    f" lies {off:+.3g} {edge_unit(c, ascii=True)} off the samples of the next "
+                    f"{HOLD_STEPS * grid_s:g} s, which agree, at one speed: a glitch, left out")
+            if c == "P1":  # the format zeroes P1 at its first valid sample: that one now
+                p1_ref = (p1_ref or 0.0) + float(y[nxt])
+                y = y - y[nxt]
+                text += "; P1 is zeroed at the next sample"
+            warnings.warn(BenchWarning(f"{run.path}: {text} (fix: check the sensor's first "
+                                       "reading)"), stacklevel=3)
+            said.append(text)
+            columns[col] = y
         rows = spike_rows(run.time_s, y, unit_tol, alpha, grid_s)
         if not len(rows):
             continue
@@ -65,7 +87,7 @@ def without_spikes(run: BenchRun, channels: list[str], alpha: float, grid_s: flo
         y = y.copy()
         y[rows] = np.nan
         columns[col] = y
-    return (replace(run, columns=columns) if said else run), said
+    return (replace(run, columns=columns, P1_reference_um=p1_ref) if said else run), said
 
 
 def coolant_as_room(run: BenchRun, spec) -> str | None:

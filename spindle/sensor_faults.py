@@ -87,6 +87,45 @@ def spike_rows(time_s: np.ndarray, y: np.ndarray, tolerance: float, alpha: float
     return valid[np.flatnonzero(hit) + 1]
 
 
+def first_sample_glitch(time_s: np.ndarray, y: np.ndarray, speed_rpm: np.ndarray,
+                        tolerance: float, alpha: float, within_s: float,
+                        speed_band_rel: float, standstill_rpm: float) -> int | None:
+    """The row of ``y``'s first valid sample where it is a glitch, else None. The first
+    sample has no neighbour before it, so :func:`spike_rows`, which asks a spike to come
+    back, cannot judge it; here the samples after it stand in. It is a glitch where the
+    valid samples within ``within_s`` [s] after it (at least two) agree with one another
+    within the bound and it departs from their median by more than the bound, while the
+    speed held (no logged speed moves from the first's by more than ``speed_band_rel`` of
+    it, or ``standstill_rpm``): at one speed a thermal reading, or the growth, cannot move
+    a tolerance within the grid step, while a speed start's shortening can. The bound is
+    :func:`spike_rows`': the larger of ``tolerance`` and the noise's Bonferroni step."""
+    valid = np.flatnonzero(~np.isnan(y))
+    if len(valid) < 10:
+        return None
+    t = np.asarray(time_s, dtype=float)
+    v = y[valid]
+    d = np.diff(v)
+    noise_step = 1.4826 * float(np.median(np.abs(d - np.median(d))))
+    bound = max(float(norm.isf(alpha / (2 * len(v)))) * noise_step, tolerance)
+    i0 = valid[0]
+    after = valid[1:][t[valid[1:]] - t[i0] <= within_s]
+    if len(after) < 2:
+        return None
+    ref = float(np.median(y[after]))
+    if float(np.ptp(y[after])) > bound or abs(float(y[i0]) - ref) <= bound:
+        return None
+    n = np.asarray(speed_rpm, dtype=float)
+    logged = np.flatnonzero(~np.isnan(n[:after[-1] + 1]))
+    if not len(logged):
+        return i0
+    before = logged[logged <= i0]
+    n0 = float(n[before[-1]] if len(before) else n[logged[0]])
+    span = n[logged[logged >= i0]]
+    if np.any(np.abs(span - n0) > max(speed_band_rel * n0, standstill_rpm)):
+        return None
+    return int(i0)
+
+
 def check_room_in_celsius(columns: dict[str, np.ndarray], line_no: np.ndarray,
                           error: Callable[[str, str, str], InputError]) -> None:
     """Refuse a room temperature (T_env_C, °C) whose median is above :data:`ROOM_MAX_C`:

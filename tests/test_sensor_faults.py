@@ -1,6 +1,8 @@
 """Sensor columns that cannot be what a sensor read (spindle.sensor_faults): single-sample
 spikes, which fit leaves out with a warning."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -71,6 +73,61 @@ def test_spikes_are_left_out_of_the_run_and_said(tmp_path):
     others = np.setdiff1d(np.flatnonzero(~np.isnan(y0)), spiked)
     assert np.array_equal(y1[others], y0[others])
     assert len(said) == 1 and said[0].startswith("T1_C:")
+
+
+def _first_raised(tmp_path, src: str, col: str, by: float):
+    """The peer's run ``src`` with the first sample of ``col`` raised by ``by``, read."""
+    from spindle.bench import read_bench
+
+    lines = (PEER_RUNS / src).read_text(encoding="utf-8").splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
+    k = lines[head].split(",").index(col)
+    row = lines[head + 1].split(",")
+    row[k] = f"{float(row[k]) + by:g}"
+    path = tmp_path / "run.csv"
+    path.write_text("\n".join([*lines[:head + 1], ",".join(row), *lines[head + 2:]]) + "\n",
+                    encoding="utf-8")
+    return read_bench(path)
+
+
+@pytest.mark.parametrize("src", ["bench-runs/dev-01.csv", "bench-runs-2/dev2-02.csv"])
+def test_a_glitch_on_the_first_sample_is_left_out_and_p1_zeroed_after_it(tmp_path, src):
+    """Fuzzing round 6: P1's first sample 3 um high moved the zero the format puts there, and
+    the control dev2-02 ended "unexplained". Where the samples of the hold's two steps after
+    it agree, at one speed, and it lies more than a tolerance off them, it is a glitch: left
+    out, and P1 zeroed at the next sample, so the column is the unedited run's (to its
+    float rounding). The unedited runs have none (nor does any committed run: docs/fit-history.md
+    (18))."""
+    from spindle.bench import read_bench
+    from spindle.bench_clean import without_spikes
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain, _ = without_spikes(read_bench(PEER_RUNS / src), ["P1", "T1"], 0.01, 60.0)
+    assert plain.P1_reference_um == read_bench(PEER_RUNS / src).P1_reference_um
+    run = _first_raised(tmp_path, src, "P1_um", 3.0)
+    with pytest.warns(BenchWarning, match=r"P1_um: its first sample .* lies \+[23]"):
+        clean, said = without_spikes(run, ["P1", "T1"], 0.01, 60.0)
+    y, y0 = clean.columns["P1_um"], plain.columns["P1_um"]
+    valid = np.flatnonzero(~np.isnan(y))
+    assert np.isnan(y[0]) and valid[0] > 0 and y[valid[0]] == 0.0
+    # the unedited run re-zeroed at the same sample: the edited run's column
+    np.testing.assert_allclose(y[valid], y0[valid] - y0[valid[0]], atol=1e-9)
+    assert said and "zeroed at the next sample" in said[0]
+
+
+def test_a_first_sample_at_a_speed_start_is_no_glitch():
+    """A growth reading whose first sample is logged before a speed start (the shortening
+    steps it by 4 um at once) is not judged: the speed did not hold."""
+    from spindle.sensor_faults import first_sample_glitch
+
+    t, y = _warming()
+    y[1:] -= 4.0
+    speed = np.full(len(t), np.nan)
+    speed[0], speed[1] = 0.0, 8000.0
+    assert first_sample_glitch(t, y, speed, 1.5, 0.01, 120.0, 0.01, 1.0) is None
+    speed[1] = 0.0  # the same step at one speed is a glitch
+    assert first_sample_glitch(t, y, speed, 1.5, 0.01, 120.0, 0.01, 1.0) == 0
 
 
 @pytest.mark.slow  # two fits: the test above and test_a_stuck_channel_is_named_in_the_fits_report
