@@ -33,7 +33,7 @@ import numpy as np
 
 from spindle.bench_text import hint_for, text_lines
 from spindle.errors import InputError
-from spindle.sensor_faults import check_not_copies, check_room_in_celsius
+from spindle.sensor_faults import check_not_copies, check_room_in_celsius, drop_impossible_samples
 from spindle.spec import Spec
 from spindle.units import CYCLE_MAX_S, POWER_MAX_KW, SPEED_MAX_RPM, TORQUE_MAX_NM, ZERO_C_K
 
@@ -324,6 +324,8 @@ def read_bench(path: str | Path) -> BenchRun:
     t = _read_time(table, seen["time_s"], error)
     columns = _read_known_columns(table, seen, error, name)
     _read_reversed(columns, name)
+    drop_impossible_samples(columns, line_no, lambda m: warnings.warn(BenchWarning(
+        f"{name}: {m}"), stacklevel=4), (T_MIN_C, T_KELVIN_MEDIAN_C, T_KELVIN_MAX_C, P1_LIMIT_UM))
     _check_plausible(columns, line_no, error)
     check_room_in_celsius(columns, line_no, error)
     extra = _read_unknown_columns(table, header)

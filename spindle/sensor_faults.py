@@ -126,6 +126,43 @@ def first_sample_glitch(time_s: np.ndarray, y: np.ndarray, speed_rpm: np.ndarray
     return int(i0)
 
 
+def drop_impossible_samples(columns: dict[str, np.ndarray], line_no: np.ndarray,
+                            warn: Callable[[str], None],
+                            limits: tuple[float, float, float, float]) -> None:
+    """Read as not measured (NaN, in place, each column's with one ``warn``) a sensor
+    column's single samples that no sensor reads: beyond the reader's limits ``limits`` =
+    (lowest °C, highest median °C, highest °C, largest |P1| µm) while the samples logged
+    before and after them are within them. A logger's "no data" code (-999, 9999) or an
+    open PT100 (850 °C) between two readings is no temperature, and the same physics as a
+    spike's says so: nothing thermal leaves its neighbours that far and comes back. Left to
+    the reader's refusal: a run of such samples, a column whose median is beyond them (a
+    unit), and a value that is a plausible temperature in kelvin (one row exported in K)."""
+    t_min, t_kelvin_median, t_max, p1_max = limits
+    for col in SENSOR_COLUMNS:
+        y = columns.get(col)
+        if y is None:
+            continue
+        valid = np.flatnonzero(~np.isnan(y))
+        v = y[valid]
+        if col == "P1_um":
+            bad = np.abs(v) > p1_max
+        else:
+            kelvin = (v - 273.15 >= t_min) & (v - 273.15 <= t_kelvin_median)
+            bad = ((v < t_min) | (v > t_max)) & ~kelvin
+        if not bad.any() or bad.mean() > 0.5:
+            continue
+        alone = bad.copy()
+        alone[1:] &= ~bad[:-1]
+        alone[:-1] &= ~bad[1:]
+        if not alone.any():
+            continue
+        rows = valid[alone]
+        warn(f"{col}: {len(rows)} single sample(s) no sensor reads ({y[rows[0]]:g} on line "
+             f"{line_no[rows[0]]}{', ...' if len(rows) > 1 else ''}) between plausible "
+             "readings are read as not measured (a logger's no-data code or an open sensor)")
+        y[rows] = np.nan
+
+
 def check_room_in_celsius(columns: dict[str, np.ndarray], line_no: np.ndarray,
                           error: Callable[[str, str, str], InputError]) -> None:
     """Refuse a room temperature (T_env_C, °C) whose median is above :data:`ROOM_MAX_C`:

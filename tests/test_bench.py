@@ -196,10 +196,12 @@ ERRORS = [
     ("kelvin one", HEADER, lambda ls: ls[:30] + [row(1800, ts="300")] + ls[31:], "T_stator_C (line 32)",
      "300 (median 30) looks like kelvin"),
     # 5000 K is no bench temperature either: a broken reading, not a unit
-    ("spike", HEADER, lambda ls: ls[:30] + [row(1800, t1="5000")] + ls[31:], "T1_C (line 32)",
+    # two rows in a row: no single sample between readings (drop_impossible_samples)
+    ("spike", HEADER, lambda ls: ls[:30] + [row(1800, t1="5000"), row(1860, t1="5000")]
+     + ls[32:], "T1_C (line 32)",
      "5000 °C is above 250 °C while the column's median is 22 °C: a broken reading"),
-    ("too cold", HEADER, lambda ls: ls[:7] + [row(420, cool="-80")] + ls[8:], "T_coolant_C (line 9)",
-     "-80 °C is below -60 °C"),
+    ("too cold", HEADER, lambda ls: ls[:7] + [row(420, cool="-80"), row(480, cool="-80")]
+     + ls[9:], "T_coolant_C (line 9)", "-80 °C is below -60 °C"),
     ("speed high", HEADER, lambda ls: ls[:7] + [row(420, speed="258000")] + ls[8:], "speed_rpm (line 9)",
      "above 100000 rpm"),
     ("speed negative and high", HEADER, lambda ls: ls[:7] + [row(420, speed="-258000")] + ls[8:],
@@ -212,7 +214,8 @@ ERRORS = [
     ("cell underscore", HEADER, lambda ls: ls[:20] + [row(1200, t1="2_2")] + ls[21:], "T1_C (line 22)",
      "'2_2' is not a number"),
     # a growth of 6500 um is no spindle's: nm exported as um (found by fuzzing: 1e12 passed)
-    ("P1 in nm", HEADER, lambda ls: ls[:7] + [row(420, p1="6500")] + ls[8:], "P1_um (line 9)",
+    ("P1 in nm", HEADER, lambda ls: ls[:7] + [row(420, p1="6500"), row(480, p1="6600")] + ls[9:],
+     "P1_um (line 9)",
      "beyond ±5000 um"),
     ("too few rows", HEADER, lambda ls: [row(i * 60.0, speed="1") for i in range(40)], "rows",
      "40 rows with a measured channel"),
@@ -1020,3 +1023,22 @@ def test_a_coolant_that_reads_the_room_on_a_water_cooled_spec_is_said(tmp_path, 
     said = coolant_as_room(run, spec)
     assert said and "looks like the room's" in said and "fix:" in said
     assert coolant_as_room(run, load_spec("fin-shaft")) is None
+
+
+@pytest.mark.parametrize("column, cell", [("T1_C", "850"), ("T2_C", "-999"),
+                                          ("P1_um", "9999"), ("T_env_C", "-999")])
+def test_a_single_sample_no_sensor_reads_is_read_as_not_measured(tmp_path, column, cell):
+    """A logger's no-data code or an open PT100 between two readings (fuzzing round 6: one
+    such cell in 5531 rows refused the whole run, and the user had to edit the export): read
+    as not measured, with a warning naming the column, the value and the line. Two such
+    samples in a row stay refused (the ERRORS above), and so does a single value that is a
+    plausible temperature in kelvin ("kelvin one")."""
+    j = HEADER.split(",").index(column)
+    lines = good_rows()
+    cells = lines[20].split(",")
+    cells[j] = cell
+    lines[20] = ",".join(cells)
+    with pytest.warns(BenchWarning, match=rf"{column}: 1 single sample.* \({cell} on line 22\)"):
+        run = read_bench(write(tmp_path, lines))
+    y = run.columns[column]
+    assert np.isnan(y[20]) and np.count_nonzero(np.isnan(y)) == 1
