@@ -96,7 +96,7 @@ def coolant_as_room(run: BenchRun, spec) -> str | None:
     sensors carry their own noise, and a chiller's supply is regulated apart from the
     room, so that is the room's column twice (an air-cooled spindle's coolant is the room's
     air, which check_not_copies lets pass). None otherwise."""
-    if not any(getattr(s, "T_ref", None) == "coolant" for s in spec.surfaces):
+    if not any(s.T_ref == "coolant" for s in spec.surfaces):
         return None
     env, cool = run.columns["T_env_C"], run.columns["T_coolant_C"]
     both = ~np.isnan(env) & ~np.isnan(cool)

@@ -62,6 +62,16 @@ def check_not_copies(columns: dict[str, np.ndarray],
                             "mapping)")
 
 
+def _spike_bound(d: np.ndarray, tolerance: float, alpha: float) -> float:
+    """The step a valid sample must exceed to be no reading (:func:`spike_rows`,
+    :func:`first_sample_glitch`), from the first differences ``d`` of a channel's valid
+    samples: the larger of ``tolerance`` and the largest step its noise makes among the
+    len(d) + 1 samples at level ``alpha`` (the noise from the median absolute first
+    difference, Bonferroni over the samples)."""
+    noise_step = 1.4826 * float(np.median(np.abs(d - np.median(d))))
+    return max(float(norm.isf(alpha / (2 * (len(d) + 1)))) * noise_step, tolerance)
+
+
 def spike_rows(time_s: np.ndarray, y: np.ndarray, tolerance: float, alpha: float,
                within_s: float) -> np.ndarray:
     """Indices into ``y`` (one channel's column, NaN where not logged; ``time_s`` [s] its
@@ -78,8 +88,7 @@ def spike_rows(time_s: np.ndarray, y: np.ndarray, tolerance: float, alpha: float
     if len(v) < 10:
         return np.zeros(0, dtype=int)
     d = np.diff(v)
-    noise_step = 1.4826 * float(np.median(np.abs(d - np.median(d))))
-    bound = max(float(norm.isf(alpha / (2 * len(v)))) * noise_step, tolerance)
+    bound = _spike_bound(d, tolerance, alpha)
     up, down = d[:-1], -d[1:]
     dt = np.diff(t)
     close = (dt[:-1] <= within_s) & (dt[1:] <= within_s)
@@ -103,10 +112,7 @@ def first_sample_glitch(time_s: np.ndarray, y: np.ndarray, speed_rpm: np.ndarray
     if len(valid) < 10:
         return None
     t = np.asarray(time_s, dtype=float)
-    v = y[valid]
-    d = np.diff(v)
-    noise_step = 1.4826 * float(np.median(np.abs(d - np.median(d))))
-    bound = max(float(norm.isf(alpha / (2 * len(v)))) * noise_step, tolerance)
+    bound = _spike_bound(np.diff(y[valid]), tolerance, alpha)
     i0 = valid[0]
     after = valid[1:][t[valid[1:]] - t[i0] <= within_s]
     if len(after) < 2:
