@@ -3,6 +3,7 @@ compare/synth/bench.py): nesting of every effect, agreement with the lumped mode
 intervals, and forward selection on data with a known truth."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -167,6 +168,51 @@ def test_seat_conductance_is_nested_and_cools_the_rings(setup):
     cooled = {c: np.max(on[c] - T_cool) for c in rise}
     assert cooled["T1"] < 0.7 * rise["T1"] and cooled["T2"] < 0.7 * rise["T2"], (rise, cooled)
     assert (rise["T_stator"] - cooled["T_stator"]) < (rise["T1"] - cooled["T1"])
+
+
+def _air_cooled(tmp_path):
+    """spl2782 with its jacket's films towards the room: a spindle without a coolant."""
+    text = Path(load_spec("spl2782").path).read_text(encoding="utf-8")
+    assert text.count('T_ref = "coolant"') >= 1  # the jacket's films
+    path = tmp_path / "air.toml"
+    path.write_text(text.replace('T_ref = "coolant"', 'T_ref = "ambient"'), encoding="utf-8")
+    return load_spec(path)
+
+
+def test_an_air_cooled_spindle_has_no_coolant_parameters(setup, tmp_path):
+    """On a spec without a coolant film, h_coolant scales no edge and the bearing seats have
+    no coolant to be linked to: neither is a parameter (the default extras had ended ``fit``
+    with an internal error, and h_coolant was reported not identifiable), and the model
+    with G_seat_W_K asked for is the model without it."""
+    from compare.fit.params import DEFAULT_BASE_EXTRA
+
+    _, _, inp = setup
+    air = _air_cooled(tmp_path)
+    gb = GreyBox(air, DRIVES["spl2782"], inp, base_extra=DEFAULT_BASE_EXTRA)
+    assert gb.inert_params() == {"h_coolant", "G_seat_W_K"}
+    params = gb.parameters()
+    assert "h_coolant" not in params and "G_seat_W_K" not in params
+    assert {"h_air", "h_rotating", "contact", "stator_contact", "axial_scale"} <= set(params)
+    without = GreyBox(air, DRIVES["spl2782"], inp, base_extra=("axial_scale",
+                                                                "friction_exponent"))
+    a, b = gb.simulate({}), without.simulate({})
+    for c in CHANNELS:
+        np.testing.assert_array_equal(a[c], b[c])
+    # the shipped, water-cooled spec: every parameter acts
+    assert GreyBox(setup[0], DRIVES["spl2782"], inp).inert_params() == set()
+
+
+def test_asking_for_seats_on_an_air_cooled_spindle_is_refused(tmp_path, capsys):
+    """``--base-extra G_seat_W_K`` on a spec without a coolant: exit 2, naming the option and
+    the fix, nothing written."""
+    _air_cooled(tmp_path)
+    run = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs" / "dev-06.csv"
+    out = tmp_path / "fit"
+    assert main(["fit", str(run), "--spec", str(tmp_path / "air.toml"), "--out", str(out),
+                 "--quiet", "--base-extra", "G_seat_W_K"]) == 2
+    err = capsys.readouterr().err
+    assert "--base-extra" in err and "G_seat_W_K acts on nothing" in err
+    assert "leave G_seat_W_K out" in err and not out.exists()
 
 
 @pytest.mark.parametrize("scale", [0.88, 1.1])

@@ -31,6 +31,8 @@ ROTATING = ("shaft", "tool", "rotor")
 _K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact", "heat_capacity",
              "axial_scale", "G_seat_W_K")
 CHANNELS = ("T1", "T2", "T_stator", "P1")
+#: the parameters that scale a group of the network's edges (films, contacts)
+_GROUPS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact")
 
 
 def _geometric(x: np.ndarray, floor: float, rel: float) -> np.ndarray:
@@ -107,11 +109,27 @@ class GreyBox:
     @property
     def _seats(self) -> bool:
         """Whether the network has the bearing seats' links to the coolant (G_seat_W_K)."""
-        return "G_seat_W_K" in self.base_extra
+        return "G_seat_W_K" in self.base_extra and "G_seat_W_K" not in self.inert_params()
+
+    def inert_params(self) -> frozenset[str]:
+        """The base parameters (and extras) that act on nothing in this spec's network, so
+        that no run can tell their value: a film or contact group without an edge (h_coolant
+        of an air-cooled spindle) and the bearing seats' link where there is no coolant to
+        link them to (G_seat_W_K). None on a water-cooled spec with every group."""
+        key = ("inert", self.nodes)
+        if key not in self._cache:
+            plain = GreyBox(self.spec, self.drive, self.inputs, self.nodes, _cache=self._cache)
+            model, groups, _ = plain._structure()
+            inert = set(_GROUPS) - set(groups)
+            if _coolant_port(model.net) is None:
+                inert.add("G_seat_W_K")
+            self._cache[key] = frozenset(inert)
+        return self._cache[key]
 
     def parameters(self) -> dict[str, Param]:
-        out = base_params(self.drive)
-        out.update({k: EXTRA_BASE_PARAMS[k] for k in self.base_extra})
+        inert = self.inert_params()
+        out = {k: p for k, p in base_params(self.drive).items() if k not in inert}
+        out.update({k: EXTRA_BASE_PARAMS[k] for k in self.base_extra if k not in inert})
         if self.inputs.prehistory_s > 0:  # a moved start (compare.fit.start)
             out[PREHISTORY.name] = dc_replace(PREHISTORY, default=min(max(
                 self.inputs.prehistory_s / 3600.0, PREHISTORY.lo), PREHISTORY.hi))
@@ -191,11 +209,7 @@ class GreyBox:
         handles = {e.name: e.extend_network(net, self.spec, self.power_measured)
                    for e, _ in effects}
         if self._seats:
-            adv_block = next((b for b in net.network.blocks
-                              if getattr(b, "name", "") == "coolant_advection"), None)
-            cool_port = (adv_block.port_a if adv_block is not None else
-                         next(b for b in net.network.blocks if isinstance(b, FixedTemperature)
-                              and b.source == "coolant").port)
+            cool_port = _coolant_port(net)
             for p in net.parts.values():
                 if p.part.role in ("front_bearing", "rear_bearing"):
                     outer = [m for m in p.masses if m.name.endswith("outer")] or p.masses[-1:]
@@ -477,6 +491,18 @@ def _stretch_exponents(spec: Spec, nodes: int
                      else 0.0)
         out[longer] = (edge, cap, chain)
     return out
+
+
+def _coolant_port(net):
+    """The port at the coolant's temperature the films of the lumped network ``net`` see
+    (behind the coolant's advection where it has one); None without a coolant film."""
+    blocks = net.network.blocks
+    adv = next((b for b in blocks if getattr(b, "name", "") == "coolant_advection"), None)
+    if adv is not None:
+        return adv.port_a
+    fixed = next((b for b in blocks if isinstance(b, FixedTemperature)
+                  and b.source == "coolant"), None)
+    return None if fixed is None else fixed.port
 
 
 def film_groups(spec: Spec) -> dict[str, str]:

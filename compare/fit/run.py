@@ -95,6 +95,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
 
     criteria = criteria or Criteria()
     say = progress or (lambda _m: None)
+    asked = base_extra is not None
     base_extra = tuple(DEFAULT_BASE_EXTRA if base_extra is None else base_extra)
     _check_base_extra(base_extra)
     if not 0.2 <= fit_fraction <= 0.9:
@@ -123,6 +124,12 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                         raw.load_torque_Nm, criteria.no_load_Nm)
     measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks, criteria)
     plain = GreyBox(spec, drive, raw, nodes, speed_bin_rel=criteria.speed_bin_rel)
+    inert = [k for k in base_extra if k in plain.inert_params()]
+    if inert and asked:
+        raise InputError("command line", "--base-extra", f"{inert[0]} acts on nothing in the "
+                         f"spec {spec.name} (it links the bearing seats to the coolant, and "
+                         "the spec has no coolant film)", f"leave {inert[0]} out")
+    base_extra = tuple(k for k in base_extra if k not in inert)
     begins = run_start(plain, default_theta(plain.parameters()),
                        first_samples(run, channels, raw.grid_s), criteria)
     raw = replace(raw, prehistory_s=begins.prehistory_s)
