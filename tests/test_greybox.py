@@ -215,6 +215,52 @@ def test_asking_for_seats_on_an_air_cooled_spindle_is_refused(tmp_path, capsys):
     assert "leave G_seat_W_K out" in err and not out.exists()
 
 
+def test_effects_through_the_coolant_are_not_tried_on_an_air_cooled_spindle(tmp_path, capsys):
+    """coolant_dynamics (and the outside causes that act through the coolant) need a coolant
+    film: on a spec without one synth had ended with an internal error (a matmul of no
+    film rows); now synth refuses them and fit neither tries nor lets one be asked for,
+    each with exit 2 before any work and nothing written."""
+    from compare.synth.outside import OUTSIDE
+
+    air = _air_cooled(tmp_path)
+    spec = tmp_path / "air.toml"
+    lacking = {n for n, e in {**LIBRARY, **OUTSIDE}.items() if e.missing_in(air)}
+    assert lacking == {"coolant_dynamics", "coolant_flow_drop", "coolant_sensor_offset"}
+    assert not any(e.missing_in(load_spec("spl2782")) for e in {**LIBRARY, **OUTSIDE}.values())
+    run = tmp_path / "run.csv"
+    for effect in ("coolant_dynamics", "coolant_flow_drop"):
+        assert main(["synth", "--spec", str(spec), "--effect", effect, "--out", str(run)]) == 2
+        err = capsys.readouterr().err
+        assert f"{effect} needs a coolant film" in err and "choose another effect" in err
+        assert not run.exists()
+    peer = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs" / "dev-06.csv"
+    assert main(["fit", str(peer), "--spec", str(spec), "--out", str(tmp_path / "fit"),
+                 "--quiet", "--candidates", "coolant_dynamics"]) == 2
+    assert "leave coolant_dynamics out" in capsys.readouterr().err
+
+
+OWN_SPECS = Path(__file__).resolve().parent / "data" / "own-specs"
+
+
+def test_axial_scale_on_a_spindle_whose_layout_changes_when_stretched(capsys):
+    """bs25 (a user's own spec) has a lumped network whose layout changes when stretched:
+    axial_scale, a default extra, had refused the whole fit, with a message that read as a
+    fault of the spec. Asked for, it is refused as an option (exit 2 before any work); by
+    default it is left out with a warning (compare.fit.run.calibrate_base; the fit runs)."""
+    from compare.fit.greybox import stretch_exponents
+    from spindle.errors import InputError
+
+    bs25 = load_spec(OWN_SPECS / "bs25.toml")
+    with pytest.raises(InputError, match="axial_scale cannot be calibrated on the spec bs25"):
+        stretch_exponents(bs25, 11)
+    stretch_exponents(load_spec("spl2782"), 11)  # the shipped spec's stays
+    peer = Path(__file__).resolve().parent / "data" / "peer-runs" / "bench-runs" / "dev-06.csv"
+    assert main(["fit", str(peer), "--spec", str(OWN_SPECS / "bs25.toml"), "--out", "unused",
+                 "--quiet", "--base-extra", "axial_scale"]) == 2
+    err = capsys.readouterr().err
+    assert "--base-extra" in err and "leave axial_scale out of --base-extra" in err
+
+
 @pytest.mark.parametrize("scale", [0.88, 1.1])
 def test_axial_scale_is_the_stretched_spindle(setup, scale):
     """The default base extra axial_scale reproduces the network built anew from the spec

@@ -245,7 +245,7 @@ class GreyBox:
             # every effect set's structure
             plain_key = ("stretch_exponents", self.nodes)
             if plain_key not in self._cache:
-                self._cache[plain_key] = _stretch_exponents(self.spec, self.nodes)
+                self._cache[plain_key] = stretch_exponents(self.spec, self.nodes)
             model = self._structure()[0]
             names = [e[3] for e in model.system.edges]
             sides, chain = {}, {}
@@ -448,8 +448,8 @@ STRETCH_PROBE = 1.2
 _STRETCH_RPM = 3000.0
 
 
-def _stretch_exponents(spec: Spec, nodes: int
-                       ) -> dict[bool, tuple[dict[str, float], dict[str, float], float]]:
+def stretch_exponents(spec: Spec, nodes: int
+                      ) -> dict[bool, tuple[dict[str, float], dict[str, float], float]]:
     """Per side of 1 (``True``: the spec stretched axially by ``STRETCH_PROBE``, ``False``: by
     its inverse), the exponents e, per edge name and per block label, with which the plain
     network's conductances and capacities change from ``spec`` to the stretched spec (value
@@ -468,10 +468,12 @@ def _stretch_exponents(spec: Spec, nodes: int
         b = plain(stretch_axially(spec, factor))
         eb = b.system.edges
         if names != [e[3] for e in eb] or len(set(names)) != len(names):
-            raise InputError(str(spec.path), "axial_scale", "the lumped network's layout "
-                             f"changes when the spindle is stretched axially by {factor:g}, "
-                             "so its lengths cannot be scaled as one parameter",
-                             "leave axial_scale out: --base-extra G_seat_W_K")
+            raise InputError("command line", "--base-extra", "axial_scale cannot be "
+                             f"calibrated on the spec {spec.name}: its lumped network's "
+                             "layout changes when the spindle is stretched axially by "
+                             f"{factor:g}, so its lengths do not scale as one parameter",
+                             "leave axial_scale out of --base-extra, e.g. --base-extra "
+                             "G_seat_W_K friction_exponent")
         log_f = np.log(factor)
         edge = {}
         for (_, _, Ga, name), (_, _, Gb, _) in zip(ea, eb, strict=True):

@@ -27,7 +27,7 @@ from compare.fit.criteria import Criteria
 from compare.fit.effects import LIBRARY
 from compare.fit.effects import candidates as candidate_labels
 from compare.fit.gaps import unknown_input_spans
-from compare.fit.greybox import GreyBox
+from compare.fit.greybox import GreyBox, stretch_exponents
 from compare.fit.growth_check import check_growth, library_terms
 from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, default_theta
 from compare.fit.select import Selection, select
@@ -130,6 +130,16 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                          f"spec {spec.name} (it links the bearing seats to the coolant, and "
                          "the spec has no coolant film)", f"leave {inert[0]} out")
     base_extra = tuple(k for k in base_extra if k not in inert)
+    if "axial_scale" in base_extra:
+        try:  # its lengths must scale as one parameter (compare.fit.greybox)
+            stretch_exponents(spec, nodes)
+        except InputError:
+            if asked:
+                raise
+            base_extra = tuple(k for k in base_extra if k != "axial_scale")
+            left_out.append("axial_scale, a default extra, is not calibrated: the spec's "
+                            "lumped network changes its layout when the spindle is stretched "
+                            "axially, so its lengths do not scale as one parameter")
     begins = run_start(plain, default_theta(plain.parameters()),
                        first_samples(run, channels, raw.grid_s), criteria)
     raw = replace(raw, prehistory_s=begins.prehistory_s)
@@ -235,7 +245,8 @@ def signature_tests(run: BenchRun, gb: GreyBox, theta: dict[str, float], channel
     order (a test may read an earlier one: compare.fit.signatures.Context)."""
     ctx = Context(run, gb, theta, channels, criteria)
     for effect in LIBRARY.values():
-        ctx.tests.update(effect.signature(ctx))
+        if not effect.missing_in(gb.spec):
+            ctx.tests.update(effect.signature(ctx))
     return ctx.tests
 
 
@@ -312,6 +323,12 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
     if unknown:  # before any work
         raise InputError("command line", "--candidates", f"unknown effect {unknown[0]}",
                          f"use some of {', '.join(LIBRARY)}")
+    lacks = {c: LIBRARY[c].missing_in(spec) for c in candidates or LIBRARY}
+    if candidates and any(lacks.values()):
+        c = next(c for c, need in lacks.items() if need)
+        raise InputError("command line", "--candidates", f"{c} needs {lacks[c]}, which the "
+                         f"spec {spec.name} lacks", f"leave {c} out")
+    candidates = [c for c, need in lacks.items() if not need]  # the rest act on nothing
     say = progress or (lambda _m: None)
     prep = calibrate_base(path, spec, fit_fraction, nodes, grid_s, progress, fem_level,
                           base_extra, blocks, criteria, workers)

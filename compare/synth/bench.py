@@ -264,7 +264,10 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
                          "give clean alone, or the effects without it")
     names = [n for n in names if n != "clean"]
     for n in names:
-        kind_of(n)
+        lacks = kind_of(n).missing_in(spec)
+        if lacks:  # before any work: it would act on nothing, or on a port that is not there
+            raise InputError(spec.path, "effect", f"{n} needs {lacks}, which the spec lacks",
+                             "choose another effect, or a spec that has it")
     rng = np.random.default_rng(seed)
     params = {n: (truths or {}).get(n) or draw_truth(n, rng) for n in names}
     if len(names) == 1:
