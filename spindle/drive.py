@@ -49,6 +49,98 @@ def drive_for(spec: Spec) -> Drive | None:
                      "relative to the spec's folder (format: docs/power.md)")
 
 
+#: the shipped cycles' rated point (the SPL2782.1's, paper section 3): ``nominal`` holds it
+#: and ``spl-16h`` climbs to its speed
+PAPER_RATED = (4300.0, 38000.0)  # rpm, W of mechanical output
+
+
+def rated_cycles(spec: Spec, drive: Drive) -> tuple[Cycle, Cycle]:
+    """(steady, transient) cycles at the spindle's own rated point: the shipped ``nominal``
+    and ``spl-16h`` where the drive's nominal point is the paper's (the SPL2782.1's);
+    otherwise the drive's nominal point held (its ``[nominal]`` speed against the torque
+    P_mech / omega, the losses from the drive's own models) and ``spl-16h`` with every
+    speed scaled by the rated speed / 4300 rpm (the same plateaus at the same shares of the
+    rated speed, the same room and chiller). A drive without ``[nominal]`` is rated at the
+    spec's ``[operating] speed_rpm``, without load."""
+    from dataclasses import replace
+
+    from spindle.cycles import Step
+    from spindle.units import RPM_TO_RAD_S
+
+    nominal, cycle = load_cycle("nominal"), load_cycle("spl-16h")
+    point = drive.nominal
+    speed, p_mech = ((point.speed_rpm, point.P_mech_W) if point is not None
+                     else (spec.speed_rpm, 0.0))
+    if (speed, p_mech) == PAPER_RATED:
+        return nominal, cycle
+    torque = p_mech / (speed * RPM_TO_RAD_S)
+    what = (f"the drive's nominal point, {speed:g} rpm and {p_mech / 1e3:g} kW" if point
+            else f"the spec's operating speed, {speed:g} rpm without load")
+    steady = replace(nominal, name="rated", description=f"{what}, held to a steady state",
+                     source=f"the drive file of {spec.name}",
+                     steps=(Step(speed, nominal.steps[0].duration_s, torque),))
+    scale = speed / PAPER_RATED[0]
+    transient = replace(cycle, name=f"spl-16h at {speed:g} rpm",
+                        description=f"{cycle.description}, its speeds x {scale:.4g} ({what})",
+                        steps=tuple(replace(s, speed_rpm=s.speed_rpm * scale)
+                                    for s in cycle.steps))
+    return steady, transient
+
+
+#: cycles named for a spindle's own rating (:func:`rated_cycles`): its rated point held, and
+#: the paper's 16 h cycle at its rated speed
+RATED_CYCLES = ("rated", "rated-16h")
+
+
+def rated_scale(spec: Spec, drive: Drive) -> tuple[float, float | None]:
+    """(speed factor, torque factor) from the paper's rated point (:data:`PAPER_RATED`) to
+    the spindle's (the drive's ``[nominal]``): (1, 1) for the SPL2782.1. The torque factor
+    is None where the drive has no nominal point (its rated torque is not known)."""
+    point = drive.nominal
+    if point is None:
+        return spec.speed_rpm / PAPER_RATED[0], None
+    if (point.speed_rpm, point.P_mech_W) == PAPER_RATED:
+        return 1.0, 1.0
+    torque, paper = point.P_mech_W / point.speed_rpm, PAPER_RATED[1] / PAPER_RATED[0]
+    return point.speed_rpm / PAPER_RATED[0], torque / paper
+
+
+def spindle_cycle(spec: Spec, name: str, seed: int = 0) -> Cycle:
+    """The cycle ``name`` for this spindle: ``rated`` and ``rated-16h`` at its own rated
+    point (:func:`rated_cycles`); ``random``, ``random-loaded``, ``random-ramped-load``
+    drawn from ``seed`` (spindle.cycles.drawn_cycle, drawn for the SPL2782.1) with speeds
+    and torques scaled to its rated point (:func:`rated_scale`); else the shipped cycle or
+    cycle file as it is."""
+    from dataclasses import replace
+
+    from spindle.cycles import RANDOM_CYCLES, drawn_cycle
+
+    drive = drive_for(spec)
+    if name in RATED_CYCLES:
+        if drive is None:
+            raise InputError(spec.path, "power_balance.preset", f"the cycle '{name}' is the "
+                             "drive's rated point, and the spec names no drive",
+                             "add [power_balance] preset to the spec, or name another cycle")
+        return rated_cycles(spec, drive)[RATED_CYCLES.index(name)]
+    if name not in RANDOM_CYCLES:
+        return load_cycle(name)
+    cycle = drawn_cycle(name, seed)
+    speed, torque = rated_scale(spec, drive) if drive is not None else (1.0, 1.0)
+    if (speed, torque) == (1.0, 1.0):
+        return cycle
+    loaded = any(s.load_torque_Nm > 0 for s in cycle.steps)
+    if torque is None and loaded:
+        raise InputError(spec.path, "power_balance.preset", f"'{name}' draws process loads "
+                         "relative to the drive's rated torque, and the drive file has no "
+                         "[nominal] point", "add [nominal] speed_rpm and P_mech_W to the drive "
+                         "file (docs/power.md), or use 'random'")
+    return replace(cycle, description=f"{cycle.description}; speeds x {speed:.4g}, torques x "
+                   f"{torque or 0:.4g} (the spindle's rated point)",
+                   steps=tuple(replace(s, speed_rpm=s.speed_rpm * speed,
+                                       load_torque_Nm=s.load_torque_Nm * (torque or 0.0))
+                               for s in cycle.steps))
+
+
 def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None,
                     where: str | None = None) -> LoadCase:
     """The LoadCase of ``cycle`` on ``spec``: speeds, ambient and coolant from the cycle;
@@ -67,8 +159,37 @@ def cycle_load_case(spec: Spec, cycle: Cycle, drive: Drive | None = None,
                              "give the step a power_kW above its mechanical power M omega, or "
                              "leave power_kW out (the motor model then gives the losses)") from None
     check_drive_feeds(spec, drive)
+    _warn_overload(cycle, drive, where)
     sources = {k: TimeSeries(starts, tuple(h[k] for h in heats), "previous") for k in heats[0]}
     return cycle.to_load_case(spec, sources, others="zero")
+
+
+#: a step's process torque beyond this many times the drive's rated torque is warned of: a
+#: spindle motor's short-time ratings (S6, S2) are 1.3-1.6 times its S1 torque
+OVERLOAD = 2.0
+
+
+def _warn_overload(cycle: Cycle, drive: Drive, where: str | None) -> None:
+    """A CycleWarning where a step of ``cycle`` asks more than :data:`OVERLOAD` times the
+    drive's rated torque (P_mech / omega at its ``[nominal]`` point; none without one)."""
+    import warnings
+
+    from spindle.errors import CycleWarning
+    from spindle.units import RPM_TO_RAD_S
+
+    point = drive.nominal
+    if point is None:
+        return
+    rated = point.P_mech_W / (point.speed_rpm * RPM_TO_RAD_S)
+    worst = max(range(len(cycle.steps)), key=lambda i: cycle.steps[i].load_torque_Nm)
+    torque = cycle.steps[worst].load_torque_Nm
+    if torque > OVERLOAD * rated:
+        warnings.warn(CycleWarning(
+            f"{where or 'cycle ' + cycle.name}: steps[{worst}]: a process torque of {torque:g} "
+            f"N m is {torque / rated:.1f} times the drive's rated {rated:.3g} N m "
+            f"({point.P_mech_W / 1e3:g} kW at {point.speed_rpm:g} rpm): its heat is computed, "
+            "but no spindle motor holds it (fix: check the cycle's torques and units)"),
+            stacklevel=3)
 
 
 def check_drive_feeds(spec: Spec, drive: Drive) -> list[str]:
@@ -133,7 +254,8 @@ def check_load_case(spec: Spec, case: LoadCase) -> None:
 
 
 def load_case(spec: Spec, name_or_path: str | Path, base: LoadCase | None = None) -> LoadCase:
-    """The LoadCase of any cycle a user can name: a shipped cycle name, a cycle TOML, a
+    """The LoadCase of any cycle a user can name: a shipped cycle name, ``rated`` or
+    ``rated-16h`` (the spindle's own rating, :func:`rated_cycles`), a cycle TOML, a
     step-table CSV (``speed_rpm, duration_s, ...``: heat from the power balance) or a
     time-series CSV (``time_s, speed_rpm, T_env_C, T_coolant_C, <source>_W``: heat as given,
     what the file leaves out taken from ``base``, by default the spec's own load case)."""
@@ -144,4 +266,6 @@ def load_case(spec: Spec, name_or_path: str | Path, base: LoadCase | None = None
         if "time_s" in [h.strip() for h in header.split(",")]:
             return read_cycle_csv(path, [h.name for h in spec.heat_sources],
                                   base if base is not None else spec.default_load_case())
+    if str(name_or_path) in RATED_CYCLES:
+        return cycle_load_case(spec, spindle_cycle(spec, str(name_or_path)))
     return cycle_load_case(spec, load_cycle(name_or_path), where=str(name_or_path))

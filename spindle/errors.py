@@ -61,3 +61,7 @@ def stop_if_requested() -> None:
     """KeyboardInterrupt if the user asked the run to stop."""
     if STOP["requested"]:
         raise KeyboardInterrupt
+
+
+class CycleWarning(UserWarning):
+    """A load cycle the tool runs but doubts (a load beyond the drive's rating)."""

@@ -284,3 +284,95 @@ def test_a_cycle_file_with_a_byte_order_mark_is_read(tmp_path):
     plain.write_text(text, encoding="utf-8")
     marked.write_text(text, encoding="utf-8-sig")
     assert load_cycle(marked).steps == load_cycle(plain).steps
+
+
+OWN_SPECS = __import__("pathlib").Path(__file__).resolve().parent / "data" / "own-specs"
+
+
+def test_the_spl2782_is_rated_at_the_papers_cycles():
+    """For the SPL2782.1 (its drive's nominal point is the paper's) 'rated' and 'rated-16h'
+    are the shipped nominal and spl-16h, and the drawn cycles are drawn as they were: the
+    study, the sensors, measures and the ROM give what they gave."""
+    from spindle.cycles import drawn_cycle
+    from spindle.drive import rated_scale, spindle_cycle
+
+    spec = load_spec("spl2782")
+    assert rated_scale(spec, drive_for(spec)) == (1.0, 1.0)
+    assert spindle_cycle(spec, "rated") == load_cycle("nominal")
+    assert spindle_cycle(spec, "rated-16h") == load_cycle("spl-16h")
+    for name in ("random", "random-loaded", "random-ramped-load"):
+        assert spindle_cycle(spec, name, 3) == drawn_cycle(name, 3)
+
+
+def test_another_spindle_is_studied_at_its_own_rated_point():
+    """A user's spec (gs24: 15 kW at 24000 rpm) had been studied at the SPL2782's 38 kW /
+    4300 rpm and its 16 h cycle, which put 250 K on its shaft. Its rated point is its
+    drive's [nominal]: the torque P_mech / omega held, and spl-16h's plateaus at the same
+    shares of its rated speed; the drawn cycles are scaled by the same two ratios."""
+    from compare.verify.study import study_cases
+    from spindle.cycles import drawn_cycle
+    from spindle.drive import spindle_cycle
+    from spindle.units import RPM_TO_RAD_S
+
+    spec = load_spec(OWN_SPECS / "gs24.toml")
+    drive = drive_for(spec)
+    torque = 15000.0 / (24000.0 * RPM_TO_RAD_S)  # the drive file's [nominal]
+    steady, transient = study_cases(spec)
+    assert steady.speed_rpm(0.0) == 24000.0
+    for name, q in drive.heat_W(24000.0, torque).items():
+        assert steady.sources[name](0.0) == pytest.approx(q, rel=1e-12)
+    paper = load_cycle("spl-16h")
+    shares = [s.speed_rpm / 4300.0 for s in paper.steps]
+    rated16 = spindle_cycle(spec, "rated-16h")
+    assert [s.speed_rpm / 24000.0 for s in rated16.steps] == pytest.approx(shares)
+    assert transient.duration_s == paper.duration_s
+    drawn, scaled = drawn_cycle("random-loaded", 1), spindle_cycle(spec, "random-loaded", 1)
+    k = torque / (38000.0 / 4300.0 / RPM_TO_RAD_S)  # its rated torque over the paper's
+    for a, b in zip(drawn.steps, scaled.steps, strict=True):
+        assert b.speed_rpm == pytest.approx(a.speed_rpm * 24000.0 / 4300.0)
+        assert b.load_torque_Nm == pytest.approx(a.load_torque_Nm * k)
+
+
+def test_a_drive_without_a_nominal_point_draws_no_loads_it_cannot_scale(tmp_path):
+    """Without [nominal] the rated torque is not known: a loaded drawn cycle is refused
+    (naming the drive file's table), an unloaded one runs at the spec's operating speed."""
+    from spindle.cycles import drawn_cycle
+    from spindle.drive import spindle_cycle
+
+    folder = tmp_path / "own"
+    folder.mkdir()
+    (folder / "drives").mkdir()
+    text = (OWN_SPECS / "drives" / "ms12.toml").read_text(encoding="utf-8")
+    start = text.index("[nominal]")
+    end = text.index("[", start + 1)
+    (folder / "drives" / "ms12.toml").write_text(text[:start] + text[end:], encoding="utf-8")
+    (folder / "ms12.toml").write_text((OWN_SPECS / "ms12.toml").read_text(encoding="utf-8"),
+                                      encoding="utf-8")
+    spec = load_spec(folder / "ms12.toml")
+    assert drive_for(spec).nominal is None
+    with pytest.raises(InputError, match=r"no \[nominal\] point"):
+        spindle_cycle(spec, "random-loaded", 0)
+    plain = spindle_cycle(spec, "random", 0)
+    top = max(s.speed_rpm for s in drawn_cycle("random", 0).steps)
+    assert max(s.speed_rpm for s in plain.steps) == pytest.approx(top * spec.speed_rpm / 4300.0)
+
+
+def test_a_load_beyond_the_drives_rating_is_warned_of(tmp_path):
+    """A process torque above twice the rated torque (a spindle motor's short-time ratings
+    are 1.3-1.6 times S1) is computed and warned of, naming the step; the paper's nominal
+    point (0.86 of the SPL2782's rated torque) is not."""
+    import warnings
+
+    from spindle.errors import CycleWarning
+
+    spec = load_spec(OWN_SPECS / "gs24.toml")
+    cycle = tmp_path / "heavy.toml"
+    cycle.write_text('[cycle]\nname = "heavy"\nsteps = [\n  { speed_rpm = 20000.0, duration_h '
+                     '= 1.0 },\n  { speed_rpm = 20000.0, duration_h = 1.0, load_torque_Nm = '
+                     '25.0 },\n]\n', encoding="utf-8")
+    with pytest.warns(CycleWarning, match=r"steps\[1\]: a process torque of 25 N m is 4.2 "
+                      r"times the drive's rated 5.97 N m"):
+        cycle_load_case(spec, load_cycle(str(cycle)), where=str(cycle))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CycleWarning)
+        cycle_load_case(load_spec("spl2782"), load_cycle("nominal"))

@@ -54,8 +54,8 @@ def _cmd_measures(args: argparse.Namespace, progress: Progress) -> int:
     inputs = [spec.path, str(mpath)]
     if args.case:
         case = load_case_input(spec, args.case, case, inputs)
-    elif spec.power_preset:
-        case = load_case(spec, "nominal", case)
+    elif spec.power_preset:  # the spindle's rated point (the SPL2782.1's: nominal)
+        case = load_case(spec, "rated", case)
     rep = run_measures(spec, mfile, case, args.level, tuple(args.lumped_nodes),
                        sweeps=not args.no_sweeps, points=args.points or 7,
                        scheduler=args.scheduler, workers=args.workers,

@@ -24,10 +24,16 @@ from compare.cli.common import (
 from compare.progress import Progress
 from spindle.errors import InputError
 
+#: the held-out cycles of the issue: the paper's 16 h cycle and the rated steady state (the
+#: SPL2782.1's spl-16h and nominal; another spindle's at its own rated point), a loaded
+#: random cycle and a no-load random cycle (seeds other than the training's)
+HELD_OUT = ("rated-16h", "rated", "random-loaded:1", "random:2")
+
 
 def _check_cycles(texts: list[str]) -> None:
     from spindle.cycle_files import shipped_cycles
     from spindle.cycles import RANDOM_CYCLES
+    from spindle.drive import RATED_CYCLES
 
     for text in texts:
         name, _, seed = text.partition(":")
@@ -35,13 +41,14 @@ def _check_cycles(texts: list[str]) -> None:
             raise InputError("command line", "--cycle/--held-out", f"'{text}': the seed "
                              f"'{seed}' is not a whole number >= 0 (a seed of the random "
                              "stream)", "write NAME or NAME:SEED, e.g. random:0")
-        if name not in RANDOM_CYCLES and name not in shipped_cycles():
+        if name not in (*RANDOM_CYCLES, *RATED_CYCLES) and name not in shipped_cycles():
             from pathlib import Path
 
             if not Path(name).is_file():
                 raise InputError("command line", "--cycle/--held-out", f"'{name}' is neither "
                                  "a shipped cycle, random, random-loaded nor a cycle file",
-                                 "give one of " + ", ".join([*shipped_cycles(), *RANDOM_CYCLES]))
+                                 "give one of " + ", ".join([*shipped_cycles(), *RANDOM_CYCLES,
+                                                             *RATED_CYCLES]))
 
 
 @with_progress("rom")
@@ -97,12 +104,14 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--level", type=MESH_LEVEL, default=2,
                    help="FEM level of the reference (default 2, the ground truth of spl2782)")
     p.add_argument("--cycle", "--case", default="random-loaded:0", metavar="CYCLE[:SEED]",
-                   help="training cycle: a shipped cycle, a cycle file, or random / "
-                        "random-loaded with a seed (default random-loaded:0)")
-    p.add_argument("--held-out", nargs="+", default=["spl-16h", "nominal", "random-loaded:1",
-                                                     "random:2"], metavar="CYCLE[:SEED]",
-                   help="cycles to check the ROM on (default spl-16h nominal random-loaded:1 "
-                        "random:2; a steady cycle is a steady state)")
+                   help="training cycle: a shipped cycle, a cycle file, rated / rated-16h "
+                        "(the spindle's rated point held, the paper's 16 h cycle at its rated "
+                        "speed), or random / random-loaded with a seed, scaled to the "
+                        "spindle's rated point (default random-loaded:0)")
+    p.add_argument("--held-out", nargs="+", default=list(HELD_OUT), metavar="CYCLE[:SEED]",
+                   help=f"cycles to check the ROM on (default {' '.join(HELD_OUT)}: for "
+                        "spl2782 rated-16h and rated are spl-16h and nominal; a steady cycle "
+                        "is a steady state)")
     p.add_argument("--dt", type=TIME_STEP_S, default=60.0,
                    help="time step of the FEM and ROM runs compared [s] (default 60)")
     p.add_argument("--tol-temp", type=POSITIVE, default=0.05,

@@ -91,9 +91,10 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--nodes", type=NODE_COUNT, nargs="+", default=list(NODES),
                    help="lumped node counts (default " + " ".join(map(str, NODES)) + ")")
     p.add_argument("--cases", nargs="+", metavar="CYCLE",
-                   help="shipped cycle names or cycle files; a steady cycle (nominal) is a "
-                        "steady state, the others transients (default: the study's two cases, "
-                        "e.g. nominal and spl-16h)")
+                   help="shipped cycle names, rated / rated-16h (the spindle's own rating) or "
+                        "cycle files; a steady cycle (nominal, rated) is a steady state, the "
+                        "others transients (default: the study's two cases, rated and "
+                        "rated-16h: for spl2782 nominal and spl-16h)")
     p.add_argument("--level", type=MESH_LEVEL, default=2,
                    help="FEM level of the reference for the node count (default 2)")
     p.add_argument("--dt", type=TIME_STEP_S, default=60.0,

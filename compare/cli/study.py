@@ -48,7 +48,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     progress.done()
     conv = result.convergence
     gt = result.ground_truth_level
-    print(f"{spec.name}: verification study, {result.runtime_s:.1f} s")
+    print(f"{spec.name}: verification study, {result.runtime_s:.1f} s; {result.cases_text()}")
     print(f"FEM grid convergence ({conv.case_name}, levels {levels_text(conv.levels)}, "
           f"{conv.dofs[-1]} DOFs at the finest): ground truth = "
           + (f"level {gt} (GCI <= {args.threshold:g} % for every quantity)" if gt is not None

@@ -232,15 +232,14 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
     ``effect``: ``clean``, an effect of the library, a cause outside it (compare.synth.outside),
     or several of them (a list: injected together). Their sizes are drawn from the seed
     (each kind's ``draw``) unless ``truths`` gives them (name -> parameters).
-    ``cycle_name``: a shipped cycle or cycle file, or ``random`` / ``random-loaded`` /
-    ``random-ramped-load`` (a cycle drawn from the seed, :func:`spindle.cycles.drawn_cycle`).
+    ``cycle_name``: a shipped cycle or cycle file, ``rated`` / ``rated-16h``, or ``random`` /
+    ``random-loaded`` / ``random-ramped-load`` (a cycle drawn from the seed, scaled to the
+    spindle's rated point: :func:`spindle.drive.spindle_cycle`).
     ``mismatch``: the data come from a spindle that differs from ``spec``
     (:func:`compare.synth.mismatch.draw_mismatch`, drawn from the seed; its FEM level replaces
     ``level``), recorded in the truth."""
     from compare.synth.mismatch import draw_mismatch
-    from spindle.cycle_files import load_cycle
-    from spindle.cycles import RANDOM_CYCLES, drawn_cycle
-    from spindle.drive import cycle_load_case, drive_for
+    from spindle.drive import cycle_load_case, drive_for, spindle_cycle
     from spindle.errors import InputError
     from spindle.outputs import atomic_write
 
@@ -278,8 +277,7 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
              "cycle": cycle_name, "fem_level": level, "spec": spec.name}
     # the mismatch and the random cycle have streams of their own, so that a seed's effect
     # and bench sampling stay what they were without them
-    cycle = drawn_cycle(cycle_name, seed) if cycle_name in RANDOM_CYCLES else \
-        load_cycle(cycle_name)
+    cycle = spindle_cycle(spec, cycle_name, seed)
     if mismatch:
         mm = draw_mismatch(np.random.default_rng([seed, 1]))
         spec, drive = mm.apply(spec, drive)

@@ -26,15 +26,15 @@ def default_cases(spec: Spec) -> list[LoadCase]:
 
 
 def load_cases(spec: Spec, names: Sequence[str], steady_cycles: bool = True) -> list[LoadCase]:
-    """Load cases from shipped cycle names (or cycle files), through the spec's power balance
+    """Load cases from shipped cycle names, ``rated`` / ``rated-16h`` (the spindle's own
+    rating: spindle.drive.rated_cycles) or cycle files, through the spec's power balance
     (:func:`spindle.drive.cycle_load_case`). A cycle marked ``steady`` (``nominal``) becomes a
     steady case (duration 0 s) when ``steady_cycles``; every other cycle is a transient."""
-    from spindle.cycle_files import load_cycle
-    from spindle.drive import cycle_load_case
+    from spindle.drive import cycle_load_case, spindle_cycle
 
     out = []
     for name in names:
-        cycle = load_cycle(name)
+        cycle = spindle_cycle(spec, name)
         case = cycle_load_case(spec, cycle)
         if cycle.steady and steady_cycles:
             case = replace(case, duration_s=0.0)

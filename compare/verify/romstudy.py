@@ -26,21 +26,14 @@ def named_case(spec, name: str, seed: int = 0) -> LoadCase:
     synth`` draws from ``seed`` (spindle.cycles.drawn_cycle), named with its seed."""
     from dataclasses import replace
 
-    from spindle.cycle_files import load_cycle
-    from spindle.cycles import RANDOM_CYCLES, drawn_cycle
-    from spindle.drive import cycle_load_case
+    from spindle.cycles import RANDOM_CYCLES
+    from spindle.drive import cycle_load_case, spindle_cycle
 
-    if name in RANDOM_CYCLES:
-        case = cycle_load_case(spec, drawn_cycle(name, seed))
-        return replace(case, name=f"{name} (seed {seed})")
-    cycle = load_cycle(name)
+    cycle = spindle_cycle(spec, name, seed)
     case = cycle_load_case(spec, cycle)
+    if name in RANDOM_CYCLES:
+        return replace(case, name=f"{name} (seed {seed})")
     return replace(case, duration_s=0.0) if cycle.steady else case
-
-
-#: the held-out cycles of the issue: the paper's 16 h cycle, the nominal steady state, a
-#: loaded random cycle and a no-load random cycle (seeds other than the training's)
-HELD_OUT = ("spl-16h", "nominal", "random-loaded:1", "random:2")
 
 
 def parse_cycle(text: str) -> tuple[str, int]:

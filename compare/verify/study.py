@@ -172,6 +172,17 @@ class StudyResult:
         return files
 
     # ------------------------------------------------------------------ report
+    def cases_text(self) -> str:
+        """The load cases in words: the steady one's speed and heat per source, the
+        transient one's name (spindle.drive.rated_cycles)."""
+        c = self.steady_case
+        heat = {k: float(q(0.0)) for k, q in c.sources.items()}
+        text = (f"steady case '{c.name}' at {c.speed_rpm(0.0):g} rpm, {sum(heat.values()):.0f} W "
+                "of heat (" + ", ".join(f"{k} {q:.0f} W" for k, q in heat.items()) + ")")
+        if self.transient is not None:
+            text += f"; transient case '{self.transient.case_name}'"
+        return text
+
     def _html(self, out: Path, pictures: bool) -> str:
         def img(name: str, alt: str) -> str:
             # without pictures, a PNG left in ``out`` by an earlier run must not be shown
@@ -188,7 +199,7 @@ class StudyResult:
             f"<h1>Verification study: {html.escape(self.spec.name)}</h1>",
             f"<p>{html.escape(self.spec.description)}<br>Source: {html.escape(self.spec.source)}"
             f"<br>Run time {self.runtime_s:.1f} s. Tolerances (paper): {TOL_TEMP_K:g} K, "
-            f"±{TOL_GROWTH_UM:g} µm.</p>",
+            f"±{TOL_GROWTH_UM:g} µm.<br>Load cases: {html.escape(self.cases_text())}.</p>",
             f'<p class="summary">{html.escape(self.headline())}</p>',
             "<h2>Verdicts</h2>" + self._verdict_table(),
             self._failures_html(),
@@ -290,15 +301,16 @@ def _reference_entry(conv: ConvergenceResult, case: LoadCase) -> tuple[Entry, st
 
 
 def study_cases(spec: Spec) -> tuple[LoadCase, LoadCase]:
-    """(steady case, transient case): nominal and spl-16h through the power balance for a spec
-    with one; otherwise its own load case, and an 8 h warm-up from ambient."""
-    from spindle.cycle_files import load_cycle
-    from spindle.drive import cycle_load_case, drive_for
+    """(steady case, transient case) through the power balance for a spec with one: the
+    spindle's rated point held and the paper's 16 h cycle at its rated speed
+    (spindle.drive.rated_cycles: for the SPL2782.1 the shipped ``nominal`` and ``spl-16h``);
+    otherwise its own load case, and an 8 h warm-up from ambient."""
+    from spindle.drive import cycle_load_case, drive_for, rated_cycles
 
     drive = drive_for(spec)
     if drive is not None:
-        return (cycle_load_case(spec, load_cycle("nominal"), drive),
-                cycle_load_case(spec, load_cycle("spl-16h"), drive))
+        steady, transient = rated_cycles(spec, drive)
+        return (cycle_load_case(spec, steady, drive), cycle_load_case(spec, transient, drive))
     base = spec.default_load_case()
     return base, replace(base, name="warm-up 8 h", duration_s=WARMUP_S)
 
