@@ -33,9 +33,13 @@ from spindle.units import ZERO_C_K
 T20_K = ZERO_C_K + 20.0
 #: Standard gravity [m/s2]
 G_M_S2 = 9.80665
-#: Speeds at which the film tables are tabulated by default [rpm]
+#: Speeds at which the film tables are tabulated by default [rpm], up to the spec reader's
+#: limit (spindle.units.SPEED_MAX_RPM): a table held its last value beyond its last point,
+#: so a high-speed spindle's films would stop rising with speed
 DEFAULT_SPEEDS_RPM: tuple[float, ...] = (0.0, 250.0, 500.0, 1000.0, 1500.0, 2000.0, 3000.0,
-                                         4300.0, 6000.0, 8000.0, 10000.0, 12000.0)
+                                         4300.0, 6000.0, 8000.0, 10000.0, 12000.0, 15000.0,
+                                         18000.0, 24000.0, 30000.0, 40000.0, 50000.0,
+                                         60000.0, 80000.0, 100000.0)
 
 
 # ------------------------------------------------------------------------ fluid properties

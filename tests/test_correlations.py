@@ -146,3 +146,15 @@ def test_speed_tables_for_specs():
         correlations.speed_table(lambda n: n, (0.0, 10.0, 5.0))
     with pytest.raises(ValueError):
         correlations.speed_table(lambda n: n, (-1.0, 10.0))
+
+
+def test_a_correlation_film_rises_beyond_12000_rpm():
+    """The film tables had ended at 12 000 rpm, so a 24 000 rpm grinder's shaft film stayed
+    at its 12 000 rpm value (74 W/m2K where the correlation gives 118). The table now reaches
+    the spec reader's speed limit; at 24 000 rpm it is the correlation itself (a table point),
+    and below 12 000 rpm nothing moved (the old points are kept)."""
+    g = correlations.shaft_film_table(0.05)
+    assert g.speed_rpm[-1] == 100000.0 and set(g.speed_rpm) >= {0.0, 4300.0, 12000.0}
+    assert g(24000.0) == pytest.approx(correlations.h_rotating_shaft_W_m2K(24000.0, 0.05),
+                                       rel=1e-12)
+    assert g(24000.0) > 1.4 * g(12000.0)
