@@ -40,6 +40,10 @@ DEFAULT_SPEEDS_RPM: tuple[float, ...] = (0.0, 250.0, 500.0, 1000.0, 1500.0, 2000
                                          4300.0, 6000.0, 8000.0, 10000.0, 12000.0, 15000.0,
                                          18000.0, 24000.0, 30000.0, 40000.0, 50000.0,
                                          60000.0, 80000.0, 100000.0)
+#: up to this speed [rpm] a film table is the correlation's within its range, or an error;
+#: beyond it the table ends where the correlation leaves its range (an air gap's Taylor
+#: number above Becker and Kaye's 1e7) and holds its last value
+STRICT_TO_RPM = 12000.0
 
 
 # ------------------------------------------------------------------------ fluid properties
@@ -310,7 +314,15 @@ def speed_table(h_of_rpm: Callable[[float], float],
         raise ValueError("speeds_rpm is empty; give at least one speed")
     if any(b <= a for a, b in zip(speeds, speeds[1:], strict=False)):
         raise ValueError(f"speeds_rpm {speeds} must be strictly ascending")
-    return SpeedTable(speeds, tuple(float(h_of_rpm(s)) for s in speeds))
+    values = []
+    for s in speeds:
+        try:
+            values.append(float(h_of_rpm(s)))
+        except ValueError:
+            if s <= STRICT_TO_RPM:
+                raise
+            break  # the correlation's range ends here: the table holds its last value
+    return SpeedTable(speeds[:len(values)], tuple(values))
 
 
 def shaft_film_table(d_m: float, speeds_rpm: Sequence[float] = DEFAULT_SPEEDS_RPM, *,

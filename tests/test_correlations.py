@@ -158,3 +158,28 @@ def test_a_correlation_film_rises_beyond_12000_rpm():
     assert g(24000.0) == pytest.approx(correlations.h_rotating_shaft_W_m2K(24000.0, 0.05),
                                        rel=1e-12)
     assert g(24000.0) > 1.4 * g(12000.0)
+
+
+def test_a_table_beyond_12000_rpm_ends_where_its_correlation_does():
+    """A wide air gap leaves Becker and Kaye's range (Taylor number 1e7) at speeds the
+    spindle never runs: beyond 12 000 rpm its table ends there and holds its last value, so
+    the spec reads as it did (bs25, a user's 2500 rpm boring spindle, had been refused once
+    the tables reached 100 000 rpm); up to 12 000 rpm a correlation out of range stays an
+    error."""
+    from pathlib import Path
+
+    from spindle.spec import AirGapLink
+    from spindle.spec_reader import load_spec
+
+    spec = load_spec(Path(__file__).resolve().parent / "data" / "own-specs" / "bs25.toml")
+    gap = next(lk for lk in spec.links if isinstance(lk, AirGapLink)).h_W_m2K
+    assert correlations.STRICT_TO_RPM < gap.speed_rpm[-1] < 100000.0
+
+    def h(n: float) -> float:  # a correlation whose range ends at 11 000 rpm
+        if n > 11000.0:
+            raise ValueError("outside the correlation's range")
+        return 1.0 + n
+
+    with pytest.raises(ValueError):
+        correlations.speed_table(h, (0.0, 10000.0, 12000.0))
+    assert correlations.speed_table(h, (0.0, 10000.0, 15000.0)).speed_rpm == (0.0, 10000.0)
