@@ -127,6 +127,10 @@ def _regions(spec: Spec) -> list[Region]:
 def _level0(spec: Spec, regions: list[Region]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     h0 = spec.h0_m
     cuts = sorted({round(z, 9) for r in regions for z in (r.shape.z_start, r.shape.z_end)})
+    # a film on outer or inner faces that ends inside a section ends on a node line, so its
+    # area is the spec's at every level (between two nodes it took a level's share of a facet)
+    cuts = sorted({*cuts, *(round(z, 9) for s in spec.surfaces if s.side not in ("front", "rear")
+                            for z in (s.z_min, s.z_max) if cuts[0] < z < cuts[-1])})
     zs: list[float] = []
     for a, b in zip(cuts, cuts[1:], strict=False):
         n = max(1, math.ceil((b - a) / h0 - 1e-9))

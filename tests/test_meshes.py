@@ -162,3 +162,21 @@ def test_a_spec_scaled_in_radius_is_the_same_spindle_slimmer():
     assert [s.r for s in slim.sensors] == pytest.approx([0.8 * s.r for s in spec.sensors])
     sections = [sec for p in slim.parts for sec in p.sections]
     assert all(any(sec.contains(s.z, s.r) for sec in sections) for s in slim.sensors)
+
+
+def test_a_film_that_ends_inside_a_section_has_the_same_area_at_every_level():
+    """ms12 (a user's spec) ends its shaft_rear_free film at z = 14 mm, inside the shaft's
+    rear section: its area was 28.9, 28.9, 26.5 and 27.7 cm2 at levels 0-3 (a facet across
+    the limit counted or not by its midpoint), and the study's grid convergence oscillated.
+    The limit is now a node line at every level (meshes.build._level0)."""
+    from pathlib import Path
+
+    spec = load_spec(Path(__file__).resolve().parent / "data" / "own-specs" / "ms12.toml")
+    areas = []
+    for level in range(3):
+        sm = build_mesh(spec, level)
+        p = sm.mesh.p[:, sm.mesh.facets[:, sm.surfaces["shaft_rear_free"]]]
+        length = np.hypot(p[0, 0] - p[0, 1], p[1, 0] - p[1, 1])
+        areas.append(float(np.sum(2 * np.pi * 0.5 * (p[1, 0] + p[1, 1]) * length)))
+        assert np.max(p[0]) == pytest.approx(0.014, abs=1e-12)  # it ends at its limit
+    assert areas == pytest.approx([areas[0]] * 3, rel=1e-12)
