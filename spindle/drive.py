@@ -107,7 +107,8 @@ def rated_scale(spec: Spec, drive: Drive) -> tuple[float, float | None]:
 
 def spindle_cycle(spec: Spec, name: str, seed: int = 0) -> Cycle:
     """The cycle ``name`` for this spindle: ``rated`` and ``rated-16h`` at its own rated
-    point (:func:`rated_cycles`); ``random``, ``random-loaded``, ``random-ramped-load``
+    point (:func:`rated_cycles`; a spec without a drive, whose sources are constant, takes the
+    shipped ``nominal`` and ``spl-16h`` as they are); ``random``, ``random-loaded``, ``random-ramped-load``
     drawn from ``seed`` (spindle.cycles.drawn_cycle, drawn for the SPL2782.1) with speeds
     and torques scaled to its rated point (:func:`rated_scale`); else the shipped cycle or
     cycle file as it is."""
@@ -116,12 +117,10 @@ def spindle_cycle(spec: Spec, name: str, seed: int = 0) -> Cycle:
     from spindle.cycles import RANDOM_CYCLES, drawn_cycle
 
     drive = drive_for(spec)
-    if name in RATED_CYCLES:
-        if drive is None:
-            raise InputError(spec.path, "power_balance.preset", f"the cycle '{name}' is the "
-                             "drive's rated point, and the spec names no drive",
-                             "add [power_balance] preset to the spec, or name another cycle")
-        return rated_cycles(spec, drive)[RATED_CYCLES.index(name)]
+    if name in RATED_CYCLES:  # without a drive: the paper's, with the spec's own sources
+        cycles = (rated_cycles(spec, drive) if drive is not None
+                  else (load_cycle("nominal"), load_cycle("spl-16h")))
+        return cycles[RATED_CYCLES.index(name)]
     if name not in RANDOM_CYCLES:
         return load_cycle(name)
     cycle = drawn_cycle(name, seed)

@@ -137,7 +137,8 @@ MOTOR_FIELDS = (Field("R20_ohm", "ohm", lo=0.0, lo_open=True, hi=100.0),  # (0.1
 BEARING_FIELDS = (Field("f0", "-", lo=0.0, lo_open=True, hi=100.0),  # Palmgren's 1-10 (0.26)
                   # 2 m catches a pitch diameter given in mm
                   Field("dm_m", "m", lo=0.0, lo_open=True, hi=2.0),
-                  Field("nu_mm2_s", "mm2/s", lo=0.0, lo_open=True, hi=1e5),  # (12)
+                  # 0.1 mm2/s is a tenth of water's: it catches a viscosity given in m2/s
+                  Field("nu_mm2_s", "mm2/s", lo=0.1, hi=1e5),  # (12)
                   Field("preload_N", "N", lo=0.0, hi=1e6),  # (300-400)
                   # 100 N catches a rating given in kN (40-52 kN)
                   Field("C0_N", "N", lo=100.0, hi=1e8),
@@ -148,7 +149,8 @@ DRIVE_KEYS = ("name", "description", "T_winding_K")
 TABLES = ("drive", "nominal", "motor", "bearings")
 #: A unit slip that a range check most likely caught, named in the fix.
 UNIT_SLIPS = {"T_winding_K": " (in K: 120 degC is 393.15 K)", "dm_m": " (in m: 115 mm is 0.115 m)",
-              "C0_N": " (in N: 40 kN is 40000 N)"}
+              "C0_N": " (in N: 40 kN is 40000 N)",
+              "nu_mm2_s": " (in mm2/s: 1.5e-5 m2/s is 15 mm2/s)"}
 #: Heat-source names the motor feeds; a bearing set cannot take them.
 MOTOR_SOURCES = ("stator", "rotor")
 

@@ -288,6 +288,17 @@ def read_cycle_csv(path: str | Path, source_names: list[str], base: LoadCase) ->
                              "give the heat the source puts into the spindle, in W (a loss is "
                              "never negative)")
     sources = {s: series(f"{s}_W") for s in source_names if f"{s}_W" in data}
+    kept = [s for s in source_names if s not in sources]
+    if sources and kept:  # some heat follows the file, some stays constant: say which
+        import warnings
+
+        from spindle.errors import CycleWarning
+
+        warnings.warn(CycleWarning(
+            f"{name}: no column {', '.join(f'{s}_W' for s in kept)}: "
+            f"{'that source keeps' if len(kept) == 1 else 'those sources keep'} the spec's "
+            "constant power throughout, at standstill too (fix: add the column, with 0 where "
+            "the source is off)"), stacklevel=2)
     return case.with_sources(sources)
 
 

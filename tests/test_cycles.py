@@ -398,3 +398,29 @@ def test_a_step_table_too_long_asks_for_its_own_column(tmp_path):
     with pytest.raises(InputError) as exc:
         load_cycle(str(p))
     assert "duration_s column" in exc.value.problem.fix and "duration_h" not in str(exc.value)
+
+
+def test_a_time_series_with_some_source_columns_says_which_keep_the_specs_power(tmp_path):
+    """A time series that gives the stator's heat and not the bearings' kept the bearings at
+    the spec's constant watts, at standstill too, without a word (a user's T1 stayed 47 K up
+    after an hour at 0 rpm); now a warning names the columns left out. A file with every
+    source's column, or none (the spec's sources throughout, as asked), warns of nothing."""
+    import warnings
+
+    from spindle.errors import CycleWarning
+    from spindle.loads import read_cycle_csv
+    from spindle.spec_reader import load_spec
+
+    spec = load_spec("fin-shaft")
+    names = [h.name for h in spec.heat_sources]
+    base = spec.default_load_case()
+    p = write(tmp_path, "partial.csv", f"time_s,speed_rpm,{names[0]}_W\n0,0,1\n60,0,0\n")
+    with pytest.warns(CycleWarning, match=f"no column {names[1]}_W: that source keeps the "
+                      "spec's constant power"):
+        case = read_cycle_csv(p, names, base)
+    assert case.sources[names[1]](30.0) == base.sources[names[1]](30.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CycleWarning)
+        read_cycle_csv(write(tmp_path, "all.csv", "time_s," + ",".join(f"{n}_W" for n in names)
+                             + "\n0,1,1\n60,0,0\n"), names, base)
+        read_cycle_csv(write(tmp_path, "none.csv", "time_s,speed_rpm\n0,0\n60,0\n"), names, base)

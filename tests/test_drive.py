@@ -246,6 +246,8 @@ def test_friction_exponent_scales_the_bearing_friction_with_speed():
     ("kT_Nm_A = 0.8", "kT_Nm_A = 1e-300", "motor.kT_Nm_A", "out of range"),
     # a static load rating given in kN: the preload over C0 made a torque of 1e98 N m
     ("C0_N = ", "C0_N = 40.0 # ", "bearings.front_bearing.C0_N", "out of range"),
+    # a viscosity in m2/s (a user's drive file): the friction fell a million-fold, T1 36 K
+    ("nu_mm2_s = ", "nu_mm2_s = 1.5e-5 # ", "bearings.front_bearing.nu_mm2_s", "out of range"),
 ])
 def test_drive_values_beyond_any_spindle_are_refused_by_name(tmp_path, old, new, field, words):
     """The bounds sit a hundred to a thousand times beyond any motor spindle's value
@@ -259,6 +261,8 @@ def test_drive_values_beyond_any_spindle_are_refused_by_name(tmp_path, old, new,
     assert field in by_field and words in by_field[field].message
     if field.endswith("C0_N"):
         assert "40000 N" in by_field[field].fix
+    if field.endswith("nu_mm2_s"):
+        assert "15 mm2/s" in by_field[field].fix
 
 
 def test_a_cycle_step_whose_power_is_below_its_mechanical_power_names_the_step(tmp_path):
