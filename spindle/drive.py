@@ -199,10 +199,13 @@ def check_drive_feeds(spec: Spec, drive: Drive) -> list[str]:
     names = [h.name for h in spec.heat_sources]
     missing = [k for k in fed if k not in names]
     if missing:
+        unfed = [k for k in names if k not in fed]
         raise InputError(spec.path, "heat_sources", f"the power balance of the drive "
-                         f"'{drive.name}' feeds sources {missing} that the spec does not have",
-                         f"name the spec's heat sources {', '.join(fed)}, as the drive's "
-                         "motor and bearing sets are named")
+                         f"'{drive.name}' feeds sources {missing} that the spec does not have"
+                         + (f" (the spec's {unfed} get nothing)" if unfed else ""),
+                         f"name the drive file's sets ([bearings.NAME]) as the spec's heat "
+                         f"sources, or the spec's heat sources {', '.join(fed)}, as the "
+                         "drive's motor and bearing sets are named")
     return [k for k in names if k not in fed]
 
 

@@ -126,6 +126,9 @@ def _check_parts_joined(r: FieldReader, parts: list[Part], links: list[Link],
     """No part stands alone, bearings sit between shaft and housing, and a rotor and a
     stator have an air-gap link."""
     roles = {p.name: p.role for p in parts}
+    if any(p.role in BEARING_ROLES for p in parts) and "shaft" not in roles.values():
+        r.add("parts", "no part has the role \"shaft\", which the bearings sit on",
+              "give the spindle's shaft role = \"shaft\" (docs/spec.md, roles)")
     for p in parts:
         if len(parts) > 1 and not joined[p.name]:
             r.add(f"parts[{parts.index(p)}]", f"part '{p.name}' is separated from every other "

@@ -54,8 +54,11 @@ def test_a_source_the_drive_feeds_and_the_spec_lacks_is_refused_by_fit(tmp_path,
     out = tmp_path / "o"
     assert main(["fit", str(run), "--spec", spec.path, "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
-    assert f"{spec.path}: heat_sources:" in err and "stator_winding" not in err.split("fix")[0]
-    assert "fix: name the spec's heat sources stator, rotor" in err
+    assert f"{spec.path}: heat_sources:" in err
+    # the spec's source the drive does not feed is named, and the fix points at both files
+    assert "(the spec's ['stator_winding'] get nothing)" in err.split("fix")[0]
+    assert "fix: name the drive file's sets ([bearings.NAME]) as the spec's heat sources" in err
+    assert "or the spec's heat sources stator, rotor" in err
     assert "Traceback" not in err and not out.exists()
 
 

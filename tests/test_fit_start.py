@@ -142,7 +142,11 @@ def test_a_run_of_another_spindle_is_warned_of():
         return replace(read_bench(PEER_RUNS / "bench-runs-2" / "dev2-06.csv"),
                        metadata={"spindle": named} if named else {})
 
-    assert "names the spindle 'spl9999'" in _other_spindle(run("spl9999"), SPEC)
+    from spindle.bench import BenchWarning
+
+    # in the report and on stderr at once (a user's run had it on stdout after the verdict)
+    with pytest.warns(BenchWarning, match="names the spindle 'spl9999'"):
+        assert "names the spindle 'spl9999'" in _other_spindle(run("spl9999"), SPEC)
     assert _other_spindle(run("SPL2782"), SPEC) == ""
     assert _other_spindle(run("SPL2782-family spindle (not identical to the shipped spl2782 "
                               "spec)"), SPEC) == ""

@@ -332,3 +332,18 @@ def test_a_film_table_at_a_negative_speed_is_named(tmp_path):
     found = problems(tmp_path, GOOD.replace(
         "h_W_m2K = 10.0", "h_W_m2K = { speed_rpm = [-100.0, 0.0], value = [10.0, 10.0] }", 1))
     assert [p.field for p in found] == ["surfaces[0].h_W_m2K.speed_rpm"], found
+
+
+def test_bearings_without_a_shaft_say_that_no_part_is_the_shaft(tmp_path):
+    """A spec whose shaft has another role (a user's mutation: role = "tool") was told only
+    that each bearing must touch the shaft; the first problem now says no part is one."""
+    from pathlib import Path
+
+    text = Path(load_spec("spl2782").path).read_text(encoding="utf-8")
+    path = tmp_path / "case.toml"
+    path.write_text(text.replace('role = "shaft"', 'role = "tool"', 1), encoding="utf-8")
+    with pytest.raises(SpecError) as exc:
+        load_spec(path)
+    found = exc.value.problems
+    assert found[0].field == "parts" and 'no part has the role "shaft"' in found[0].message
+    assert 'role = "shaft"' in found[0].fix

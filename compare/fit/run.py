@@ -35,6 +35,7 @@ from compare.fit.signatures import Context, EventTest
 from compare.fit.start import Start, first_samples, run_start
 from spindle.bench import (
     BenchRun,
+    BenchWarning,
     check_against_spec,
     read_bench,
 )
@@ -387,8 +388,11 @@ def _other_spindle(run: BenchRun, spec: Spec) -> str:
     named = run.metadata.get("spindle", "").strip()
     if not named or spec.name.lower() in named.lower():
         return ""
-    return (f"the run's header names the spindle '{named}' and it is fitted with the spec "
+    text = (f"the run's header names the spindle '{named}' and it is fitted with the spec "
             f"'{spec.name}': check that --spec describes this spindle")
+    # on stderr at once too: every figure of the fit rests on the spec
+    warnings.warn(BenchWarning(f"{run.path}: {text}"), stacklevel=2)
+    return text
 
 
 def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fraction: float,
