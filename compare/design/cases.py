@@ -311,7 +311,8 @@ def solve_inverse(spec: Spec, case: LoadCase, template: Measure, target: Inverse
         return InverseResult(target, template.kind, False, math.nan, size_formula, start,
                              math.nan, best, size_max, len(values) + 1,
                              f"not reachable: the reference reaches {best:.4g} "
-                             f"{'um' if use_growth else '%'} at {hi:.4g}")
+                             f"{'um' if use_growth else '%'} at {target.vary} = {hi:.4g}, "
+                             "its size_max")
     size = float(brentq(f, lo, hi, xtol=1e-9 * hi, rtol=1e-6))
     v = value(size)
     return InverseResult(target, template.kind, True, size, size_formula, start, v, v,
