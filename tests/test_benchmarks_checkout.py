@@ -132,3 +132,27 @@ def test_the_logging_perturbations_leave_the_data_as_they_say(monkeypatch, tmp_p
     for c in ("T1_C", "P1_um"):
         n0 = np.isfinite(base.columns[c]).sum()
         assert np.isfinite(runs["sparse"].columns[c]).sum() == n0 - n0 // 2
+
+
+def test_interval_coverage_counts_the_intervals_that_hold_the_truth(monkeypatch, tmp_path):
+    """benchmarks/bench_interval_coverage.py on two made-up reports: an interval that holds
+    the injected value, one that misses it, and a named effect that is not the injected one
+    (not counted)."""
+    import json
+
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import bench_interval_coverage as cov
+
+    reports, cache = tmp_path / "reports", tmp_path / "cache"
+    reports.mkdir()
+    cache.mkdir()
+    for run, (lo, hi) in {"effect-1": (0.1, 0.2), "effect-2": (0.05, 0.09)}.items():
+        (cache / f"{run}.truth.json").write_text(json.dumps(
+            {"effect": "bearing_preload", "parameters": {"k_preload_1_K": 0.15}}))
+        (reports / f"{run}.json").write_text(json.dumps({"effects": [
+            {"name": "bearing_preload", "parameters": {"k_preload_1_K": 0.5 * (lo + hi)},
+             "confidence_intervals": {"k_preload_1_K": [lo, hi]}},
+            {"name": "mount_conduction", "parameters": {"G_mount_W_K": 3.0},
+             "confidence_intervals": {"G_mount_W_K": [2.0, 4.0]}}]}))
+    rows = cov.interval_rows(reports, cache)
+    assert [(r["run"], r["holds"]) for r in rows] == [("effect-1", True), ("effect-2", False)]
