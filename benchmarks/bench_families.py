@@ -117,22 +117,27 @@ def logs_on_change(family: str, seed: int) -> bool:
     return bool(np.random.default_rng([seed, 5, FAMILIES.index(family)]).random() < 0.5)
 
 
-def draw(family: str, seed: int) -> tuple[list[str], str]:
+def draw(family: str, seed: int, spec=None) -> tuple[list[str], str]:
     """The effects (or cause outside the library) and the cycle of a family's run ``seed``,
-    from a stream of its own (the run's other draws are synth's)."""
+    from a stream of its own (the run's other draws are synth's); of a ``spec`` other than
+    the shipped one, only those that can act on it (Effect.missing_in: an air-cooled spindle
+    has no coolant to act through; the shipped spec's draws are as they were)."""
     import numpy as np
 
     from compare.fit.effects import LIBRARY
     from compare.synth.outside import OUTSIDE
 
+    def acting(kinds: dict) -> list[str]:
+        return [k for k, e in kinds.items() if spec is None or not e.missing_in(spec)]
+
     rng = np.random.default_rng([seed, 7, FAMILIES.index(family)])
     cycle = str(rng.choice(CYCLES))
     if family == "effect":
-        return [str(rng.choice(list(LIBRARY)))], cycle
+        return [str(rng.choice(acting(LIBRARY)))], cycle
     if family == "outside":
-        return [str(rng.choice(list(OUTSIDE)))], cycle
+        return [str(rng.choice(acting(OUTSIDE)))], cycle
     if family == "two":
-        return [str(x) for x in rng.choice(list(LIBRARY), size=2, replace=False)], cycle
+        return [str(x) for x in rng.choice(acting(LIBRARY), size=2, replace=False)], cycle
     return ["clean"], cycle
 
 
@@ -154,7 +159,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
         run, truth = Path(case.path), case.truth
         sizes = effect_sizes(case.truth_doc or {})
     else:
-        effects, cycle = draw(case.family, case.seed)
+        effects, cycle = draw(case.family, case.seed, spec)
         run = Path(case.cache) / f"{case.family}-{case.seed}.csv"
         sidecar = run.with_suffix(".truth.json")
         if not (run.exists() and sidecar.exists()):
@@ -349,6 +354,10 @@ def main(argv: list[str] | None = None) -> None:
                     "times these factors; fitted with the shipped spec")
     ap.add_argument("--fit-own-spec", action="store_true",
                     help="with --geometry: fit with the other spindle's own spec")
+    ap.add_argument("--spec", default="spl2782",
+                    help="draw the runs from this spindle and fit them with its spec (a shipped "
+                    "name or a spec file, e.g. tests/data/own-specs/gs24.toml; default spl2782); "
+                    "its runs are kept in a cache folder of its own")
     args = ap.parse_args(argv)
     if args.rows:
         try:
@@ -366,14 +375,18 @@ def main(argv: list[str] | None = None) -> None:
         args.cache = args.cache / f"geometry-{geometry[0]:g}-{geometry[1]:g}"
     elif args.fit_own_spec:
         ap.error("--fit-own-spec: only with --geometry")
+    if args.spec != "spl2782":
+        from spindle.spec_reader import load_spec
+
+        args.cache = args.cache / f"spec-{load_spec(args.spec).name}"
     args.cache.mkdir(parents=True, exist_ok=True)
     criteria = _criteria(ap, args.criterion)
     reports = None
     if args.reports:
         args.reports.mkdir(parents=True, exist_ok=True)
         reports = str(args.reports)
-    cases = [FamilyRun(f, s, str(args.cache), reports=reports, criteria=criteria,
-                       geometry=geometry, fit_own_spec=args.fit_own_spec)
+    cases = [FamilyRun(f, s, str(args.cache), spec=args.spec, reports=reports,
+                       criteria=criteria, geometry=geometry, fit_own_spec=args.fit_own_spec)
              for f in args.families
              if f in FAMILIES
              for s in range(args.first_seed, args.first_seed + args.runs_per_family)]
