@@ -245,10 +245,11 @@ def loss_excess(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
                 load_torque_Nm: np.ndarray) -> LossExcess | None:
     """Each running interval's losses, its mean electrical power [kW] less the load's
     mechanical power M omega (torque [N m], speed [rpm]), against the losses of ``drive`` at
-    its speed and the larger of the load's torque and the rated one. A torque only adds
-    losses, so no spindle makes more: for spl2782 at no load five times its no-load losses at
-    the nominal speed, thirty times at 1000 rpm. None without a nominal point or a running
-    interval with a measured power."""
+    its speed and the larger of the load's torque and the rated one, its bearings' friction
+    taken :data:`PALMGREN_SPREAD` times (the most a bearing set's f0 is off from its
+    spec's). A torque only adds losses, so no spindle makes more: for spl2782 at no load
+    five times its no-load losses at the nominal speed, thirty times at 1000 rpm. None
+    without a nominal point or a running interval with a measured power."""
     rated = rated_torque_Nm(drive)
     if rated is None:
         return None
@@ -260,8 +261,10 @@ def loss_excess(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
             continue
         running += 1
         key = (round(float(n)), max(abs(float(M)), rated))
-        if key not in limits:
-            limits[key] = sum(drive.heat_W(float(key[0]), key[1], None).values())
+        if key not in limits:  # above its rated speed a spindle's friction can dominate
+            heat = drive.heat_W(float(key[0]), key[1], None)
+            limits[key] = sum(q * (PALMGREN_SPREAD if k in drive.bearings else 1.0)
+                              for k, q in heat.items())
         ratio = (P * 1e3 - M * omega_rad_s(float(n))) / limits[key]
         over += ratio > 1.0
         if best is None or ratio > best[0]:
