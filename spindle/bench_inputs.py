@@ -337,12 +337,13 @@ def no_load_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,
                   load_torque_Nm: np.ndarray, loaded_Nm: float = LOAD_CELL_ZERO_NM
                   ) -> tuple[float, int]:
     """(median [-], intervals) over the running intervals without a load (torque [N m] at
-    most ``loaded_Nm``) of the power [kW] against the drive's no-load losses at the speed
-    [rpm]: all such power is loss, and a spindle's losses lie within a few times its spec's
-    (:data:`PALMGREN_SPREAD`), so a median far above it says the speeds are too low for the
-    power. nan without such an interval."""
+    most ``loaded_Nm``) of the losses, the power [kW] less the logged torque's M omega,
+    against the drive's no-load losses at the speed [rpm]: a spindle's losses lie within a
+    few times its spec's (:data:`PALMGREN_SPREAD`), so a median far above it says the speeds
+    are too low for the power. (At 24 000 rpm a load cell's zero, 0.5 N m, is 1.3 kW, as
+    much as a grinder loses: its M omega is taken out.) nan without such an interval."""
     no_load = _per_rpm(lambda n: sum(drive.heat_W(n, 0.0, None).values()))
-    shares = [P * 1e3 / no_load(n)
+    shares = [(P * 1e3 - M * omega_rad_s(float(n))) / no_load(n)
               for n, P, M in zip(speed_rpm, power_kW, load_torque_Nm, strict=True)
               if n >= STANDSTILL_RPM and abs(M) <= loaded_Nm and math.isfinite(P)]
     return (float(np.median(shares)) if shares else float("nan")), len(shares)

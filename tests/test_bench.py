@@ -1045,3 +1045,34 @@ def test_a_single_sample_no_sensor_reads_is_read_as_not_measured(tmp_path, colum
         run = read_bench(write(tmp_path, lines))
     y = run.columns[column]
     assert np.isnan(y[20]) and np.count_nonzero(np.isnan(y)) == 1
+
+
+OWN_SPECS = Path(__file__).resolve().parent / "data" / "own-specs"
+
+
+def test_a_high_speed_spindle_at_its_losses_passes_the_power_balance(tmp_path):
+    """gs24 (a user's 15 kW / 24 000 rpm grinder) with a load cell at 0.4 N m, within its
+    zero, and losses three times the drive's friction: drawn runs like it had been refused
+    twice, once as losses beyond the rated torque's (friction dominates there; the bound now
+    takes the bearings' friction three times, Palmgren's spread) and once as speeds too low
+    for the power (0.4 N m at 24 000 rpm is 1 kW of the power; the no-load median now takes
+    the logged M omega out). Energy is still checked: a run drawing 4 times the losses
+    without a torque column is refused."""
+    spec = load_spec(OWN_SPECS / "gs24.toml")
+    drive = drive_for(spec)
+    n, torque = 24000.0, 0.4
+    omega = n * 2.0 * np.pi / 60.0
+    heat = drive.heat_W(n, torque, None)
+    losses = sum(q * (3.0 if k in drive.bearings else 1.0) for k, q in heat.items())
+    header = HEADER + ",load_torque_Nm"
+
+    def hour(power_kW: float, name: str, with_torque: bool = True) -> Path:
+        lines = [row(i * 60.0, speed=f"{n:g}", power=f"{power_kW:.6f}")
+                 + (f",{torque:g}" if with_torque else "") for i in range(61)]
+        return write(tmp_path, lines, name=name, header=header if with_torque else HEADER)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BenchWarning)
+        inputs(read_bench(hour(0.99 * (losses + torque * omega) / 1e3, "ok.csv")), spec)
+    with pytest.raises(InputError):
+        inputs(read_bench(hour(4.0 * losses / 1e3, "four.csv", with_torque=False)), spec)
