@@ -270,7 +270,7 @@ def power_balance_text(doc: dict) -> str:
                ("loaded_without_torque", "losses / bound, loaded runs read without torque",
                 "(what it catches)"),
                ("efficiency", "median M·ω / P_el, loaded runs", "below 1"),
-               ("no_load_share", "median P_el / the drive's no-load losses, without a load",
+               ("no_load_share", "median (P_el - M ω) / the drive's no-load losses, without a load",
                 "below 3"),
                ("standstill_kW", "median P_el at standstill [kW]", "below 4.03"),
                ("growth_gain", "P1 / the spec's predicted growth", "0.0316 to 31.6"),
