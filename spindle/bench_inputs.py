@@ -424,7 +424,10 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
                 "export the drive's electrical power in kW (a power in MW is 1000 times too "
                 "small; a column of zeros was not logged)")
     check_power_moves(run)
-    ex = loss_excess(drive, speed_rpm, power_kW, load_torque_Nm)
+    # an interval at a logging gap holds inputs from either side of it (a speed changed in
+    # the gap), which no energy balance can judge: the fit places the change (compare.fit.gaps)
+    at_gap = gap_intervals(run.time_s, grid_s)
+    ex = loss_excess(drive, speed_rpm, np.where(at_gap, np.nan, power_kW), load_torque_Nm)
     if ex is not None and ex.over > 0:
         _refuse_loss_excess(run, drive, grid_s, speed_rpm, power_kW, load_torque_Nm, ex)
     first, length = below_friction_stretch(drive, speed_rpm, power_kW, load_torque_Nm,
@@ -465,6 +468,23 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
                 "so it turned while speed_rpm says it stood",
                 "export speed_rpm as the bench logged it (a column of zeros, or another "
                 "channel mapped to it)")
+
+
+def gap_intervals(time_s: np.ndarray, grid_s: np.ndarray,
+                  hold_steps: float = HOLD_STEPS) -> np.ndarray:
+    """Per interval of ``grid_s`` [s], whether it overlaps a logging gap of the rows'
+    ``time_s`` [s] (a silence longer than :func:`silence_s`) or is the first interval after
+    one."""
+    t = np.asarray(time_s, dtype=float)
+    g = np.asarray(grid_s, dtype=float)
+    out = np.zeros(len(g) - 1, dtype=bool)
+    if len(t) < 2 or len(g) < 2:
+        return out
+    step = float(np.median(np.diff(g)))
+    long = np.flatnonzero(np.diff(t) > silence_s(hold_steps, step, t))
+    for k in long:
+        out |= (g[1:] > t[k]) & (g[:-1] < t[k + 1] + step)
+    return out
 
 
 def check_power_moves(run: BenchRun) -> None:

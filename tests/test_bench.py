@@ -1076,3 +1076,29 @@ def test_a_high_speed_spindle_at_its_losses_passes_the_power_balance(tmp_path):
         inputs(read_bench(hour(0.99 * (losses + torque * omega) / 1e3, "ok.csv")), spec)
     with pytest.raises(InputError):
         inputs(read_bench(hour(4.0 * losses / 1e3, "four.csv", with_torque=False)), spec)
+
+
+def test_an_interval_at_a_logging_gap_is_not_judged_by_the_loss_bound(tmp_path):
+    """A speed change inside a logging gap leaves the interval at the gap's end with the old
+    speed and the new power (a drawn ms12 run, 7800 -> 16 500 rpm in a 20 min gap, was
+    refused as 1.1 times the losses any spindle makes). Such intervals are left to the fit,
+    which places the change (compare.fit.gaps); the loss bound judges every other one, so
+    a unit slip is still refused (the tests above)."""
+    from spindle.bench_inputs import gap_intervals
+
+    spec = load_spec("spl2782")
+    drive = drive_for(spec)
+    header = HEADER + ",load_torque_Nm"
+    omega = 6000.0 * 2.0 * np.pi / 60.0
+    high_kW = (sum(drive.heat_W(6000.0, 60.0, None).values()) + 60.0 * omega) / 1e3
+    low_kW = sum(drive.heat_W(1500.0, 0.0, None).values()) / 1e3
+    lines = [row(i * 10.0, speed="1500", power=f"{low_kW:.4f}") + ",0" for i in range(90)]
+    lines += [row(1800.0 + i * 10.0, speed="6000", power=f"{high_kW:.4f}") + ",60"
+              for i in range(180)]  # silent from 890 s to 1800 s: the change inside
+    run = read_bench(write(tmp_path, lines, header=header))
+    grid = bench_grid(run, 60.0)
+    at_gap = gap_intervals(run.time_s, grid)
+    assert at_gap.any() and not at_gap[:14].any() and not at_gap[32:].any()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BenchWarning)
+        inputs(run, spec)
