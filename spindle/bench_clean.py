@@ -91,12 +91,12 @@ def without_spikes(run: BenchRun, channels: list[str], alpha: float, grid_s: flo
 
 
 def coolant_as_room(run: BenchRun, spec) -> str | None:
-    """A warning where the spec cools the spindle with a liquid (a surface with T_ref =
-    "coolant") but ``run``'s coolant reads the room's value in every row that logs both: two
+    """A warning where the spec cools the spindle with a liquid (a film towards the coolant:
+    Spec.liquid_cooled) but ``run``'s coolant reads the room's value in every row that logs both: two
     sensors carry their own noise, and a chiller's supply is regulated apart from the
     room, so that is the room's column twice (an air-cooled spindle's coolant is the room's
     air, which check_not_copies lets pass). None otherwise."""
-    if not any(s.T_ref == "coolant" for s in spec.surfaces):
+    if not spec.liquid_cooled:
         return None
     env, cool = run.columns["T_env_C"], run.columns["T_coolant_C"]
     both = ~np.isnan(env) & ~np.isnan(cool)

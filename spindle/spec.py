@@ -180,6 +180,12 @@ class Spec:
                          for s in self.part(part).sections
                          if section is None or s.name == section))
 
+    @property
+    def liquid_cooled(self) -> bool:
+        """Whether a surface has a film towards the coolant (a jacket): without one the
+        coolant's temperature drives nothing."""
+        return any(s.T_ref == "coolant" and s.h_W_m2K is not None for s in self.surfaces)
+
     def temperature_sensors(self) -> list[Sensor]:
         return [s for s in self.sensors if s.kind == "temperature"]
 

@@ -119,9 +119,8 @@ class GreyBox:
         key = ("inert", self.nodes)
         if key not in self._cache:
             plain = GreyBox(self.spec, self.drive, self.inputs, self.nodes, _cache=self._cache)
-            model, groups, _ = plain._structure()
-            inert = set(_GROUPS) - set(groups)
-            if _coolant_port(model.net) is None:
+            inert = set(_GROUPS) - set(plain._structure()[1])
+            if not self.spec.liquid_cooled:
                 inert.add("G_seat_W_K")
             self._cache[key] = frozenset(inert)
         return self._cache[key]

@@ -24,7 +24,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from compare.fit.effects.base import NEEDS_COOLANT, Effect, Feedback, coolant_film
+from compare.fit.effects.base import Effect, Feedback
 from spindle.loads import TimeSeries
 
 #: the ramp [s] at either end of a window of hours: a door opened, a filter clogging
@@ -75,9 +75,7 @@ class SensorDrift(Effect):
 
 class CoolantSensorOffset(Effect):
     name = "coolant_sensor_offset"
-
-    def missing_in(self, spec):  # without a coolant film the logged coolant drives nothing
-        return "" if coolant_film(spec) else NEEDS_COOLANT
+    needs_coolant = True  # without a coolant film the logged coolant drives nothing
 
     def draw(self, rng):
         return {"start_h": float(rng.uniform(3.0, 11.0)),
@@ -138,9 +136,7 @@ class EnclosureDraft(Effect):
 
 class CoolantFlowDrop(Effect):
     name = "coolant_flow_drop"
-
-    def missing_in(self, spec):
-        return "" if coolant_film(spec) else NEEDS_COOLANT
+    needs_coolant = True
 
     def draw(self, rng):
         return {**_draw_window(rng), "R_K_W": float(rng.uniform(0.003, 0.008))}

@@ -13,7 +13,7 @@ An :class:`Effect` declares
   temperatures, or the measurement) and how to draw its size;
 - the hint the verdict gives when it is named;
 - what it needs of a spindle, where it needs something (:meth:`Effect.missing_in`: a coolant
-  film for an effect that acts through the coolant).
+  film for an effect that acts through the coolant, ``needs_coolant``).
 
 An effect that acts on one sensor (a lag) is ``per_channel``: it is tried on each measured
 channel, and its candidate label names the channel, ``sensor_lag(T2)``.
@@ -70,11 +70,15 @@ class Effect:
     hint: str = ""
     #: acts on the measurement alone (a recorded run can carry it injected: compare.synth.inject)
     measurement_only: bool = False
+    #: acts through the coolant, so a spindle needs a coolant film (Spec.liquid_cooled)
+    needs_coolant: bool = False
 
     def missing_in(self, spec: Spec) -> str:
         """What the spindle ``spec`` lacks for this effect to act ("" where nothing): one that
         cannot act on a spindle is no candidate of its fit, and no synthetic run of it can
         carry it."""
+        if self.needs_coolant and not spec.liquid_cooled:
+            return 'a coolant film (a [[surfaces]] entry with T_ref = "coolant")'
         return ""
 
     # ------------------------------------------------------------------ the grey box
@@ -146,15 +150,6 @@ class Effect:
         """A recorded run's columns (SI: ``speed_rpm``, ``T_env_K``, the channels in K, P1 in
         m) with this measurement-side effect injected (``measurement_only`` effects)."""
         raise NotImplementedError(f"{self.name} acts on the physics, not on the measurement")
-
-
-#: what an effect that acts through the coolant needs of a spec (Effect.missing_in)
-NEEDS_COOLANT = 'a coolant film (a [[surfaces]] entry with T_ref = "coolant")'
-
-
-def coolant_film(spec: Spec) -> bool:
-    """Whether a surface of ``spec`` has a film towards the coolant."""
-    return any(s.T_ref == "coolant" and s.h_W_m2K is not None for s in spec.surfaces)
 
 
 def spread_heat(net, masses, source: str, prefix: str) -> None:

@@ -17,7 +17,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from compare.fit.effects.base import NEEDS_COOLANT, Effect, Feedback, coolant_film
+from compare.fit.effects.base import Effect, Feedback
 from compare.fit.params import Param
 from compare.fit.signatures import EventTest
 from spindle.loads import TimeSeries
@@ -38,9 +38,7 @@ class CoolantDynamics(Effect):
                     "K/W; 0.02 is a flow of 0.7 l/min"),)
     in_conductance = ("R_adv_K_W",)
     hint = "the coolant flow (the chiller's flow rate and the jacket's supply temperature)"
-
-    def missing_in(self, spec):
-        return "" if coolant_film(spec) else NEEDS_COOLANT
+    needs_coolant = True
 
     def network_options(self):
         return {"coolant_advection_W_K": 1.0}  # set per parameter set
