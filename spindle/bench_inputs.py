@@ -18,7 +18,7 @@ import numpy as np
 
 from spindle.bench import DEFAULT_GRID_S, STANDSTILL_RPM, BenchRun, BenchWarning
 from spindle.checks import omega_rad_s
-from spindle.drive import Drive, check_drive_feeds, drive_for
+from spindle.drive import Drive, check_drive_feeds, drive_for, rated_torque_Nm
 from spindle.errors import InputError
 from spindle.loads import LoadCase, TimeSeries
 from spindle.power import bearing_friction, power_balance
@@ -232,13 +232,6 @@ class LossExcess:
     interval: int
     over: int
     running: int
-
-
-def rated_torque_Nm(drive: Drive) -> float | None:
-    """The drive's rated torque [N m]: its nominal point's P_mech / omega (None without one)."""
-    if drive.nominal is None:
-        return None
-    return drive.nominal.P_mech_W / omega_rad_s(drive.nominal.speed_rpm)
 
 
 def loss_excess(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray,

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from spindle.checks import omega_rad_s
 from spindle.cycle_files import load_cycle
 from spindle.cycles import Cycle
 from spindle.drive_file import Drive, read_drive_toml
@@ -49,6 +50,13 @@ def drive_for(spec: Spec) -> Drive | None:
                      "relative to the spec's folder (format: docs/power.md)")
 
 
+def rated_torque_Nm(drive: Drive) -> float | None:
+    """The drive's rated torque [N m]: its nominal point's P_mech / omega (None without one)."""
+    if drive.nominal is None:
+        return None
+    return drive.nominal.P_mech_W / omega_rad_s(drive.nominal.speed_rpm)
+
+
 #: the shipped cycles' rated point (the SPL2782.1's, paper section 3): ``nominal`` holds it
 #: and ``spl-16h`` climbs to its speed
 PAPER_RATED = (4300.0, 38000.0)  # rpm, W of mechanical output
@@ -65,7 +73,6 @@ def rated_cycles(spec: Spec, drive: Drive) -> tuple[Cycle, Cycle]:
     from dataclasses import replace
 
     from spindle.cycles import Step
-    from spindle.units import RPM_TO_RAD_S
 
     nominal, cycle = load_cycle("nominal"), load_cycle("spl-16h")
     point = drive.nominal
@@ -73,7 +80,7 @@ def rated_cycles(spec: Spec, drive: Drive) -> tuple[Cycle, Cycle]:
                      else (spec.speed_rpm, 0.0))
     if (speed, p_mech) == PAPER_RATED:
         return nominal, cycle
-    torque = p_mech / (speed * RPM_TO_RAD_S)
+    torque = rated_torque_Nm(drive) or 0.0
     what = (f"the drive's nominal point, {speed:g} rpm and {p_mech / 1e3:g} kW" if point
             else f"the spec's operating speed, {speed:g} rpm without load")
     steady = replace(nominal, name="rated", description=f"{what}, held to a steady state",
@@ -174,12 +181,11 @@ def _warn_overload(cycle: Cycle, drive: Drive, where: str | None) -> None:
     import warnings
 
     from spindle.errors import CycleWarning
-    from spindle.units import RPM_TO_RAD_S
 
-    point = drive.nominal
-    if point is None:
+    rated = rated_torque_Nm(drive)
+    if rated is None:
         return
-    rated = point.P_mech_W / (point.speed_rpm * RPM_TO_RAD_S)
+    point = drive.nominal
     worst = max(range(len(cycle.steps)), key=lambda i: cycle.steps[i].load_torque_Nm)
     torque = cycle.steps[worst].load_torque_Nm
     if torque > OVERLOAD * rated:
