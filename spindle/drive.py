@@ -108,8 +108,8 @@ def rated_scale(spec: Spec, drive: Drive) -> tuple[float, float | None]:
         return spec.speed_rpm / PAPER_RATED[0], None
     if (point.speed_rpm, point.P_mech_W) == PAPER_RATED:
         return 1.0, 1.0
-    torque, paper = point.P_mech_W / point.speed_rpm, PAPER_RATED[1] / PAPER_RATED[0]
-    return point.speed_rpm / PAPER_RATED[0], torque / paper
+    paper_Nm = PAPER_RATED[1] / omega_rad_s(PAPER_RATED[0])
+    return point.speed_rpm / PAPER_RATED[0], rated_torque_Nm(drive) / paper_Nm
 
 
 def spindle_cycle(spec: Spec, name: str, seed: int = 0) -> Cycle:
