@@ -36,9 +36,10 @@ from compare.fit.select import CRITERIA_ORDER, OPEN_LOOP, model_changes
 #: asked of every candidate counted (they gate the cross-validation)
 PREREQUISITES = ("significant", "material")
 #: the criteria counted: the rest, restores_plausible_base within changes_prediction
-#: (final_model_adequate is asked after the selection, of the names only)
+#: (null_at_optimum and final_model_adequate are asked of the joining candidate only)
 CRITERIA = tuple(c for c in CRITERIA_ORDER
-                 if c not in (*PREREQUISITES, "restores_plausible_base", "final_model_adequate"))
+                 if c not in (*PREREQUISITES, "restores_plausible_base", "null_at_optimum",
+                              "final_model_adequate"))
 
 
 def passes(crit: dict, name: str) -> bool:

@@ -63,6 +63,7 @@ class Criteria:
     held_out_misfit_unexplained: bool
     distinct_among_alternatives: bool
     open_loop_adequate_model: bool
+    null_from_candidate: bool
     competitor_step_s: float
     scan_null_tail: int
     competitor_masses: tuple[str, ...]

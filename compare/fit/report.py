@@ -189,6 +189,15 @@ def verdict_lines(doc: dict) -> list[str]:
         lines.append(f"Fitted and withdrawn: {', '.join(gone)}. The model with {them} still "
                      "misses the tolerances on held-out data, so the open loop's likelihood "
                      f"ratio does not tell the cause; the selection went on without {them}.")
+    short = [c for c in doc.get("candidates", [])
+             if c["criteria"].get("null_at_optimum") is False]
+    if short:
+        labels = list(dict.fromkeys(c["candidate"] for c in short))
+        gain = max(c["null_shortfall"] for c in short)
+        lines.append(f"Calibrated again: the model without {', '.join(labels)} fitted better "
+                     f"from where {'its' if len(labels) == 1 else 'their'} refit ended (log-"
+                     f"likelihood up by {gain:.1f}), so that gain named nothing; the base and "
+                     "every test are the better fit's.")
     lines.append(f"Validation error before -> after: {_change_text(doc)}.")
     return lines
 
@@ -440,7 +449,10 @@ def _criteria_html(doc: dict) -> str:
             "this effect by its signature or by every open-loop criterion, of which the "
             "last is changes_prediction or, failing it, restores_plausible_base "
             "(compare.fit.select). Its complements each add to it as it adds to them, so "
-            "distinct does not count them as rivals.</p>"
+            "distinct does not count them as rivals. The candidate that joins is last asked "
+            "null_at_optimum: whether the model without it, refitted from where its refit "
+            "ended, gains less than one degree of freedom's margin; where it gains more, the "
+            "round is judged again from there.</p>"
             + html_table(["candidate", "round", "gain", "p", "peak [tol]", *names,
                           "complements", "qualifies by"], rows, ["s"] * (len(names) + 7)))
 

@@ -46,7 +46,7 @@ from compare.fit.linear import Local, effect_held_out, fit_effect, local
 OPEN_LOOP = ("predicts", "beats_something_else", "distinct")
 #: every named criterion of a candidate, in the order :attr:`Judgement.route` asks them
 CRITERIA_ORDER = ("significant", "material", "signature", *OPEN_LOOP, "changes_prediction",
-                  "restores_plausible_base", "final_model_adequate")
+                  "restores_plausible_base", "null_at_optimum", "final_model_adequate")
 
 
 def model_changes(criteria: Mapping[str, bool | None]) -> bool:
@@ -76,8 +76,10 @@ class Judgement:
     @property
     def route(self) -> str | None:
         c = self.criteria
-        # withdrawn after the selection, or short of what both routes ask
-        if (c.get("final_model_adequate") is False or not c["material"]
+        # withdrawn after the selection, its gain the null's shortfall, or short of what
+        # both routes ask
+        if (c.get("final_model_adequate") is False or c.get("null_at_optimum") is False
+                or not c["material"]
                 or c["signature"] is False or not c["significant"]):
             return None
         if c["signature"]:
@@ -244,6 +246,19 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
             best = joins_first(qualified)
             say(f"round {rnd}: refitting with {best.label}")
             best.fit, best.figures["refit_from"] = refit(cal, loc, fits[best.label], criteria)
+            if criteria.null_from_candidate:
+                again, shortfall = null_from(cal, current, best.fit, criteria)
+                best.figures["null_shortfall"] = shortfall
+                best.criteria["null_at_optimum"] = shortfall <= criteria.distinct_margin()
+                if not best.criteria["null_at_optimum"]:
+                    say(f"round {rnd}: the model without {best.label} fits better from where "
+                        f"{best.label}'s fit ended; judging the round again from there")
+                    if not steps:  # the base was short of its optimum
+                        base = again
+                        cal.memo.pop("competitor", None)
+                        reg = regressors(cal, base, criteria)
+                    current, loc = again, local(cal, again)
+                    continue
             steps.append(Step(best, current))
             current = best.fit
             loc = local(cal, current)
@@ -348,6 +363,23 @@ def refit(cal: Calibrator, loc: Local, ef, criteria: Criteria) -> tuple[Fit, str
     return fits[best], best
 
 
+def null_from(cal: Calibrator, current: Fit, joined: Fit, criteria: Criteria
+              ) -> tuple[Fit, float]:
+    """The current model (``current``, without the candidate) refitted from where ``joined``
+    (it with the candidate) ended, the candidate's own values dropped, and its log-posterior
+    gain over ``current`` (counted in ``current``'s effective samples, as every gain of the
+    selection). A likelihood-ratio test holds only where the null is at its optimum: a
+    candidate's refit can move the base into a better basin than its calibration found, and
+    its gain is then the null's shortfall, which the null without it gains as well
+    (Criteria.null_from_candidate)."""
+    shrink = current.sample_share
+    again = cal.fit(current.effects, start={k: v for k, v in joined.theta.items()
+                                            if k in current.theta},
+                    max_nfev=criteria.refit_nfev)
+    return again, float((again.loglik - current.loglik) * shrink
+                        - (again.penalty - current.penalty))
+
+
 def withdraw_unsupported(steps: list[Step], final: Fit,
                          criteria: Criteria) -> tuple[Fit, str | None]:
     """Criteria.open_loop_adequate_model: where the ``final`` model misses the tolerance of
@@ -440,6 +472,7 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
                                     if criteria.plausible_base_route else None),
         "beats_something_else": bool(penalised >= competitor),
         "distinct": bool(penalised >= rival + margin),
+        "null_at_optimum": None,  # asked of the candidate that joins, after its refit
         "final_model_adequate": None,  # asked of the open loop's names after the selection
     }
     figures: dict[str, object] = {
