@@ -120,7 +120,8 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-optimizer-tol": "fit-trade-optimizer-tol.json",
           "trade-optimizer-tol-held-out": "fit-trade-optimizer-tol-held-out.json",
           "trade-exact-keys": "fit-trade-exact-keys.json",
-          "trade-refit-exact-steps": "fit-trade-refit-exact-steps.json"}
+          "trade-refit-exact-steps": "fit-trade-refit-exact-steps.json",
+          "trade-null-at-optimum": "fit-trade-null-at-optimum.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
