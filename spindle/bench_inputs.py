@@ -463,20 +463,28 @@ def check_power_balance(run: BenchRun, drive: Drive, grid_s: np.ndarray,
                 "channel mapped to it)")
 
 
+def logging_gaps(time_s: np.ndarray, grid_step_s: float, hold_steps: float = HOLD_STEPS
+                 ) -> list[tuple[float, float]]:
+    """(start, end) [s] of each stretch without a row (``time_s``, the rows' times [s])
+    longer than :func:`silence_s` allows on a grid of ``grid_step_s`` [s]."""
+    t = np.asarray(time_s, dtype=float)
+    if len(t) < 2:
+        return []
+    longest = silence_s(hold_steps, grid_step_s, t)
+    return [(float(t[k]), float(t[k + 1])) for k in np.flatnonzero(np.diff(t) > longest)]
+
+
 def gap_intervals(time_s: np.ndarray, grid_s: np.ndarray,
                   hold_steps: float = HOLD_STEPS) -> np.ndarray:
     """Per interval of ``grid_s`` [s], whether it overlaps a logging gap of the rows'
-    ``time_s`` [s] (a silence longer than :func:`silence_s`) or is the first interval after
-    one."""
-    t = np.asarray(time_s, dtype=float)
+    ``time_s`` [s] (:func:`logging_gaps`) or is the first interval after one."""
     g = np.asarray(grid_s, dtype=float)
     out = np.zeros(len(g) - 1, dtype=bool)
-    if len(t) < 2 or len(g) < 2:
+    if len(g) < 2:
         return out
     step = float(np.median(np.diff(g)))
-    long = np.flatnonzero(np.diff(t) > silence_s(hold_steps, step, t))
-    for k in long:
-        out |= (g[1:] > t[k]) & (g[:-1] < t[k + 1] + step)
+    for start, end in logging_gaps(time_s, step, hold_steps):
+        out |= (g[1:] > start) & (g[:-1] < end + step)
     return out
 
 

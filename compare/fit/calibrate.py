@@ -180,6 +180,11 @@ class Fit:
         (every log-likelihood gain of the selection is weighed by it)."""
         return self.n_eff / max(self.n, 1)
 
+    def log_posterior(self, share: float) -> float:
+        """The log-posterior with the data counted at ``share`` (n_eff / n) of its samples, as
+        the selection counts every gain: loglik x share less the prior penalty."""
+        return self.loglik * share - self.penalty
+
     def validation_score(self) -> float:
         """Weighted RMS over the validation window (tolerance units)."""
         v = self.errors["validation"]

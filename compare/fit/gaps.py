@@ -28,7 +28,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from compare.fit.criteria import Criteria
-from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM, Inputs, silence_s
+from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM, Inputs
+from spindle.bench_inputs import logging_gaps as gaps_of_rows
 
 #: the criteria of the gaps (gap_min_steps, gap_judge_s, gap_level_s) when none are given
 _DEFAULT = Criteria()
@@ -101,10 +102,8 @@ def logging_gaps(t_rows_s: np.ndarray, grid_s: np.ndarray, criteria: Criteria = 
                  ) -> list[tuple[float, float]]:
     """(start, end) [s] of each stretch without any row (``t_rows_s``, every row's time)
     longer than ``criteria.gap_min_steps`` steps of the grid ``grid_s`` [s] or of the run's
-    own logging, whichever is longer (spindle.bench_inputs.silence_s)."""
-    t = np.asarray(t_rows_s, dtype=float)
-    longest = silence_s(criteria.gap_min_steps, float(np.median(np.diff(grid_s))), t)
-    return [(float(t[i]), float(t[i + 1])) for i in np.where(np.diff(t) > longest)[0]]
+    own logging, whichever is longer (spindle.bench_inputs.logging_gaps)."""
+    return gaps_of_rows(t_rows_s, float(np.median(np.diff(grid_s))), criteria.gap_min_steps)
 
 
 def unknown_input_spans(t_rows_s: np.ndarray, grid_s: np.ndarray,

@@ -359,7 +359,7 @@ def refit(cal: Calibrator, loc: Local, ef, criteria: Criteria) -> tuple[Fit, str
               "nested": {**current.theta, **ef.values}}
     fits = {name: cal.fit(current.effects + (ef.label,), start=start,
                           max_nfev=criteria.refit_nfev) for name, start in starts.items()}
-    best = max(fits, key=lambda k: fits[k].loglik * shrink - fits[k].penalty)
+    best = max(fits, key=lambda k: fits[k].log_posterior(shrink))
     return fits[best], best
 
 
@@ -376,8 +376,7 @@ def null_from(cal: Calibrator, current: Fit, joined: Fit, criteria: Criteria
     again = cal.fit(current.effects, start={k: v for k, v in joined.theta.items()
                                             if k in current.theta},
                     max_nfev=criteria.refit_nfev)
-    return again, float((again.loglik - current.loglik) * shrink
-                        - (again.penalty - current.penalty))
+    return again, float(again.log_posterior(shrink) - current.log_posterior(shrink))
 
 
 def withdraw_unsupported(steps: list[Step], final: Fit,
