@@ -133,13 +133,16 @@ def test_a_base_short_of_its_optimum_is_refitted_from_the_joining_candidates_fit
     round 1, and the model without it, refitted from where its refit ended, gains more than
     Criteria.distinct_margin over that base. The candidate does not join on that gain
     (null_at_optimum False); the round is judged again from the better base, where it joins
-    (True) and is recovered as in the test above. Before the rule the base stayed as given."""
+    (True) and is recovered as in the test above. Before the rule the base stayed as given. The
+    signature tests are read at the base given and again at the better one."""
     spec, inp = setup
     truth = GreyBox(spec, DRIVES["spl2782"], inp, effects=("fixture_expansion",))
     vals = _noisy(truth.simulate({"k_fix_um_K": 1.5, "f0": 0.4}), len(inp.grid_s), 3)
     cal = Calibrator(GreyBox(spec, DRIVES["spl2782"], inp), Measured(inp.grid_s, vals), CHANNELS)
     short = cal.fit(start={"f0": 1.2, "h_air": 3.0}, max_nfev=3)
-    sel = select(cal, short, candidates(CHANNELS), Criteria())
+    read_at = []  # the base values each reading of the signatures was given
+    sel = select(cal, short, candidates(CHANNELS), Criteria(),
+                 signatures=lambda fit: read_at.append(fit.theta) or {})
     asked = [(j.label, j.round, j.criteria["null_at_optimum"]) for j in sel.judged
              if j.criteria["null_at_optimum"] is not None]
     assert asked == [("fixture_expansion", 1, False), ("fixture_expansion", 2, True)]
@@ -147,6 +150,8 @@ def test_a_base_short_of_its_optimum_is_refitted_from_the_joining_candidates_fit
     first = next(j for j in sel.judged if j.criteria["null_at_optimum"] is False)
     assert first.figures["null_shortfall"] > margin
     assert sel.base.loglik > short.loglik and abs(sel.base.theta["f0"] - 0.4) < 0.1
+    # a signature may read the base's values, so they are read again at the better base
+    assert read_at == [short.theta, sel.base.theta]
     assert [s.label for s in sel.steps] == ["fixture_expansion"]
     assert abs(sel.final.theta["k_fix_um_K"] - 1.5) < 0.1
 

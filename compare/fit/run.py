@@ -336,9 +336,9 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
     run, channels, inputs, measured = prep.run, prep.channels, prep.inputs, prep.measured
     cal, base = prep.cal, prep.base
     say("reading the effects' signatures in the raw samples")
-    sig = signature_tests(run, cal.gb, base.theta, channels, criteria)
     unknown = unknown_input_spans(run.time_s, inputs.grid_s, criteria)
-    sel = select(cal, base, candidate_labels(channels, candidates), criteria, sig, say,
+    sel = select(cal, base, candidate_labels(channels, candidates), criteria,
+                 lambda fit: signature_tests(run, cal.gb, fit.theta, channels, criteria), say,
                  unknown_inputs=unknown)
     final = sel.final
     for fit in (sel.base, final):  # nothing impossible is written (issue 14)
@@ -376,7 +376,7 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
         say(f"cross-validating over {criteria.cv_blocks} blocks")
         cv = {"base": local(cal, sel.base).cross_validation_report(criteria.cv_blocks),
               "final": local(cal, final).cross_validation_report(criteria.cv_blocks)}
-    return FitReport(run, spec, channels, measured, inputs, sel, sig, diag_b, diag_a,
+    return FitReport(run, spec, channels, measured, inputs, sel, sel.signatures, diag_b, diag_a,
                      time.perf_counter() - t0, criteria, prep.anchor, cal.floor,
                      cal.prior_z(final) or None, adequacy, warns, cv, prep.gap_switches,
                      unknown, prep.start)

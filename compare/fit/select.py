@@ -162,6 +162,8 @@ class Selection:
     steps: list[Step]
     judged: list[Judgement]
     verdict: Verdict | None = None
+    #: the signature tests by label, read at ``base`` (compare.fit.signatures.EventTest)
+    signatures: dict = field(default_factory=dict)
 
     @property
     def final(self) -> Fit:
@@ -218,16 +220,19 @@ def known_inputs(loc: Local, unknown_s: Sequence[tuple[float, float]]) -> np.nda
 
 
 def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Criteria,
-           signatures: Mapping[str, object] | None = None,
+           signatures: Callable[[Fit], Mapping[str, object]] | None = None,
            progress: Callable[[str], None] | None = None,
            unknown_inputs: Sequence[tuple[float, float]] = ()) -> Selection:
     """Forward selection of ``candidates`` (labels) from the calibrated ``base`` (module
-    docstring); ``signatures``: the run's signature tests by label. ``unknown_inputs``: spans
+    docstring); ``signatures``: reads the run's signature tests (by label) at a base model,
+    called again where the selection replaces the base, since a test may read the base's
+    values (compare.fit.signatures.Context). ``unknown_inputs``: spans
     [t0, t1) [s] where the run's inputs are not known (a logging gap and the settling after
     it): something else is not looked for there, since the model's misfit there says nothing
     but that the inputs are not known."""
     say = progress or (lambda _m: None)
-    sig = dict(signatures or {})
+    read = signatures or (lambda _fit: {})
+    sig = dict(read(base))
     current = base
     steps: list[Step] = []
     judged: list[Judgement] = []
@@ -257,6 +262,8 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
                         base = again
                         cal.memo.pop("competitor", None)
                         reg = regressors(cal, base, criteria)
+                        say("reading the effects' signatures again at the better base")
+                        sig = dict(read(base))
                     current, loc = again, local(cal, again)
                     continue
             steps.append(Step(best, current))
@@ -272,7 +279,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         current, loc = kept, local(cal, kept)
     say("fitting something else on the final model")
     return Selection(base, steps, judged, verdict_on(loc, reg, criteria,
-                                                     unknown_inputs=unknown_inputs))
+                                                     unknown_inputs=unknown_inputs), sig)
 
 
 def _fit_candidates(loc: Local, pending: Sequence[str], sig: Mapping[str, object], rnd: int,
