@@ -28,8 +28,7 @@
 from __future__ import annotations
 
 import math
-import time
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -73,21 +72,13 @@ class Measured:
         if self.blocks <= 1:
             self._fit_points = g <= self.split_s
             return
-        block = self.block_of(g)
+        block = block_index(np.linspace(g[0], g[-1], self.blocks + 1), g)
         self._fit_points = ~np.isin(block, self.validation_blocks())
 
     @property
     def split_s(self) -> float:
         """End of the fit window of a one-split scheme [s]."""
         return float(self.grid_s[0] + self.fit_fraction * (self.grid_s[-1] - self.grid_s[0]))
-
-    def block_edges(self) -> np.ndarray:
-        """The blocks' bounds [s]: ``blocks`` equal parts of the grid's span."""
-        return np.linspace(self.grid_s[0], self.grid_s[-1], self.blocks + 1)
-
-    def block_of(self, t_s: np.ndarray) -> np.ndarray:
-        """Index of the block each time [s] lies in."""
-        return block_index(self.block_edges(), t_s)
 
     def validation_blocks(self) -> list[int]:
         """The validating blocks: ``held_out``, or round(blocks (1 - fit_fraction)) of them
@@ -163,16 +154,11 @@ class Fit:
     n_eff: float
     model: dict[str, np.ndarray]
     errors: dict[str, dict[str, dict[str, float]]]  # window -> channel -> rmse, max, within
-    runtime_s: float = 0.0
     nfev: int = 0
     penalty: float = 0.0  # 1/2 sum ((z - z_ref) / sd)^2 over the free parameters with a prior
     #: for a parameter the run does not determine alone, the one it is determined with:
     #: (name, correlation), where fixing that one would make it identifiable (_intervals)
     partners: dict[str, tuple[str, float]] = field(default_factory=dict)
-
-    @property
-    def k(self) -> int:
-        return len(self.free)
 
     @property
     def sample_share(self) -> float:
@@ -202,7 +188,6 @@ class Calibrator:
     max_nfev: int = 60
     #: least_squares' ftol and xtol (compare.fit.criteria.Criteria.optimizer_tol)
     tol: float = 1e-6
-    progress: Callable[[str], None] | None = None
     #: prior centres (the spec's values, compare.fit.discrepancy); the widths are Param.prior_sd
     prior: dict[str, float] | None = None
     #: sqrt(s^2 n / n_eff) of the data term, so that data and prior weigh as a posterior
@@ -226,17 +211,14 @@ class Calibrator:
             floor[c] = float(np.sqrt(np.var(np.diff(r, 2)) / 6.0)) if len(r) > 3 else 0.0
         self.floor = floor
 
-    def fit_with_prior(self, centre: dict[str, float], start: dict[str, float] | None = None,
-                       free_nfev: int | None = None,
-                       say: Callable[[str], None] | None = None) -> tuple[Fit, Fit]:
+    def fit_with_prior(self, centre: dict[str, float], start: dict[str, float] | None = None
+                       ) -> tuple[Fit, Fit]:
         """(fit without priors, fit with priors around ``centre``): the first sets the data's
         weight against the priors and the noise floor (set_prior, set_floor), the second
         starts where it ended."""
-        free_fit = self.fit(start=start, max_nfev=free_nfev)
+        free_fit = self.fit(start=start)
         self.set_prior(centre, free_fit)
         self.set_floor(free_fit)
-        if say is not None:
-            say("calibrating with priors")
         return free_fit, self.fit(start=free_fit.theta)
 
     def prior_z(self, fit: Fit) -> dict[str, float]:
@@ -296,7 +278,6 @@ class Calibrator:
         the effects ``effects``, labels)."""
         from scipy.optimize import least_squares
 
-        t0 = time.perf_counter()
         gb = self.gb.variant(effects)
         params = gb.parameters()
         free = list(free) if free is not None else list(params)
@@ -336,7 +317,7 @@ class Calibrator:
         ci, corr, ident, partners = _intervals(J, r_all, n, n_eff, free, params, sol.x)
         return Fit(tuple(effects), theta, free, ci, corr, ident,
                    concentrated_loglik(res.values()), n, n_eff, out, self.errors(out),
-                   time.perf_counter() - t0, nfev, penalty, partners)
+                   nfev, penalty, partners)
 
 
 def over_tolerance(window_errors: Mapping[str, Mapping[str, float]]) -> dict[str, float]:

@@ -16,6 +16,7 @@ from dataclasses import replace as dc_replace
 import numpy as np
 
 from compare.fit.effects import effect_of, parse_label
+from compare.fit.effects.base import CHANNELS
 from compare.fit.params import EXTRA_BASE_PARAMS, PREHISTORY, Param, base_params
 from lumped.blocks import Convection, FixedTemperature, varies_with_speed
 from lumped.build import build_network
@@ -30,7 +31,6 @@ ROTATING = ("shaft", "tool", "rotor")
 #: the base parameters that change the conductance matrix K (an effect declares its own)
 _K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact", "heat_capacity",
              "axial_scale", "G_seat_W_K")
-CHANNELS = ("T1", "T2", "T_stator", "P1")
 #: the parameters that scale a group of the network's edges (films, contacts)
 _GROUPS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact")
 
@@ -70,9 +70,7 @@ class GreyBox:
 
     def variant(self, effects: tuple[str, ...]) -> GreyBox:
         """The same model with another effect set (sharing caches and discrepancy)."""
-        return GreyBox(self.spec, self.drive, self.inputs, self.nodes, tuple(effects),
-                       self._cache, self.discrepancy, self.base_extra, self.speed_bin_rel,
-                       self.p1_reference_s)
+        return dc_replace(self, effects=tuple(effects))
 
     def plain(self) -> GreyBox:
         """The spec's lumped model on the same inputs: no effects, no base extras, no

@@ -151,7 +151,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
 
     def calibrator(on: Inputs) -> Calibrator:
         return Calibrator(replace(spec_model, inputs=on, _cache={}), measured, channels,
-                          progress=say, tol=criteria.optimizer_tol, workers=workers)
+                          tol=criteria.optimizer_tol, workers=workers)
 
     cal = calibrator(inputs)
     spec_values = default_theta(cal.gb.parameters(), [*BASE_PARAMS, *base_extra])
@@ -348,20 +348,18 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
             raise SolverError(f"{path}: P1: the calibrated model's growth is not finite; fix: "
                               "check the run's inputs (speed, power, torque) for values far "
                               "outside the spec's operating range")
-    ins = {"speed": np.concatenate([[inputs.speed_rpm[0]], inputs.speed_rpm]),
-           "power": np.concatenate([[inputs.power_kW[0]], inputs.power_kW]),
-           "T_env": np.concatenate([[inputs.T_env_K[0]], inputs.T_env_K])}
+    ins = {k: np.concatenate([[x[0]], x]) for k, x in (
+        ("speed", inputs.speed_rpm), ("power", inputs.power_kW), ("T_env", inputs.T_env_K))}
     dt = float(np.median(np.diff(inputs.grid_s)))
-    diag_b = diagnose({c: (measured.values[c] - sel.base.model[c]) / TOLERANCE[c]
-                       for c in channels}, dt, ins, alpha=criteria.alpha)
-    diag_a = diagnose({c: (measured.values[c] - final.model[c]) / TOLERANCE[c]
-                       for c in channels}, dt, ins, alpha=criteria.alpha)
+    diag_b, diag_a = (diagnose({c: (measured.values[c] - fit.model[c]) / TOLERANCE[c]
+                                for c in channels}, dt, ins, alpha=criteria.alpha)
+                      for fit in (sel.base, final))
     ranges = {k: (p.lo, p.hi) for k, p in cal.gb.parameters().items()}
-    adequacy = base_adequacy(sel.base.errors, sel.base.theta, prep.spec_values,
-                             cal.prior_z(sel.base), ranges, criteria, sel.base.partners)
-    adequacy["with_effects"] = base_adequacy(final.errors, final.theta, prep.spec_values,
-                                             cal.prior_z(final), ranges, criteria,
-                                             final.partners)
+    def adequacy_of(fit: Fit) -> dict:
+        return base_adequacy(fit.errors, fit.theta, prep.spec_values, cal.prior_z(fit),
+                             ranges, criteria, fit.partners)
+
+    adequacy = {**adequacy_of(sel.base), "with_effects": adequacy_of(final)}
     warns = list(prep.left_out) + [t for t in [prep.start.text(), _other_spindle(run, spec)]
                                    if t]
     warns += extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
