@@ -153,7 +153,7 @@ class Fit:
     n: int
     n_eff: float
     model: dict[str, np.ndarray]
-    errors: dict[str, dict[str, dict[str, float]]]  # window -> channel -> rmse, max, within
+    errors: dict[str, dict[str, dict[str, float]]]  # window -> channel -> error_row and rmse_w [tolerances]
     nfev: int = 0
     penalty: float = 0.0  # 1/2 sum ((z - z_ref) / sd)^2 over the free parameters with a prior
     #: for a parameter the run does not determine alone, the one it is determined with:
@@ -204,12 +204,8 @@ class Calibrator:
         """The floor from the noise of ``fit``'s residual, estimated from its second
         differences (var(d2 r) = 6 sigma^2 for white noise; the smooth model-form part hardly
         enters them)."""
-        floor = {}
-        for c in self.channels:
-            m = self.measured.mask(c, "all")
-            r = (self.measured.values[c][m] - fit.model[c][m]) / TOLERANCE[c]
-            floor[c] = float(np.sqrt(np.var(np.diff(r, 2)) / 6.0)) if len(r) > 3 else 0.0
-        self.floor = floor
+        self.floor = {c: float(np.sqrt(np.var(np.diff(r, 2)) / 6.0)) if len(r) > 3 else 0.0
+                      for c, r in self.residuals(fit.model, "all").items()}
 
     def fit_with_prior(self, centre: dict[str, float], start: dict[str, float] | None = None
                        ) -> tuple[Fit, Fit]:
@@ -248,11 +244,10 @@ class Calibrator:
         return np.asarray(out)
 
     def residuals(self, out: dict[str, np.ndarray], window: str) -> dict[str, np.ndarray]:
-        res = {}
-        for c in self.channels:
-            m = self.measured.mask(c, window)
-            res[c] = (self.measured.values[c][m] - out[c][m]) / TOLERANCE[c]
-        return res
+        """Measured minus ``out`` per channel on ``window``'s samples [tolerances]."""
+        masks = {c: self.measured.mask(c, window) for c in self.channels}
+        return {c: (self.measured.values[c][m] - out[c][m]) / TOLERANCE[c]
+                for c, m in masks.items()}
 
     def errors(self, out: dict[str, np.ndarray]) -> dict[str, dict[str, dict[str, float]]]:
         errs: dict[str, dict[str, dict[str, float]]] = {}
@@ -264,12 +259,8 @@ class Calibrator:
                 if len(d) == 0:
                     errs[window][c] = {"n": 0}
                     continue
-                row = error_row(c, d)
-                unit = row["unit"]
-                errs[window][c] = {
-                    "n": row["n"], f"rmse_{unit}": row["rmse"], f"max_{unit}": row["max"],
-                    f"bias_{unit}": row["bias"], "within_tolerance": row["within_tolerance"],
-                    "rmse_w": float(np.sqrt(np.mean(d * d)) / TOLERANCE[c])}
+                errs[window][c] = {**error_row(c, d),
+                                   "rmse_w": float(np.sqrt(np.mean(d * d)) / TOLERANCE[c])}
         return errs
 
     def fit(self, effects: tuple[str, ...] = (), free: Sequence[str] | None = None,

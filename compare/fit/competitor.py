@@ -55,22 +55,20 @@ class WindowHeat(Effect):
 
     channels = ("T1", "T2", "T_stator", "P1")
 
-    def __init__(self, role: str, t0_s: float, t1_s: float, series: np.ndarray | None = None):
+    def __init__(self, role: str, t0_s: float, t1_s: float):
         self.role, self.t0_s, self.t1_s = role, float(t0_s), float(t1_s)
         self.name = f"{NAME}[heat into the {role}, {t0_s / 3600:.1f}-{t1_s / 3600:.1f} h]"
         self.explanation = (f"a heat of q into the {role} from {t0_s / 3600:.1f} h to "
                             f"{t1_s / 3600:.1f} h that no effect of the library explains")
         self.params = (Param("q_else_W", "W", 0.0, -Q_MAX_W, Q_MAX_W,
                              "unexplained heat into the part during the window", log=False),)
-        self.series = series  # per interval [W per W of q]; None: the window
 
     def extend_network(self, net, spec, power_measured):
         part = next(p for p in net.parts.values() if p.part.role == self.role)
         spread_heat(net, part.masses, NAME, f"source:{NAME}")
 
     def heat(self, sources_W, theta, inputs):
-        shape = self.series if self.series is not None else _window(inputs, self.t0_s, self.t1_s)
-        return {**sources_W, NAME: theta["q_else_W"] * shape}
+        return {**sources_W, NAME: theta["q_else_W"] * _window(inputs, self.t0_s, self.t1_s)}
 
 
 @dataclass(frozen=True)
@@ -114,22 +112,18 @@ def block_responses(gb, theta: dict[str, float], effects: tuple[str, ...], role:
     """(blocks, channels, grid points): each channel's response [K; m for P1] to 1 W into the
     first part of ``role`` during each block, of the model ``gb`` with ``effects`` at
     ``theta`` (linear in the heat: the model with the block's heat minus the model without)."""
-    probe = WindowHeat(role, 0.0, 0.0)
+    probe = WindowHeat(role, 0.0, 0.0)  # an empty window until each block's is set below
     probe.name = f"{NAME}[probe {role}]"
     lab = hypothesis(probe)
     model = gb.variant((*effects, lab))
     th = {**theta, "q_else_W": 1.0}
-    g = gb.inputs.grid_s
-    mid = 0.5 * (g[1:] + g[:-1])
-    probe.series = np.zeros(len(mid))
     base = model.simulate(th)
-    out = np.empty((len(edges) - 1, len(channels), len(g)))
+    out = np.empty((len(edges) - 1, len(channels), len(gb.inputs.grid_s)))
     for b in range(len(edges) - 1):
-        probe.series = ((mid >= edges[b]) & (mid < edges[b + 1])).astype(float)
+        probe.t0_s, probe.t1_s = edges[b], edges[b + 1]
         y = model.simulate(th)
         for j, c in enumerate(channels):
             out[b, j] = y[c] - base[c]
-    probe.series = None
     return out
 
 

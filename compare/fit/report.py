@@ -51,18 +51,10 @@ def _number(x: float | None, fmt: str) -> str:
 
 
 def _errors(fit: Fit) -> dict:
-    out = {}
-    for window, chans in fit.errors.items():
-        out[window] = {}
-        for c, e in chans.items():
-            if not e.get("n"):
-                continue
-            unit = edge_unit(c, ascii=True)
-            out[window][c] = {"rmse": e[f"rmse_{unit}"], "max": e[f"max_{unit}"],
-                              "bias": e[f"bias_{unit}"], "unit": unit, "rmse_tolerances":
-                              e["rmse_w"], "within_tolerance": e["within_tolerance"],
-                              "n": e["n"]}
-    return out
+    keys = ("rmse", "max", "bias", "unit", "rmse_tolerances", "within_tolerance", "n")
+    return {window: {c: {k: e["rmse_w" if k == "rmse_tolerances" else k] for k in keys}
+                     for c, e in chans.items() if e.get("n")}
+            for window, chans in fit.errors.items()}
 
 
 def _effect_entry(rep, step) -> dict:
