@@ -42,6 +42,7 @@ from spindle.bench import (
 from spindle.bench_clean import coolant_as_room, without_spikes, without_stuck
 from spindle.bench_inputs import (
     Inputs,
+    bearing_friction_W,
     check_power_balance,
     interval_inputs,
     logging_step_s,
@@ -120,7 +121,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
         left_out.append(f"the drive '{drive.name}' feeds no heat to the spec's heat source(s) "
                         f"{', '.join(unfed)}: 0 W there (the power balance names its motor "
                         "and bearing sets as the drive file does)")
-    raw = interval_inputs(run, grid_s, criteria.gap_min_steps)
+    raw = interval_inputs(run, grid_s, criteria.gap_min_steps, bearing_friction_W(drive))
     check_power_balance(run, drive, raw.grid_s, raw.speed_rpm, raw.power_kW,
                         raw.load_torque_Nm, criteria.no_load_Nm)
     measured = _measured(run, channels, raw.grid_s, fit_fraction, blocks, criteria)
