@@ -35,6 +35,13 @@ def test_losses_are_the_samples_mean_through_a_ramp_inside_a_cell():
     losses = inp.power_kW * 1e3 - inp.load_torque_Nm * omega
     # every interval, the ramp's included, gives the samples' 900 W to round-off
     np.testing.assert_allclose(losses, 900.0, atol=1e-6)
+    # also where the ramp's cell takes the speed of its mean friction (the torque is the one
+    # that does the mean mechanical work at that speed)
+    with_friction = interval_inputs(_ramp_run(), 60.0, friction_W=lambda n: n * n)
+    w = 2.0 * math.pi * with_friction.speed_rpm / 60.0
+    assert not np.allclose(w, omega)
+    np.testing.assert_allclose(with_friction.power_kW * 1e3 - with_friction.load_torque_Nm * w,
+                               900.0, atol=1e-6)
     # not vacuous: the mean power less the torque at the middle's speed (the old inputs) is
     # M (mean omega - omega_mid) = 42 N m x 70 rad/s, about 2.9 kW, off in the ramp's cell
     k = int(np.flatnonzero((inp.grid_s[:-1] <= 150.0) & (inp.grid_s[1:] > 150.0))[0])
@@ -130,3 +137,32 @@ def test_a_step_between_a_sparse_loggers_rows_is_placed_at_the_silences_middle()
         first = float(inp.grid_s[np.flatnonzero(inp.speed_rpm > 3000.0)[0]])
         # the interval whose middle lies past the step's estimate is the first at 6000 rpm
         assert expect_s - 60.0 <= first <= expect_s, (step_s, first)
+
+
+def _step_run(at_s: float = 168.0) -> BenchRun:
+    """5 min at 1 Hz: 10 000 rpm, a step to 30 000 rpm at ``at_s`` (in the cell 120-180 s,
+    after its middle), no load, a power of a kilowatt."""
+    t = np.arange(0.0, 301.0, 1.0)
+    n = np.where(t < at_s, 10000.0, 30000.0)
+    cols = {"speed_rpm": n, "power_kW": np.full_like(t, 1.0),
+            "T_env_C": np.full_like(t, 20.0), "T_coolant_C": np.full_like(t, 20.0),
+            "T1_C": np.full_like(t, 20.0)}
+    return BenchRun(Path("step.csv"), {}, t, cols, {}, [], ["T1"], float(t[-1]))
+
+
+def test_a_speed_step_inside_a_cell_takes_the_speed_of_its_mean_friction():
+    """With a friction law f = n^2 [W] the step's cell (48 s at 10 000 rpm, 12 s at 30 000)
+    has a mean friction of 0.8 x 1e8 + 0.2 x 9e8 = 2.6e8 W, so its speed is sqrt(2.6e8) =
+    16 125 rpm (the table's interpolation reads it to 0.1 %); every other cell keeps its
+    logged speed. Without the law the cell keeps the speed of its middle, 10 000 rpm, whose
+    friction is 2.6 times too small: the bearings' part of the power balance."""
+    run = _step_run()
+    plain = interval_inputs(run, 60.0)
+    inp = interval_inputs(run, 60.0, friction_W=lambda n: n * n)
+    k = int(np.flatnonzero(inp.grid_s[:-1] == 120.0)[0])
+    assert plain.speed_rpm[k] == 10000.0
+    assert inp.speed_rpm[k] == pytest.approx(math.sqrt(2.6e8), rel=1e-3)
+    others = np.arange(len(inp.speed_rpm)) != k
+    np.testing.assert_array_equal(inp.speed_rpm[others], plain.speed_rpm[others])
+    # the mechanical power is kept: no load here, so the torque stays zero
+    assert np.all(inp.load_torque_Nm == 0.0)
