@@ -290,39 +290,6 @@ def friction_floor_W(drive: Drive) -> Callable[[float], float]:
     return _per_rpm(lambda n: sum(bearing_friction(b, n).heat_W for b in low))
 
 
-def bearing_friction_W(drive: Drive) -> Callable[[float], float]:
-    """The bearings' friction [W] at a speed [rpm], as the drive's power balance takes it."""
-    return _per_rpm(lambda n: sum(bearing_friction(b, n).heat_W
-                                  for b in drive.bearings_at(n).values()))
-
-
-def friction_speed(t_n: np.ndarray, n: np.ndarray, grid: np.ndarray, hold_s: float,
-                   speed: np.ndarray, friction_W: Callable[[float], float]) -> np.ndarray:
-    """``speed`` [rpm], one per interval of ``grid`` [s], where the logged speed (samples
-    ``n`` [rpm] at ``t_n`` [s], each held for ``hold_s`` at most) changes inside the interval
-    beyond the drive's scatter band, replaced by the speed at which ``friction_W`` (the
-    bearings' friction [W] at a speed, increasing) equals its time mean over the interval.
-    The power balance then gives the bearings the heat the samples give them. At the speed of
-    the interval's middle it gave them the friction of one side of the step for the whole
-    interval and the motor the rest: a step from 10 600 to 33 500 rpm late in an interval put
-    the bearings 5 K low at its end, a step down late in one 14 K high (a 24 000 rpm grinder)."""
-    n = np.asarray(n, dtype=float)
-    # the friction is smooth and increasing: a table of 2001 speeds reads it to a few watts
-    table_n = np.linspace(0.0, max(float(np.max(n)), 1.0), 2001)
-    table_f = np.array([friction_W(float(x)) for x in table_n])
-    mean_f = cell_means(t_n, np.interp(n, table_n, table_f), grid,
-                        0.5 * (grid[:-1] + grid[1:]), hold_s)
-    # the levels an interval holds: the one at its start and every sample inside it
-    cells = len(grid) - 1
-    lo, hi = held(t_n, n, grid[:-1]), held(t_n, n, grid[:-1])
-    k = np.searchsorted(grid, t_n, side="right") - 1
-    inside = (k >= 0) & (k < cells)
-    np.minimum.at(lo, k[inside], n[inside])
-    np.maximum.at(hi, k[inside], n[inside])
-    changed = hi - lo > np.maximum(SPEED_BAND_RPM, SPEED_BAND_REL * hi)
-    return np.where(changed, np.interp(mean_f, table_f, table_n), speed)
-
-
 def friction_share(drive: Drive, speed_rpm: np.ndarray, power_kW: np.ndarray) -> float:
     """The median, over the running intervals with a measured power, of the power [kW]
     against the bearings' friction at the speed [rpm] with their friction factors divided by
@@ -675,8 +642,8 @@ def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOL
     - speed [rpm]: the one logged at the interval's middle (held), settled to the drive's
       scatter band (a step inside an interval is at most half an interval off); where the
       speed changes inside the interval and ``friction_W`` (the bearings' friction [W] at a
-      speed: :func:`bearing_friction_W`) is given, the speed of the interval's mean friction
-      (:func:`friction_speed`);
+      speed: spindle.interval_speed.bearing_friction_W) is given, the speed of the interval's
+      mean friction (spindle.interval_speed.friction_speed);
     - power [kW], ambient and coolant [K]: the time mean over the interval of the signal as
       logged, each sample held until the next one, for ``hold_steps`` steps of the grid or
       of the run's logging at most (:func:`silence_s`: a bench that logs on change writes
@@ -693,6 +660,8 @@ def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOL
     t_n, n = input_samples(run, "speed_rpm", grid_s, hold)
     speed = settled_speed(held(t_n, n, mids))
     if friction_W is not None:
+        from spindle.interval_speed import friction_speed
+
         speed = friction_speed(t_n, n, grid, hold, speed, friction_W)
     power = cell_means(*input_samples(run, "power_kW", grid_s, hold), grid, mids, hold)
     if run.load_torque_measured:

@@ -42,7 +42,6 @@ from spindle.bench import (
 from spindle.bench_clean import coolant_as_room, without_spikes, without_stuck
 from spindle.bench_inputs import (
     Inputs,
-    bearing_friction_W,
     check_power_balance,
     interval_inputs,
     logging_step_s,
@@ -51,6 +50,7 @@ from spindle.bench_inputs import (
 )
 from spindle.drive import check_drive_feeds, drive_for
 from spindle.errors import InputError, SolverError
+from spindle.interval_speed import bearing_friction_W
 from spindle.results import check_plausible
 from spindle.spec import Spec
 
