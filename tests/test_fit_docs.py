@@ -121,7 +121,8 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-optimizer-tol-held-out": "fit-trade-optimizer-tol-held-out.json",
           "trade-exact-keys": "fit-trade-exact-keys.json",
           "trade-refit-exact-steps": "fit-trade-refit-exact-steps.json",
-          "trade-null-at-optimum": "fit-trade-null-at-optimum.json"}
+          "trade-null-at-optimum": "fit-trade-null-at-optimum.json",
+          "trade-friction-speed": "fit-trade-friction-speed.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
