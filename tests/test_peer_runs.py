@@ -42,7 +42,6 @@ KNOWN_NOT_RIGHT: dict[str, str] = {
     "dev2-08": "mount_conduction: unexplained",
     "dev2-09": "outside the library: nothing named, but not unexplained",
     "dev2-10": "coolant_dynamics: nothing named (unexplained, a heat into the rear bearing)",
-    "dev2-14": "bearing_preload and sensor_lag: only the lag, of T2",
 }
 #: runs on which fit names a cause the run does not carry (the worst answer; measured as above)
 KNOWN_WRONG: dict[str, str] = {
