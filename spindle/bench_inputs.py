@@ -128,6 +128,14 @@ def settled_speed(speed_rpm: np.ndarray, rel: float = SPEED_BAND_REL,
     return out
 
 
+def speed_changed(before_rpm, after_rpm):
+    """Whether two logged speeds [rpm] differ beyond the drive's scatter band,
+    max(SPEED_BAND_RPM, SPEED_BAND_REL x speed) (scalars or arrays, element by element)."""
+    before, after = np.abs(before_rpm), np.abs(after_rpm)
+    return np.abs(after_rpm - before_rpm) > np.maximum(
+        SPEED_BAND_RPM, SPEED_BAND_REL * np.maximum(before, after))
+
+
 def cell_means(t_samples: np.ndarray, y_samples: np.ndarray, edges: np.ndarray,
                centres: np.ndarray, hold_s: float | None = None) -> np.ndarray:
     """The mean of a logged signal in each cell [edges[i], edges[i+1]) (the last cell closed),

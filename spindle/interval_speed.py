@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM, _per_rpm, cell_means, held
+from spindle.bench_inputs import _per_rpm, cell_means, held, speed_changed
 from spindle.drive import Drive
 from spindle.power import bearing_friction
 
@@ -36,10 +36,10 @@ def friction_speed(t_n: np.ndarray, n: np.ndarray, grid: np.ndarray, hold_s: flo
                         0.5 * (grid[:-1] + grid[1:]), hold_s)
     # the levels an interval holds: the one at its start and every sample inside it
     cells = len(grid) - 1
-    lo, hi = held(t_n, n, grid[:-1]), held(t_n, n, grid[:-1])
+    lo = held(t_n, n, grid[:-1])
+    hi = lo.copy()
     k = np.searchsorted(grid, t_n, side="right") - 1
     inside = (k >= 0) & (k < cells)
     np.minimum.at(lo, k[inside], n[inside])
     np.maximum.at(hi, k[inside], n[inside])
-    changed = hi - lo > np.maximum(SPEED_BAND_RPM, SPEED_BAND_REL * hi)
-    return np.where(changed, np.interp(mean_f, table_f, table_n), speed)
+    return np.where(speed_changed(lo, hi), np.interp(mean_f, table_f, table_n), speed)

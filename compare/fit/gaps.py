@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from compare.fit.criteria import Criteria
-from spindle.bench_inputs import SPEED_BAND_REL, SPEED_BAND_RPM, Inputs
+from spindle.bench_inputs import Inputs, speed_changed
 from spindle.bench_inputs import logging_gaps as gaps_of_rows
 
 #: the criteria of the gaps (gap_min_steps, gap_judge_s, gap_level_s) when none are given
@@ -59,20 +59,13 @@ class GapSwitch:
                 f"{self.torque_after_Nm:.1f} N m at {self.speed_after_rpm:.0f} rpm")
 
 
-def speed_changed(before_rpm: float, after_rpm: float) -> bool:
-    """Whether two logged speeds [rpm] differ beyond the drive's scatter band,
-    max(SPEED_BAND_RPM, SPEED_BAND_REL x speed)."""
-    return abs(after_rpm - before_rpm) > max(
-        SPEED_BAND_RPM, SPEED_BAND_REL * max(abs(before_rpm), abs(after_rpm)))
-
-
 def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.ndarray,
                      grid_s: np.ndarray, criteria: Criteria = _DEFAULT,
                      torque: tuple[np.ndarray, np.ndarray] | None = None
                      ) -> list[tuple[float, float, float, float]]:
     """(start, end, speed before, speed after) of each stretch without any row (``t_rows_s``,
     every row's time) longer than ``criteria.gap_min_steps`` grid steps across which the
-    operating point changed: the speed beyond the drive's scatter band (:func:`speed_changed`),
+    operating point changed: the speed beyond the drive's scatter band (spindle.bench_inputs.speed_changed),
     or the load torque's level (``torque``: its valid samples' times [s] and values [N m],
     where the bench logs it) by more than a load cell's zero drift
     (``criteria.no_load_Nm``). The speed before is the last valid sample at or before the
@@ -87,7 +80,7 @@ def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.
         if k < 0 or j >= len(t_speed_s):
             continue
         a, b = float(speed_rpm[k]), float(speed_rpm[j])
-        moved = speed_changed(a, b)
+        moved = bool(speed_changed(a, b))
         if not moved and torque is not None:
             m0, m1 = levels_around(torque, start, end, criteria)
             moved = bool(abs(m1 - m0) > criteria.no_load_Nm)  # False where either is nan
