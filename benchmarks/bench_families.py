@@ -6,6 +6,7 @@ not verdicts on named runs (issue 32 §7).
                                         [--peers tests/data/peer-runs/bench-runs ...]
                                         [--reports DIR] [--summary FILE] [--synth-only]
                                         [--geometry RADIAL AXIAL [--fit-own-spec]]
+                                        [--ambient-shift-K 1e-5]
 
 Families (each run drawn from its seed: the spindle's mismatch to the spec, the cycle, the
 effect and its size, the noise and sampling; ``synth --mismatch``):
@@ -103,6 +104,7 @@ class FamilyRun:
     criteria: tuple = ()  # (name, value) pairs set in compare.fit.criteria.Criteria
     geometry: tuple = ()  # (radial, axial) factors of the spindle the drawn runs come from
     fit_own_spec: bool = False  # fit with that spindle's own spec, not the shipped one
+    ambient_shift_K: float = 0.0  # fit a copy whose ambient reads this much higher
 
     @property
     def label(self) -> str:
@@ -185,6 +187,8 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
                 "sizes": sizes}
     from compare.fit.criteria import Criteria
 
+    if case.ambient_shift_K:
+        run = shifted_ambient(run, case.ambient_shift_K, Path(case.cache) / "ambient-shifted")
     fit_spec = data_spec if case.fit_own_spec else spec
     rep = run_fit(run, fit_spec, criteria=Criteria().with_options(**dict(case.criteria)))
     doc = rep.to_dict()
@@ -207,6 +211,25 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             "at_floor": at_floor(sizes),
             **({"geometry": list(case.geometry), "fit_own_spec": case.fit_own_spec}
                if case.geometry and not case.path else {})}
+
+
+def shifted_ambient(run: Path, shift_K: float, folder: Path) -> Path:
+    """A copy of the bench file ``run`` (in ``folder``) whose every T_env_C reading is
+    ``shift_K`` higher, the rest as it is, to the character: a perturbation far below a
+    sensor's resolution must not move a verdict (``--ambient-shift-K``)."""
+    lines = run.read_text(encoding="utf-8").splitlines()
+    head = next(i for i, t in enumerate(lines) if t.startswith("time_s"))
+    col = lines[head].split(",").index("T_env_C")
+    out = lines[:head + 1]
+    for t in lines[head + 1:]:
+        cells = t.split(",")
+        if len(cells) > col and cells[col].strip():
+            cells[col] = repr(float(cells[col]) + shift_K)
+        out.append(",".join(cells))
+    folder.mkdir(parents=True, exist_ok=True)
+    copy = folder / f"{run.stem}-env{shift_K:+g}K{run.suffix}"
+    copy.write_text("\n".join(out) + "\n", encoding="utf-8")
+    return copy
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float, float]:
@@ -358,6 +381,11 @@ def main(argv: list[str] | None = None) -> None:
                     help="draw the runs from this spindle and fit them with its spec (a shipped "
                     "name or a spec file, e.g. tests/data/own-specs/gs24.toml; default spl2782); "
                     "its runs are kept in a cache folder of its own")
+    ap.add_argument("--ambient-shift-K", type=float, default=0.0, metavar="K",
+                    help="fit every run from a copy whose ambient (T_env_C) reads K higher, "
+                    "e.g. 1e-5, a thousandth of the loggers' 0.01 K: compare the rows with "
+                    "an unshifted benchmark's (compare_reports.py) for the verdicts that "
+                    "round-off decides")
     args = ap.parse_args(argv)
     if args.rows:
         try:
@@ -386,7 +414,8 @@ def main(argv: list[str] | None = None) -> None:
         args.reports.mkdir(parents=True, exist_ok=True)
         reports = str(args.reports)
     cases = [FamilyRun(f, s, str(args.cache), spec=args.spec, reports=reports,
-                       criteria=criteria, geometry=geometry, fit_own_spec=args.fit_own_spec)
+                       criteria=criteria, geometry=geometry, fit_own_spec=args.fit_own_spec,
+                       ambient_shift_K=args.ambient_shift_K)
              for f in args.families
              if f in FAMILIES
              for s in range(args.first_seed, args.first_seed + args.runs_per_family)]
@@ -400,7 +429,7 @@ def main(argv: list[str] | None = None) -> None:
             truth = read_truth(folder)
             cases += [FamilyRun("peers", 0, str(args.cache), path=str(folder / f"{k}.csv"),
                                 truth=v.get("truth"), truth_doc=v, reports=reports,
-                                criteria=criteria)
+                                criteria=criteria, ambient_shift_K=args.ambient_shift_K)
                       for k, v in sorted(truth.items())]
 
     if args.synth_only:

@@ -156,3 +156,27 @@ def test_interval_coverage_counts_the_intervals_that_hold_the_truth(monkeypatch,
              "confidence_intervals": {"G_mount_W_K": [2.0, 4.0]}}]}))
     rows = cov.interval_rows(reports, cache)
     assert [(r["run"], r["holds"]) for r in rows] == [("effect-1", True), ("effect-2", False)]
+
+
+def test_the_ambient_shifted_copy_moves_the_ambient_alone(monkeypatch, tmp_path):
+    """bench_families --ambient-shift-K: of the peer's on-change file (comment lines, empty
+    cells), the copy read back has T_env_C higher by the shift wherever it was logged, and every
+    other column and every empty cell as read from the original, to the bit; the original is
+    not touched."""
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import bench_families
+
+    from spindle.bench import read_bench
+
+    run = ROOT / "tests" / "data" / "peer-runs" / "bench-runs-2" / "dev2-14.csv"
+    before = run.read_bytes()
+    copy = bench_families.shifted_ambient(run, 1e-5, tmp_path / "shifted")
+    assert run.read_bytes() == before and copy.parent == tmp_path / "shifted"
+    a, b = read_bench(run), read_bench(copy)
+    np.testing.assert_array_equal(a.time_s, b.time_s)
+    assert set(a.columns) == set(b.columns) and "T_env_C" in a.columns
+    for name, col in a.columns.items():
+        logged = ~np.isnan(col)
+        np.testing.assert_array_equal(logged, ~np.isnan(b.columns[name]))
+        want = col + 1e-5 if name == "T_env_C" else col
+        np.testing.assert_allclose(b.columns[name][logged], want[logged], rtol=0, atol=1e-12)
