@@ -9,7 +9,8 @@ truth.json, with the tool's defaults.
   nothing and says unexplained; an effect's run names it (and only it). The runs the tool does
   not yet get right are marked xfail(strict) with what it says instead, as measured by
   ``python benchmarks/bench_families.py --families peers`` (docs/fit.md); strict, so that a
-  fix shows up as a failure to update here.
+  fix shows up as a failure to update here. A run whose verdict round-off decides (it
+  differs between machines) passes with any verdict measured for it, and with no other.
 - Where the verdict names an effect or says the base is adequate, the validation open-loop RMS
   after the fit is within the paper's 1 K / 1.5 um on every channel.
 
@@ -42,6 +43,13 @@ KNOWN_NOT_RIGHT: dict[str, str] = {
     "dev2-08": "mount_conduction: unexplained",
     "dev2-09": "outside the library: nothing named, but not unexplained",
     "dev2-10": "coolant_dynamics: nothing named (unexplained, a heat into the rear bearing)",
+}
+#: runs whose verdict round-off decides, with each verdict measured (named effects, sorted):
+#: it differs between two machines' numpy/scipy builds, and on one machine with the ambient
+#: read 1e-5 K higher (``bench_families.py --families peers --ambient-shift-K 1e-5``,
+#: docs/fit.md "Verdicts that round-off decides"). Either passes; anything else fails.
+ROUND_OFF_DECIDES: dict[str, tuple[tuple[str, ...], ...]] = {
+    "dev2-14": (("bearing_preload",), ("bearing_preload", "sensor_lag")),
 }
 #: runs on which fit names a cause the run does not carry (the worst answer; measured as above)
 KNOWN_WRONG: dict[str, str] = {
@@ -113,6 +121,8 @@ def test_the_verdict_is_right(label):
         assert not named, named
     elif not true:  # outside the library
         assert not named and doc["verdict"]["kind"] == "unexplained", doc["verdict"]
+    elif label in ROUND_OFF_DECIDES:
+        assert tuple(sorted(named)) in ROUND_OFF_DECIDES[label], named
     else:
         assert sorted(named) == sorted(true), named
 
