@@ -122,7 +122,14 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "trade-exact-keys": "fit-trade-exact-keys.json",
           "trade-refit-exact-steps": "fit-trade-refit-exact-steps.json",
           "trade-null-at-optimum": "fit-trade-null-at-optimum.json",
-          "trade-friction-speed": "fit-trade-friction-speed.json"}
+          "trade-friction-speed": "fit-trade-friction-speed.json",
+          # round-off: a new machine, and the ambient read 1e-5 K higher
+          "new-machine": "fit-new-machine.json",
+          "roundoff-ambient": "fit-roundoff-ambient-peers.json",
+          "roundoff-ambient-drawn": "fit-roundoff-ambient-drawn.json",
+          "trade-prior-penalty-peers": "fit-trade-prior-penalty-peers.json",
+          "roundoff-ambient-penalty": "fit-roundoff-ambient-peers-penalty.json",
+          "trade-prior-penalty-drawn": "fit-trade-prior-penalty-drawn.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
