@@ -226,9 +226,12 @@ def shifted_ambient(run: Path, shift_K: float, folder: Path) -> Path:
         if len(cells) > col and cells[col].strip():
             cells[col] = repr(float(cells[col]) + shift_K)
         out.append(",".join(cells))
+    from spindle.outputs import atomic_write
+
     folder.mkdir(parents=True, exist_ok=True)
     copy = folder / f"{run.stem}-env{shift_K:+g}K{run.suffix}"
-    copy.write_text("\n".join(out) + "\n", encoding="utf-8")
+    # two benchmarks may share the cache: a fit never reads a half-written copy
+    atomic_write(copy, lambda tmp: tmp.write_text("\n".join(out) + "\n", encoding="utf-8"))
     return copy
 
 
