@@ -129,7 +129,11 @@ TRADES = {"trade-time-mean": "fit-trade-time-mean.json",
           "roundoff-ambient-drawn": "fit-roundoff-ambient-drawn.json",
           "trade-prior-penalty-peers": "fit-trade-prior-penalty-peers.json",
           "roundoff-ambient-penalty": "fit-roundoff-ambient-peers-penalty.json",
-          "trade-prior-penalty-drawn": "fit-trade-prior-penalty-drawn.json"}
+          "trade-prior-penalty-drawn": "fit-trade-prior-penalty-drawn.json",
+          # one objective for the calibration and the selection (2026-12-01)
+          "trade-one-objective": "fit-trade-one-objective-all.json",
+          "trade-pooled-variance-peers": "fit-trade-pooled-variance-peers.json",
+          "roundoff-ambient-one-objective": "fit-roundoff-ambient-peers-one-objective.json"}
 
 
 @pytest.mark.parametrize("block", sorted(TRADES))
@@ -192,6 +196,8 @@ def test_the_exact_keys_figures_are_their_file():
     assert_block("docs/fit.md", "exact-keys-figures", exact_keys_text())
     assert_block("docs/fit.md", "refit-exact-steps-figures",
                  exact_keys_text("fit-trade-refit-exact-steps.json"))
+    assert_block("docs/fit.md", "one-objective-figures",
+                 exact_keys_text("fit-trade-one-objective-all.json"))
 
 
 def test_the_optimizer_tolerance_figures_are_their_files():
