@@ -163,7 +163,12 @@ def _logged_every(src: Path, dst: Path, step_s: float) -> Path:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("step_s", [130.0, 300.0, 600.0])
+@pytest.mark.parametrize("step_s", [
+    pytest.param(130.0, marks=pytest.mark.xfail(
+        strict=True, reason="names nothing but says unexplained (something else on T2, "
+        "following the speed) since the calibration maximises the judged log-posterior "
+        "(docs/fit.md, 'One objective')")),
+    300.0, 600.0])
 def test_a_control_logged_sparsely_names_nothing(tmp_path, step_s):
     """The peer's clean control dev-06 (a row every 10 s) logged every 130 s or 10 min:
     refused before ("too few samples": every silence over 120 s was a gap), and at 2 min with
