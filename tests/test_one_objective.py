@@ -86,3 +86,21 @@ def test_the_fit_with_priors_maximises_the_log_posterior(calibrator):
     _, fit = cal.fit_with_prior(centre)
     assert fit.penalty > 0.1  # the priors pull
     assert _best_nearby(cal, fit, fit.sample_share) < SLACK
+
+
+def test_the_free_fits_intervals_count_its_residual(calibrator):
+    """The free fit before the priors is one least squares with the channels alike; its
+    intervals still count its residual's variance: the same fit on data whose noise is
+    scaled up 10 times (the same model, so nearly the same parameters) has intervals about 10
+    times wider on its fitted scale (between 5 and 20: the parameters move with the noise)."""
+    base = calibrator.measured
+    grid = base.grid_s
+    model = calibrator.gb.simulate({"f0": 0.4, "h_air": 1.6})
+    loud = Measured(grid, {c: model[c] + 10.0 * (base.values[c] - model[c]) for c in CHANNELS})
+    widths = []
+    for measured in (base, loud):
+        cal = Calibrator(calibrator.gb, measured, CHANNELS)
+        fit = cal.fit(reweight=False)
+        lo, hi = fit.ci95["f0"]
+        widths.append(np.log(hi / lo))
+    assert 5.0 < widths[1] / widths[0] < 20.0, widths

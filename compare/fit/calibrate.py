@@ -395,6 +395,10 @@ class Calibrator:
             n = sum(len(r) for r in res.values())
             n_eff = max(effective_samples(res), len(free) + 2.0)
             if not reweight:
+                # one variance for every channel: the intervals count the pooled residual
+                pooled = channel_weights({"all": np.concatenate(list(res.values()))},
+                                         n_eff / n)["all"]
+                weights = dict.fromkeys(weights, pooled)
                 break
             weights.update(channel_weights(res, n_eff / n))
             if (max(abs(weights[c] / used[c] - 1.0) for c in res) <= self.reweight_tol
