@@ -39,18 +39,27 @@ def calibrated():
     return cal, fit
 
 
+#: the mend (the penalty in prior sds) changes verdicts, so it waits for the main set's
+#: measurement: docs/fit.md "The linearized gains' prior penalty"
+NOT_ADOPTED = pytest.mark.xfail(strict=True, reason="the linearized gains weigh the priors "
+                                "prior_scale^2 times the calibration's log-posterior (known; "
+                                "its mend is a trade measured on 59 runs, not yet adopted)")
+
+
+@NOT_ADOPTED
 def test_the_linear_penalty_is_the_calibrations_own(calibrated):
     """At the fitted point the step of nothing carries the prior penalty the calibration
-    reports (Fit.penalty, 1/2 sum ((z - z_prior) / sd)^2), to round-off. The data rows weigh
-    far from 1 here (asserted: a penalty scaled by the data's weights, as it once was, would
-    show)."""
+    reports (Fit.penalty, 1/2 sum ((z - z_prior) / sd)^2), to round-off. It is that penalty
+    times prior_scale^2, the weight of the priors' rows in the least squares, and prior_scale
+    is not 1 here (asserted: else the test could not tell)."""
     cal, fit = calibrated
     loc = local(cal, fit)
-    assert min(fit.weights.values()) > 2.0, fit.weights
+    assert abs(cal.prior_scale - 1.0) > 0.1, cal.prior_scale
     assert fit.penalty > 0.0
     assert loc.penalty(np.zeros(loc.J.shape[1])) == pytest.approx(fit.penalty, rel=1e-12)
 
 
+@NOT_ADOPTED
 def test_a_steps_penalty_is_the_calibrators_at_the_point_it_lands(calibrated):
     """A step of a tenth of a prior sd in each parameter (away from the prior centres): the
     penalty Local scores it with is the calibrator's prior terms at the parameters the step

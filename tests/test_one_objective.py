@@ -7,6 +7,10 @@ itself must find nothing worth having. The channels carry noise 30 times apart (
 log-likelihood units for the minimiser to find without priors, 15.1 with them (measured at
 ac78811, before the reweighting, 2026-12-01).
 
+Not yet so: the calibration weighs every channel alike and the priors by one scale, and its
+reweighted mend (benchmarks/patches/one-objective.patch, `git apply`) is a trade measured and
+not adopted (docs/fit.md, "One objective"); both tests are strict xfails until it is.
+
 Tolerance: 0.05 log-likelihood units, a sixtieth of the smallest gain a selection rule acts on
 (chi2(1) at the 1 % level, 6.63 / 2 = 3.3) and far above the reweighting's own slack (its 1 %
 tolerance on the weights moved the gain by 3e-9 here)."""
@@ -35,6 +39,10 @@ CHANNELS = ["T1", "T2", "T_stator", "P1"]
 #: the channels' noise [K; m for P1]: 30 times apart in tolerances
 NOISE = {"T1": 0.6, "T2": 0.02, "T_stator": 0.05, "P1": 0.03e-6}
 SLACK = 0.05
+#: the mend is measured, not adopted (module docstring)
+NOT_ADOPTED = pytest.mark.xfail(strict=True, reason="the calibration's least squares weigh the "
+                                "channels alike, the selection by a variance per channel "
+                                "(docs/fit.md, 'One objective': a trade, not adopted)")
 
 
 @pytest.fixture(scope="module")
@@ -72,12 +80,13 @@ def _best_nearby(cal: Calibrator, fit, share: float) -> float:
     return start - float(sol.fun)
 
 
+@NOT_ADOPTED
 def test_the_free_fit_maximises_the_concentrated_likelihood(calibrator):
     fit = calibrator.fit()
-    assert max(fit.weights.values()) > 10 * min(fit.weights.values())  # the noise shows
     assert _best_nearby(calibrator, fit, 1.0) < SLACK
 
 
+@NOT_ADOPTED
 def test_the_fit_with_priors_maximises_the_log_posterior(calibrator):
     """Priors around the spec's values (f0 1, films 1: the data lie off them), the data
     counted at the fit's sample share, as the selection counts every gain."""
@@ -87,20 +96,3 @@ def test_the_fit_with_priors_maximises_the_log_posterior(calibrator):
     assert fit.penalty > 0.1  # the priors pull
     assert _best_nearby(cal, fit, fit.sample_share) < SLACK
 
-
-def test_the_free_fits_intervals_count_its_residual(calibrator):
-    """The free fit before the priors is one least squares with the channels alike; its
-    intervals still count its residual's variance: the same fit on data whose noise is
-    scaled up 10 times (the same model, so nearly the same parameters) has intervals about 10
-    times wider on its fitted scale (between 5 and 20: the parameters move with the noise)."""
-    base = calibrator.measured
-    grid = base.grid_s
-    model = calibrator.gb.simulate({"f0": 0.4, "h_air": 1.6})
-    loud = Measured(grid, {c: model[c] + 10.0 * (base.values[c] - model[c]) for c in CHANNELS})
-    widths = []
-    for measured in (base, loud):
-        cal = Calibrator(calibrator.gb, measured, CHANNELS)
-        fit = cal.fit(reweight=False)
-        lo, hi = fit.ci95["f0"]
-        widths.append(np.log(hi / lo))
-    assert 5.0 < widths[1] / widths[0] < 20.0, widths

@@ -5,17 +5,10 @@
   logging gap, Criteria.gap_min_steps, is left out). The run is split in time: the first part
   (default 60 %) is the fit window, the rest the validation window.
 - **Weighted least squares** (scipy.optimize.least_squares): residuals are divided by the
-  channel's tolerance (1 K, 1.5 µm, paper section 3), then weighted per channel by
-  sqrt(share n_c / RSS_c) (share = n_eff / n), the weights reset from the solution and the
-  fit repeated until they settle (iteratively reweighted least squares). At that fixed point
-  the gradient of the least squares' cost is the gradient of the log-posterior below, so the
-  calibration maximises the very figure the selection judges it by (with one common weight
-  it would not: a channel the model misses would weigh as much as one it fits, and a refit
-  could walk away from the better model the judge had found; docs/fit.md, "One objective").
-  Parameters are fitted on a log scale (factors) or scaled to their bounds.
-- **Confidence intervals** from the Jacobian: cov = (J_w^T J_w)^-1 n / (n - p) with J_w the
-  weighted rows, i.e. each channel's residual variance, inflated by n / n_eff for the
-  residual's autocorrelation (n_eff = n / tau_int with
+  channel's tolerance (1 K, 1.5 µm, paper section 3), so the channels weigh alike at their
+  tolerance. Parameters are fitted on a log scale (factors) or scaled to their bounds.
+- **Confidence intervals** from the Jacobian: cov = s^2 (J^T J)^-1 with s^2 the residual
+  variance, inflated by n / n_eff for the residual's autocorrelation (n_eff = n / tau_int with
   tau_int the integrated autocorrelation time: compare.residuals.effective_samples), 95 %
   intervals; correlations; a parameter is reported not identifiable when its interval spans
   more than its bounds' range (a direction the information matrix does not determine counts
@@ -23,8 +16,7 @@
   their bounds, and leaves the others alone).
 - **Priors** (when :meth:`Calibrator.set_prior` is called, as ``fit`` does): each base
   parameter is Gaussian around the spec's value on its fitted scale, with the width
-  ``Param.prior_sd``; the data term is weighted by n_eff / n against them (the share in the
-  channels' weights), the priors' rows by 1 / sd.
+  ``Param.prior_sd``; the data term is weighted by n_eff / n against them.
 - **Likelihood** (unknown variance per channel, Gaussian): l = -1/2 sum_c n_c ln(RSS_c / n_c).
   A richer model is tested against the nested one by LR = 2 [(l1 - l0) n_eff / n -
   (penalty1 - penalty0)] ~ chi2(k) (k its added parameters; the autocorrelation correction
@@ -140,58 +132,6 @@ def z_bounds(params: Sequence[Param]) -> tuple[np.ndarray, np.ndarray]:
     return b[:, 0], b[:, 1]
 
 
-#: the smallest mean square of a channel's residual the weights use [tolerances^2]: a
-#: residual of 1e-6 tolerances RMS is round-off (no bench logs finer than 1e-3 of a
-#: tolerance), and a channel fitted exactly would otherwise weigh infinitely
-MEAN_SQUARE_FLOOR = 1e-12
-
-
-def channel_weights(residuals: Mapping[str, np.ndarray], share: float) -> dict[str, float]:
-    """Per channel, the weight of its residual rows at which the least squares' cost has the
-    gradient of share x :func:`concentrated_loglik` there: sqrt(share / (RSS_c / n_c))
-    [1 / tolerance] (a channel without samples weighs 1: it has no rows)."""
-    return {c: math.sqrt(share / max(float(np.mean(r * r)), MEAN_SQUARE_FLOOR)) if len(r)
-            else 1.0 for c, r in residuals.items()}
-
-
-def reweighted_step(J: np.ndarray, r: np.ndarray, channel: np.ndarray, share: float,
-                    prior_rows: np.ndarray, prior_offset: np.ndarray, lo: np.ndarray,
-                    hi: np.ndarray, tol: float, passes: int) -> tuple[np.ndarray, np.ndarray]:
-    """On the linearized model r + J x (rows in tolerances, ``channel`` their channel's
-    index), the step x within [lo, hi] that maximises share x concentrated_loglik less the
-    priors' 1/2 |prior_rows (prior_offset + x)|^2 (prior_rows 1 / sd on the first columns, 0
-    where none): weighted linear least squares (scipy.optimize.lsq_linear), the weights reset
-    from the step's residual until no row's weight changes by more than ``tol`` (at most
-    ``passes`` solves). Returns (x, each row's weight at x)."""
-    from scipy.optimize import lsq_linear
-
-    kb = len(prior_rows)
-    keep = prior_rows > 0
-    P = np.zeros((int(keep.sum()), J.shape[1]))
-    P[:, :kb] = np.diag(prior_rows)[keep]
-    bp = -(prior_rows * prior_offset)[keep]
-    channels = np.unique(channel)
-
-    def row_weights(res: np.ndarray) -> np.ndarray:
-        w = np.empty_like(res)
-        for c in channels:
-            on = channel == c
-            w[on] = math.sqrt(share / max(float(np.mean(res[on] ** 2)), MEAN_SQUARE_FLOOR))
-        return w
-
-    weight = row_weights(r)
-    x = np.zeros(J.shape[1])
-    for _ in range(max(1, passes)):
-        A = np.vstack([J * weight[:, None], P])
-        b = np.concatenate([-r * weight, bp])
-        x = lsq_linear(A, b, bounds=(lo, hi), method="bvls" if A.shape[1] < 30 else "trf",
-                       lsmr_tol="auto").x
-        used, weight = weight, row_weights(r + J @ x)
-        if np.max(np.abs(weight / used - 1.0), initial=0.0) <= tol:
-            break
-    return x, weight
-
-
 def concentrated_loglik(residuals: Iterable[np.ndarray]) -> float:
     """-1/2 sum_c n_c ln(RSS_c / n_c) over the channels' residuals (an unknown variance per
     channel, Gaussian: module docstring)."""
@@ -219,9 +159,6 @@ class Fit:
     #: for a parameter the run does not determine alone, the one it is determined with:
     #: (name, correlation), where fixing that one would make it identifiable (_intervals)
     partners: dict[str, tuple[str, float]] = field(default_factory=dict)
-    #: per channel, the weight of its residual rows at this fit (channel_weights): the
-    #: linearized model (compare.fit.linear) steps with them
-    weights: dict[str, float] = field(default_factory=dict)
 
     @property
     def sample_share(self) -> float:
@@ -253,11 +190,8 @@ class Calibrator:
     tol: float = 1e-6
     #: prior centres (the spec's values, compare.fit.discrepancy); the widths are Param.prior_sd
     prior: dict[str, float] | None = None
-    #: the reweighting stops when no channel's weight changes by more than this share between
-    #: passes (a numerical tolerance: a weight 1 % off moves the judged gain by about 1e-4 of
-    #: its data term), or after ``max_passes``
-    reweight_tol: float = 0.01
-    max_passes: int = 5
+    #: sqrt(s^2 n / n_eff) of the data term, so that data and prior weigh as a posterior
+    prior_scale: float = 1.0
     #: per channel, the validation RMS [tolerance units] no effect can remove: the sensor
     #: noise (set_floor); None counts the whole validation error
     floor: dict[str, float] | None = None
@@ -275,11 +209,11 @@ class Calibrator:
 
     def fit_with_prior(self, centre: dict[str, float], start: dict[str, float] | None = None
                        ) -> tuple[Fit, Fit]:
-        """(fit without priors, fit with priors around ``centre``): the first, one least
-        squares with the channels weighed alike (its parameters are a start, its residual the
-        noise floor: set_floor), the second starts where it ended."""
-        free_fit = self.fit(start=start, reweight=False)
-        self.set_prior(centre)
+        """(fit without priors, fit with priors around ``centre``): the first sets the data's
+        weight against the priors and the noise floor (set_prior, set_floor), the second
+        starts where it ended."""
+        free_fit = self.fit(start=start)
+        self.set_prior(centre, free_fit)
         self.set_floor(free_fit)
         return free_fit, self.fit(start=free_fit.theta)
 
@@ -293,21 +227,12 @@ class Calibrator:
                 / params[k].prior_sd for k in fit.free
                 if params[k].prior_sd and k in self.prior}
 
-    def set_prior(self, centre: dict[str, float]) -> None:
-        """Priors around ``centre`` for the fits from then on (each weighs the data against
-        them by its own channels' weights: :meth:`fit`)."""
+    def set_prior(self, centre: dict[str, float], fit: Fit) -> None:
+        """Priors around ``centre``, weighed against the data by ``fit``'s residual variance
+        and effective sample size (held fixed from then on, so likelihoods stay comparable)."""
+        r = np.concatenate(list(self.residuals(fit.model, "fit").values()))
         self.prior = dict(centre)
-
-    def prior_rows(self, params: dict[str, Param], free: Sequence[str]
-                   ) -> tuple[np.ndarray, np.ndarray]:
-        """(1 / sd, the prior centre) of each of ``free`` on its fitted scale; (0, 0) where
-        it has no prior."""
-        rows, centre = np.zeros(len(free)), np.zeros(len(free))
-        for i, k in enumerate(free):
-            p = params[k]
-            if self.prior and p.prior_sd and k in self.prior:
-                rows[i], centre[i] = 1.0 / p.prior_sd, _to_z(p, self.prior[k])
-        return rows, centre
+        self.prior_scale = float(np.sqrt(np.mean(r * r) * fit.n / fit.n_eff))
 
     def _prior_terms(self, params: dict[str, Param], free: Sequence[str],
                      z: np.ndarray) -> np.ndarray:
@@ -339,12 +264,9 @@ class Calibrator:
         return errs
 
     def fit(self, effects: tuple[str, ...] = (), free: Sequence[str] | None = None,
-            start: dict[str, float] | None = None, max_nfev: int | None = None,
-            reweight: bool = True) -> Fit:
+            start: dict[str, float] | None = None, max_nfev: int | None = None) -> Fit:
         """Weighted least squares over ``free`` (default: every parameter of the model with
-        the effects ``effects``, labels), the channels' weights starting from the residual at
-        the start and reset until they settle (module docstring); ``reweight`` False: one
-        least squares, every channel's weight 1."""
+        the effects ``effects``, labels)."""
         from scipy.optimize import least_squares
 
         gb = self.gb.variant(effects)
@@ -359,11 +281,6 @@ class Calibrator:
         lo, hi = z_bounds([params[k] for k in free])
         z0 = np.clip(z0, lo, hi)
         nfev = 0
-        weights = dict.fromkeys(self.channels, 1.0)
-        if reweight:
-            at_start = self.residuals(gb.simulate(theta), "fit")
-            n_start = sum(len(r) for r in at_start.values())
-            weights.update(channel_weights(at_start, effective_samples(at_start) / n_start))
 
         def vec(z: np.ndarray) -> np.ndarray:
             nonlocal nfev
@@ -371,62 +288,27 @@ class Calibrator:
             th = dict(theta)
             th.update({k: _from_z(params[k], float(v)) for k, v in zip(free, z, strict=True)})
             out = gb.simulate(th)
-            return np.concatenate([*(weights[c] * r for c, r in
-                                     self.residuals(out, "fit").items()),
-                                   self._prior_terms(params, free, z)])
+            return np.concatenate([*self.residuals(out, "fit").values(),
+                                   self.prior_scale * self._prior_terms(params, free, z)])
 
         costly = set(gb.matrix_params())
-        z = z0
-        # max_nfev is the budget of the whole fit, its passes together
-        budget = max_nfev or self.max_nfev
-        for _ in range(self.max_passes if reweight else 1):
-            # the children fork with this pass's weights (vec reads them)
-            with ForkedColumns(vec, [k in costly for k in free], self.workers) as columns:
-                sol = least_squares(vec, z, bounds=(lo, hi), diff_step=1e-4, x_scale="jac",
-                                    max_nfev=budget, ftol=self.tol, xtol=self.tol,
-                                    workers=columns)
-            nfev += columns.child_evaluations
-            budget -= sol.nfev
-            z = sol.x
-            used = dict(weights)
-            theta.update({k: _from_z(params[k], float(v)) for k, v in zip(free, z, strict=True)})
-            out = gb.simulate(theta)
-            res = self.residuals(out, "fit")
-            n = sum(len(r) for r in res.values())
-            n_eff = max(effective_samples(res), len(free) + 2.0)
-            if not reweight:
-                # one variance for every channel: the intervals count the pooled residual
-                pooled = channel_weights({"all": np.concatenate(list(res.values()))},
-                                         n_eff / n)["all"]
-                weights = dict.fromkeys(weights, pooled)
-                break
-            weights.update(channel_weights(res, n_eff / n))
-            if (max(abs(weights[c] / used[c] - 1.0) for c in res) <= self.reweight_tol
-                    or budget < 1):
-                break
-            # the next pass starts from the weights the linearized model settles at (sol.jac
-            # is the Jacobian at z): the passes alone converge slowly, each moving the
-            # weights some way towards where the next pass would leave them
-            index = {c: j for j, c in enumerate(res)}
-            channel = np.concatenate([np.full(len(r), index[c]) for c, r in res.items()])
-            rows = np.concatenate([np.full(len(r), used[c]) for c, r in res.items()])
-            prior_rows, centre = self.prior_rows(params, free)
-            _, settled = reweighted_step(sol.jac[:n] / rows[:, None],
-                                         np.concatenate(list(res.values())), channel,
-                                         n_eff / n, prior_rows, z - centre, lo - z, hi - z,
-                                         0.1 * self.reweight_tol, self.max_passes)
-            weights.update({c: float(settled[channel == index[c]][0]) for c in res
-                            if len(res[c])})
-        # the data rows, weighted as the last weights say: the intervals say what this run
-        # alone determines, each channel counted at its own variance
-        rescale = np.concatenate([np.full(len(r), weights[c] / used[c])
-                                  for c, r in res.items()])
-        J = sol.jac[:n] * rescale[:, None]
-        penalty = 0.5 * float(np.sum(self._prior_terms(params, free, z) ** 2))
-        ci, corr, ident, partners = _intervals(J, n, free, params, z)
+        with ForkedColumns(vec, [k in costly for k in free], self.workers) as columns:
+            sol = least_squares(vec, z0, bounds=(lo, hi), diff_step=1e-4, x_scale="jac",
+                                max_nfev=max_nfev or self.max_nfev, ftol=self.tol,
+                                xtol=self.tol, workers=columns)
+        nfev += columns.child_evaluations
+        theta.update({k: _from_z(params[k], float(v)) for k, v in zip(free, sol.x, strict=True)})
+        out = gb.simulate(theta)
+        res = self.residuals(out, "fit")
+        r_all = np.concatenate(list(res.values()))
+        n = len(r_all)
+        n_eff = max(effective_samples(res), len(free) + 2.0)
+        J = sol.jac[:n]  # the data rows: the intervals say what this run alone determines
+        penalty = 0.5 * float(np.sum(self._prior_terms(params, free, sol.x) ** 2))
+        ci, corr, ident, partners = _intervals(J, r_all, n, n_eff, free, params, sol.x)
         return Fit(tuple(effects), theta, free, ci, corr, ident,
                    concentrated_loglik(res.values()), n, n_eff, out, self.errors(out),
-                   nfev, penalty, partners, weights)
+                   nfev, penalty, partners)
 
 
 def over_tolerance(window_errors: Mapping[str, Mapping[str, float]]) -> dict[str, float]:
@@ -438,15 +320,14 @@ def over_tolerance(window_errors: Mapping[str, Mapping[str, float]]) -> dict[str
             if e.get("n") and e["rmse_w"] > 1.0}
 
 
-def _intervals(J: np.ndarray, n: int, free: list[str], params: dict[str, Param],
-               z: np.ndarray):
+def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[str],
+               params: dict[str, Param], z: np.ndarray):
     """95 % intervals in the parameters' own units, correlations, identifiability, and for
     each parameter that is not identifiable the one it is determined with: the parameter of
     largest |correlation| r, where with that one fixed its interval (sd sqrt(1 - r^2)) would
     fit its range. Where none would, the run leaves it free with several others."""
     p = len(free)
-    # J's rows carry each channel's weight sqrt(share / s_c^2): the degrees of freedom remain
-    s2 = n / max(n - p, 1)
+    s2 = float(np.dot(r, r)) / max(n - p, 1) * (n / n_eff)
     ci: dict[str, tuple[float, float]] = {}
     ident: dict[str, bool] = {}
     try:

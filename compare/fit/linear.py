@@ -4,12 +4,10 @@ whole run) answered by one Gauss-Newton step on the Jacobian instead of a nonlin
 
 At a fit the residual (measured minus model, in tolerances) over every valid sample of the run
 is r(z) ~ r0 + J (z - z0), z the free parameters on their fitted scale (compare.fit.calibrate).
-A step minimises the weighted sum of squares over chosen rows plus the priors' terms, within
-the parameters' bounds (scipy.optimize.lsq_linear), its channels' weights reset from the step's
-residual until they settle, exactly as the nonlinear fit would to first order (both maximise
-the log-posterior the selection judges by: compare.fit.calibrate); extra columns (an
-effect's parameters at their neutral value, a window's heat) join the same step. One Jacobian
-costs one simulation per free parameter.
+A step minimises the sum of squares over chosen rows plus the priors' terms, within the
+parameters' bounds (scipy.optimize.lsq_linear), exactly as the nonlinear fit would to first
+order; extra columns (an effect's parameters at their neutral value, a window's heat) join the
+same step. One Jacobian costs one simulation per free parameter.
 """
 
 from __future__ import annotations
@@ -28,7 +26,6 @@ from compare.fit.calibrate import (
     block_index,
     concentrated_loglik,
     error_row,
-    reweighted_step,
     z_bounds,
 )
 from compare.fit.effects import effect_of
@@ -53,26 +50,36 @@ class Local:
     z0: np.ndarray
     lo: np.ndarray
     hi: np.ndarray
-    prior_rows: np.ndarray  # (free,) 1 / sd, 0 where no prior
+    prior_rows: np.ndarray  # (free,) prior_scale / sd, 0 where no prior
     prior_z: np.ndarray  # (free,) prior centre on the fitted scale (z0 where none)
+
+    def _system(self, rows: np.ndarray, extra: np.ndarray | None):
+        A = self.J[rows]
+        if extra is not None:
+            A = np.hstack([A, extra[rows]])
+        k = A.shape[1]
+        kb = self.J.shape[1]
+        P = np.zeros((kb, k))
+        P[:, :kb] = np.diag(self.prior_rows)
+        bp = -self.prior_rows * (self.z0 - self.prior_z)
+        keep = self.prior_rows > 0
+        return np.vstack([A, P[keep]]), np.concatenate([-self.r0[rows], bp[keep]])
 
     def step(self, rows: np.ndarray, extra: np.ndarray | None = None,
              extra_bounds: Sequence[tuple[float, float]] = ()) -> np.ndarray:
         """The step over ``rows`` (boolean mask) with ``extra`` columns (rows, m) bounded by
-        ``extra_bounds``: the change of the free parameters' z, then the extra amplitudes.
-        The channels' weights start from those of the rows' residual before the step and are
-        reset from the step's residual until they settle, as Calibrator.fit's do
-        (compare.fit.calibrate.reweighted_step)."""
+        ``extra_bounds``: the change of the free parameters' z, then the extra amplitudes."""
+        from scipy.optimize import lsq_linear
+
+        A, b = self._system(rows, extra)
         lo = np.concatenate([self.lo - self.z0, [a for a, _ in extra_bounds]])
         hi = np.concatenate([self.hi - self.z0, [c for _, c in extra_bounds]])
         # a parameter sitting on a bound can only move inside
         lo, hi = np.minimum(lo, 0.0), np.maximum(hi, 0.0)
-        A = self.J[rows] if extra is None else np.hstack([self.J[rows], extra[rows]])
         if A.shape[1] == 0:
             return np.zeros(0)
-        return reweighted_step(A, self.r0[rows], self.channel[rows], self.fit.sample_share,
-                               self.prior_rows, self.z0 - self.prior_z, lo, hi,
-                               self.cal.reweight_tol, self.cal.max_passes)[0]
+        return lsq_linear(A, b, bounds=(lo, hi), method="bvls" if A.shape[1] < 30 else "trf",
+                          lsmr_tol="auto").x
 
     def residual(self, delta: np.ndarray, extra: np.ndarray | None = None) -> np.ndarray:
         """The residual of every row after ``delta`` (free parameters, then extras)."""
@@ -83,8 +90,8 @@ class Local:
         return r
 
     def _prior_terms(self, delta: np.ndarray) -> np.ndarray:
-        """The priors' residuals after the step ``delta`` (the distance from the prior centre
-        on the fitted scale in prior standard deviations; 0 where no prior)."""
+        """The priors' residuals after the step ``delta`` (prior_scale / sd times the distance
+        from the prior centre on the fitted scale; 0 where no prior)."""
         kb = self.J.shape[1]
         return self.prior_rows * (self.z0 + delta[:kb] - self.prior_z)
 
@@ -99,11 +106,9 @@ class Local:
     def prior_sds(self, delta: np.ndarray) -> np.ndarray:
         """Each base parameter's distance from its prior centre after the step ``delta``, in
         prior standard deviations (0 where it has no prior)."""
-        return self._prior_terms(delta)
+        return self._prior_terms(delta) / self.cal.prior_scale
 
     def penalty(self, delta: np.ndarray) -> float:
-        """1/2 the sum of the squared prior distances after ``delta`` [prior sds^2]: the
-        calibration's Fit.penalty at the point the step lands on."""
         t = self._prior_terms(delta)
         return 0.5 * float(t @ t)
 
@@ -200,7 +205,7 @@ def local(cal: Calibrator, fit: Fit) -> Local:
     for i, k in enumerate(free):
         p = params[k]
         if cal.prior and p.prior_sd and k in cal.prior:
-            prior_rows[i] = 1.0 / p.prior_sd
+            prior_rows[i] = cal.prior_scale / p.prior_sd
             prior_z[i] = _to_z(p, cal.prior[k])
     return Local(cal, fit, ch, pt, in_fit, r0, J, z0, lo, hi, prior_rows, prior_z)
 
