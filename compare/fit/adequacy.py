@@ -1,4 +1,5 @@
-"""Verdicts on the calibrated base model before any effect is named (docs/fit-history.md, issue 13 §4-5).
+"""Verdicts on the calibrated base model before any effect is named (docs/fit-history.md,
+issue 13 §4-5).
 
 - :func:`base_adequacy`: how well the calibrated base model alone explains the run (open-loop
   RMS per channel against the paper's tolerances, 1 K and 1.5 µm), which base parameters
@@ -86,13 +87,14 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
     criteria = criteria or Criteria()
     z_crit = criteria.implausible_z()
     channels: dict[str, dict[str, float]] = {}
-    bad: list[tuple[str, str, float]] = []
+    worst: dict[str, tuple[str, float]] = {}  # each channel's largest miss: window, rmse_w
     for window in ("fit", "validation"):
         for c, e in errors.get(window, {}).items():
-            if not e.get("n"):
-                continue
-            channels.setdefault(c, {})[window] = float(e["rmse_w"])
-        bad += [(c, window, r) for c, r in over_tolerance(errors.get(window, {})).items()]
+            if e.get("n"):
+                channels.setdefault(c, {})[window] = float(e["rmse_w"])
+        for c, r in over_tolerance(errors.get(window, {})).items():
+            if r > worst.get(c, ("", 0.0))[1]:
+                worst[c] = (window, r)
     z = dict(prior_z or {})
     moved = [{"name": k, "spec": float(spec_values[k]), "calibrated": float(theta[k]),
               "z": float(z[k]) if k in z else None}
@@ -123,20 +125,17 @@ def base_adequacy(errors: Mapping[str, Mapping[str, Mapping[str, float]]],
                         if other in WHERE_IN_SPEC and not said else ""))
         return text
 
-    worst: dict[str, tuple[str, float]] = {}
-    for c, window, r in bad:
-        if r > worst.get(c, ("", 0.0))[1]:
-            worst[c] = (window, r)
     parts = []
     if worst:
         parts.append("misses " + "; ".join(
             f"{c} by {r:.1f} times its tolerance (open-loop RMS, {w} window)"
             for c, (w, r) in sorted(worst.items(), key=lambda kv: -kv[1][1])))
     if implausible:  # after a miss, a clause of its own: "...; it needs ..."
-        parts.append(("it " if parts else "") + "needs implausible values to fit the run: " + "; ".join(
-            # no parentheses around the advice: it has its own
-            f"{k} {theta[k]:.3g}, {z[k]:+.1f} prior sd from the spec's {spec_values[k]:.3g}: "
-            f"look at {where(k, 'its value in the spec')}" for k in implausible))
+        parts.append(("it " if parts else "") + "needs implausible values to fit the run: "
+                     + "; ".join(  # no parentheses around the advice: it has its own
+                         f"{k} {theta[k]:.3g}, {z[k]:+.1f} prior sd from the spec's "
+                         f"{spec_values[k]:.3g}: look at {where(k, 'its value in the spec')}"
+                         for k in implausible))
     adequate = not worst and not implausible
     statement = ("explains the run within the tolerances with every base parameter inside its "
                  "prior range" if adequate else "; ".join(parts))

@@ -76,15 +76,10 @@ def fem_readings(ref, spec: Spec, inputs: Inputs, sources_W: dict[str, np.ndarra
     res = ref.transient(case, dt, T0=T0)
     out = {}
     for c in channels:
-        if c == "P1":
-            if "P1" not in res.growth_m:
-                continue
-            y = res.growth_m["P1"] - res.growth_m["P1"][0]
-        elif c in res.names:
-            y = res.sensor(c)
-        else:
-            continue
-        out[c] = np.interp(t_rel, res.times_s, y)
+        if c == "P1" and "P1" in res.growth_m:
+            out[c] = np.interp(t_rel, res.times_s, res.growth_m["P1"] - res.growth_m["P1"][0])
+        elif c != "P1" and c in res.names:
+            out[c] = np.interp(t_rel, res.times_s, res.sensor(c))
     return out
 
 
@@ -120,8 +115,7 @@ def fem_discrepancy(gb: GreyBox, channels: tuple[str, ...] | list[str], level: i
     """FEM minus lumped (``gb`` without effects, at the spec's values) on ``gb``'s inputs."""
     fem = reference_channels(gb, channels, level)
     theta = default_theta(base_params(gb.drive))
-    plain = gb.plain()
-    lumped = plain.simulate(theta)
+    lumped = gb.plain().simulate(theta)
     offsets = {c: fem[c] - lumped[c] for c in channels}
     rms = {c: float(np.sqrt(np.mean(offsets[c] ** 2))) for c in channels}
     return Discrepancy(theta, offsets, rms, level)

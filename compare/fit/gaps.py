@@ -3,17 +3,17 @@
 A bench that stops logging for a while (a 20 min gap in ``synth``'s runs, 9 min in a peer's)
 may come back at another speed, or at the same speed under another load. The inputs then
 say nothing about when it changed, and a zero-order hold of the last speed puts the change at
-the gap's end: up to the whole gap late.
-On a 6000 -> 1600 rpm change in a 20 min gap that left the stator 10 K, the rings 1.5 K off
-the data right after the gap and pulled the calibrated jacket film to its bound (docs/fit-history.md).
+the gap's end: up to the whole gap late. On a 6000 -> 1600 rpm change in a 20 min gap that
+left the stator 10 K, the rings 1.5 K off the data right after the gap and pulled the
+calibrated jacket film to its bound (docs/fit-history.md).
 
 The switch time is a nuisance parameter of the inputs, so it is estimated like one: for each
 such gap, every grid point inside it is tried as the switch (the old speed, power and load
-torque before, the new after), the lumped grey box is simulated at the spec's values, and the time that fits
-the measured channels best over the hour after the gap (sum of squares in tolerance units)
-is taken. The fast channels (the stator, the rings) pin it to about a grid step. This runs
-before the FEM anchor is solved, so the anchor and the fit see the same inputs. Units: s, rpm,
-kW.
+torque before, the new after), the lumped grey box is simulated at the spec's values, and the
+time that fits the measured channels best over the hour after the gap (sum of squares in
+tolerance units) is taken. The fast channels (the stator, the rings) pin it to about a grid
+step. This runs before the FEM anchor is solved, so the anchor and the fit see the same inputs.
+Units: s, rpm, kW.
 
 Every gap, with a change inside or not, leaves its inputs unknown until the response to them
 has settled (:func:`unknown_input_spans`): the room and the coolant inside it are
@@ -63,16 +63,15 @@ def gaps_with_change(t_rows_s: np.ndarray, t_speed_s: np.ndarray, speed_rpm: np.
                      grid_s: np.ndarray, criteria: Criteria = _DEFAULT,
                      torque: tuple[np.ndarray, np.ndarray] | None = None
                      ) -> list[tuple[float, float, float, float]]:
-    """(start, end, speed before, speed after) of each stretch without any row (``t_rows_s``,
-    every row's time) longer than ``criteria.gap_min_steps`` grid steps across which the
-    operating point changed: the speed beyond the drive's scatter band (spindle.bench_inputs.speed_changed),
-    or the load torque's level (``torque``: its valid samples' times [s] and values [N m],
-    where the bench logs it) by more than a load cell's zero drift
-    (``criteria.no_load_Nm``). The speed before is the last valid sample at or before the
-    gap, after it the first one at or after its end (``t_speed_s``, ``speed_rpm``: the valid
-    speed samples); the torque's levels are its means over ``criteria.gap_level_s`` either
-    side. A speed logged only on change (empty cells between changes, rows going on) has no
-    gap: its change is at the sample that logs it."""
+    """(start, end, speed before, speed after) of each logging gap (:func:`logging_gaps` of
+    ``t_rows_s``, every row's time) across which the operating point changed: the speed beyond
+    the drive's scatter band (spindle.bench_inputs.speed_changed), or the load torque's level
+    (``torque``: its valid samples' times [s] and values [N m], where the bench logs it) by more
+    than a load cell's zero drift (``criteria.no_load_Nm``). The speed before is the last valid
+    sample at or before the gap, after it the first one at or after its end (``t_speed_s``,
+    ``speed_rpm``: the valid speed samples); the torque's levels are its means over
+    ``criteria.gap_level_s`` either side. A speed logged only on change (empty cells between
+    changes, rows going on) has no gap: its change is at the sample that logs it."""
     out = []
     for start, end in logging_gaps(t_rows_s, grid_s, criteria):
         k = int(np.searchsorted(t_speed_s, start, side="right")) - 1

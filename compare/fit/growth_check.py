@@ -43,9 +43,7 @@ def growth_gain(measured_m: np.ndarray, predicted_m: np.ndarray,
     fewer than ten points are measured."""
     y, m = np.asarray(measured_m, dtype=float), np.asarray(predicted_m, dtype=float)
     extra = [np.asarray(t, dtype=float) for t in terms]
-    ok = np.isfinite(y) & np.isfinite(m)
-    for t in extra:
-        ok &= np.isfinite(t)
+    ok = np.logical_and.reduce([np.isfinite(a) for a in (y, m, *extra)])
     y, m = y[ok], m[ok]
     if len(y) < 10 or np.ptp(m) < channel_tolerance("P1"):
         return None

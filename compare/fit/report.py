@@ -60,9 +60,7 @@ def _errors(fit: Fit) -> dict:
 def _effect_entry(rep, step) -> dict:
     """One named effect: its parameters at the final fit, intervals, units, evidence and the
     criteria it passed."""
-    final = rep.selection.final
-    j = step.judgement
-    lab = step.label
+    final, j, lab = rep.selection.final, step.judgement, step.label
     name, channel = parse_label(lab)
     e = effect_of(lab)
     params: dict = {p.name: final.theta[p.name] for p in e.params}
@@ -74,8 +72,7 @@ def _effect_entry(rep, step) -> dict:
             "units": {p.name: p.unit for p in e.params},
             "p_value": j.p_value, "lr": j.lr, "gain": j.gain, "peak_tolerances": j.peak,
             "evidence": test.to_dict() if test is not None and test.applies else None,
-            "criteria": j.criteria, "route": j.route, "explanation": e.explanation,
-            "hint": e.hint,
+            "criteria": j.criteria, "route": j.route, "explanation": e.explanation, "hint": e.hint,
             "at_bound": at_bound(final, lab, rep.criteria.at_bound_rel),
             "validation_rms_before": step.before.validation_score(),
             "validation_rms_after": step.fit.validation_score()}
@@ -95,19 +92,9 @@ def verdict_kind(rep) -> str:
 def _change_text(doc: dict) -> str:
     """The validation error before and after per channel, against the tolerances."""
     before = doc["error_before"].get("validation", {})
-    after = doc["error_after"].get("validation", {})
-    parts = []
-    for c, a in after.items():
-        b = before.get(c, a)
-        tol = TOLERANCE[c] * edge_scale(c)
-        parts.append(f"{c} {b['rmse']:.2f} -> {a['rmse']:.2f} {edge_unit(c)} "
-                     f"(tolerance {tol:g})")
-    return ", ".join(parts)
-
-
-def _where_more(v: dict) -> str:
-    text = place_text(v.get("residual"))
-    return f"; {text}" if text else ""
+    return ", ".join(f"{c} {before.get(c, a)['rmse']:.2f} -> {a['rmse']:.2f} {edge_unit(c)} "
+                     f"(tolerance {TOLERANCE[c] * edge_scale(c):g})"
+                     for c, a in doc["error_after"].get("validation", {}).items())
 
 
 def shown_unit(unit: str) -> str:
@@ -119,6 +106,8 @@ def shown_unit(unit: str) -> str:
 def verdict_lines(doc: dict) -> list[str]:
     """The verdict in sentences: what was found, then the error before and after."""
     v = doc["verdict"]
+    place = place_text(v.get("residual"))  # where an unexplained residual lives
+    where = f"{v.get('where')}" + (f"; {place}" if place else "")
     lines = []
     if v["kind"] == "named":
         for e in doc["effects"]:
@@ -137,15 +126,14 @@ def verdict_lines(doc: dict) -> list[str]:
                       and e["criteria"].get("restores_plausible_base") else ""))
             lines.append(f"Named: {e['label']}, {vals}. Evidence: {how}.")
         if v["unexplained"]:
-            lines.append(f"Something else remains: {v['where']}{_where_more(v)}.")
+            lines.append(f"Something else remains: {where}.")
     elif v["kind"] == "unexplained" and v.get("basis") == "held-out misfit":
         lines.append("Unexplained: the calibrated model misses the tolerances on held-out data "
-                     f"and no effect of the library explains it: {v['where']}{_where_more(v)}. "
-                     "A spindle unlike its spec shows the same way: see the base's adequacy "
-                     "below.")
+                     f"and no effect of the library explains it: {where}. A spindle unlike its "
+                     "spec shows the same way: see the base's adequacy below.")
     elif v["kind"] == "unexplained":
         lines.append("Unexplained: no effect of the library explains this run, and something "
-                     f"else does: {v['where']}{_where_more(v)}.")
+                     f"else does: {where}.")
     elif v["kind"] == "base adequate":
         # adequate to the tolerances; whether its values are plausible is the adequacy's
         # statement below, which this points to so that the two do not read as a contradiction
@@ -259,9 +247,8 @@ def report_dict(rep) -> dict:
         "criteria": rep.criteria.table(),
         "run_summary": rep.run.summary(),
         "windows": {"blocks": rep.measured.blocks,
-                    "fit": [[a, b] for a, b, w in rep.measured.spans() if w == "fit"],
-                    "validation": [[a, b] for a, b, w in rep.measured.spans()
-                                   if w == "validation"],
+                    **{w: [[a, b] for a, b, x in rep.measured.spans() if x == w]
+                       for w in ("fit", "validation")},
                     "inputs_unknown": [[a, b] for a, b in rep.unknown_inputs]},
         "cross_validation": rep.cross_validation,
         "tolerances": {"temperature_K": TOLERANCE["T1"],
@@ -304,13 +291,12 @@ def summary_text(rep) -> str:
     if ad:
         lines.append(f"The base model {ad['statement']}.")
     lines += [f"Warning: {w}." for w in doc.get("warnings") or []]
+    cv = doc.get("cross_validation") or {}
     for key, label in (("base", "before"), ("final", "after")):
-        pooled = (doc.get("cross_validation") or {}).get(key, {}).get("pooled")
-        if pooled:
-            lines.append(f"Cross-validated error {label} ({doc['cross_validation'][key]['blocks']}"
-                         " blocks, each held out): " + ", ".join(
-                             f"{c} {e['rmse']:.2f} {edge_unit(c)}" for c, e in pooled.items())
-                         + ".")
+        if cv.get(key, {}).get("pooled"):
+            lines.append(f"Cross-validated error {label} ({cv[key]['blocks']} blocks, each held "
+                         "out): " + ", ".join(f"{c} {e['rmse']:.2f} {edge_unit(c)}"
+                                              for c, e in cv[key]["pooled"].items()) + ".")
     bad = doc["not_identifiable"]
     if bad:
         lines.append(f"Not identifiable from this run: {', '.join(bad)}.")
@@ -341,15 +327,10 @@ def save_report(rep, out: Path, pictures: bool = True) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     doc = rep.to_dict()
     write_json(out / "report.json", doc)
-    files = [out / "report.json"]
-    pngs: list[tuple[str, str]] = []
-    if pictures:
-        pngs = _pictures(rep, out)
-        files += [out / name for name, _ in pngs]
-    atomic_write(out / "report.html", lambda tmp: tmp.write_text(_html(rep, doc, out, pngs),
-                                                                   "utf-8"))
-    files.append(out / "report.html")
-    return files
+    pngs = _pictures(rep, out) if pictures else []
+    atomic_write(out / "report.html",
+                 lambda tmp: tmp.write_text(_html(rep, doc, out, pngs), "utf-8"))
+    return [out / "report.json", *(out / name for name, _ in pngs), out / "report.html"]
 
 
 def _pictures(rep, out: Path) -> list[tuple[str, str]]:
@@ -360,7 +341,6 @@ def _pictures(rep, out: Path) -> list[tuple[str, str]]:
     plt = pyplot()
     g = rep.measured.grid_s / 3600
     sel = rep.selection
-    made = []
     n = len(rep.channels)
     fig, axes = plt.subplots(n, 2, figsize=(13, 2.8 * n), layout="constrained", squeeze=False)
     for i, c in enumerate(rep.channels):
@@ -391,36 +371,32 @@ def _pictures(rep, out: Path) -> list[tuple[str, str]]:
                   "(inputs unknown, something else not looked for)", fontsize=9)
     atomic_write(out / "fit_channels.png", lambda tmp: fig.savefig(tmp, dpi=110))
     plt.close(fig)
-    made.append(("fit_channels.png", "measured against the model, before and after, with the "
-                 "tolerance bands (paper Fig. 13)"))
     fig, axes = plt.subplots(n, 3, figsize=(14, 2.6 * n), layout="constrained", squeeze=False)
     dt = float(np.median(np.diff(rep.measured.grid_s)))
     for i, c in enumerate(rep.channels):
-        rb = (rep.measured.values[c] - sel.base.model[c]) / TOLERANCE[c]
-        ra = (rep.measured.values[c] - sel.final.model[c]) / TOLERANCE[c]
         ax = axes[i, 0]
-        ax.plot(g, rb, lw=0.8, color="C0", label="before")
-        ax.plot(g, ra, lw=0.8, color="C1", label="after")
-        ax.axhspan(-1, 1, color="0.9")
-        ax.set_ylabel(f"{c} residual / tol")
-        ax.legend(fontsize=7)
-        ax.grid(alpha=0.3)
         first = True
-        for r, colour, label in ((rb, "C0", "before"), (ra, "C1", "after")):
+        for fit, colour, label in ((sel.base, "C0", "before"), (sel.final, "C1", "after")):
+            r = (rep.measured.values[c] - fit.model[c]) / TOLERANCE[c]
+            ax.plot(g, r, lw=0.8, color=colour, label=label)
             if (~np.isnan(r)).sum() > 20:
                 plot_acf(axes[i, 1], r, 40, 0.01, dt, color=colour, label=label, band=first)
                 plot_cumulated_periodogram(axes[i, 2], r, 0.01, dt, color=colour, label=label,
                                            band=first)
                 first = False
-        axes[i, 1].legend(fontsize=7, loc="upper right")
-        axes[i, 2].legend(fontsize=7, loc="lower right")
-        axes[i, 1].set_title(f"{c}: ACF (before, after)", fontsize=9)
-        axes[i, 2].set_title(f"{c}: cumulated periodogram (before, after)", fontsize=9)
+        ax.axhspan(-1, 1, color="0.9")
+        ax.set_ylabel(f"{c} residual / tol")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+        for k, at, what in ((1, "upper right", "ACF"), (2, "lower right", "cumulated periodogram")):
+            axes[i, k].legend(fontsize=7, loc=at)
+            axes[i, k].set_title(f"{c}: {what} (before, after)", fontsize=9)
     atomic_write(out / "fit_residuals.png", lambda tmp: fig.savefig(tmp, dpi=110))
     plt.close(fig)
-    made.append(("fit_residuals.png", "residuals before and after (in tolerance units), their "
-                 "autocorrelation and cumulated periodograms"))
-    return made
+    return [("fit_channels.png", "measured against the model, before and after, with the "
+             "tolerance bands (paper Fig. 13)"),
+            ("fit_residuals.png", "residuals before and after (in tolerance units), their "
+             "autocorrelation and cumulated periodograms")]
 
 
 def _criteria_html(doc: dict) -> str:

@@ -33,12 +33,7 @@ from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAM
 from compare.fit.select import Selection, select
 from compare.fit.signatures import Context, EventTest
 from compare.fit.start import Start, first_samples, run_start
-from spindle.bench import (
-    BenchRun,
-    BenchWarning,
-    check_against_spec,
-    read_bench,
-)
+from spindle.bench import BenchRun, BenchWarning, check_against_spec, read_bench
 from spindle.bench_clean import coolant_as_room, without_spikes, without_stuck
 from spindle.bench_inputs import (
     Inputs,
@@ -356,18 +351,17 @@ def run_fit(path: str | Path, spec: Spec, fit_fraction: float = 0.6,
                                 for c in channels}, dt, ins, alpha=criteria.alpha)
                       for fit in (sel.base, final))
     ranges = {k: (p.lo, p.hi) for k, p in cal.gb.parameters().items()}
-    def adequacy_of(fit: Fit) -> dict:
-        return base_adequacy(fit.errors, fit.theta, prep.spec_values, cal.prior_z(fit),
-                             ranges, criteria, fit.partners)
-
-    adequacy = {**adequacy_of(sel.base), "with_effects": adequacy_of(final)}
+    ad_b, ad_a = (base_adequacy(fit.errors, fit.theta, prep.spec_values, cal.prior_z(fit), ranges,
+                                criteria, fit.partners) for fit in (sel.base, final))
+    adequacy = {**ad_b, "with_effects": ad_a}
     warns = list(prep.left_out) + [t for t in [prep.start.text(), _other_spindle(run, spec)]
                                    if t]
     warns += extrapolation_warnings(inputs.grid_s, inputs.speed_rpm, inputs.load_torque_Nm,
                                     measured.fit_points())
-    warns += [f"{g.text()} inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} h); the change "
-              f"is placed at {g.switch_s / 3600:.2f} h, where {prep.switches_placed_by} fits "
-              "the hour after the gap best (compare.fit.gaps)" for g in prep.gap_switches]
+    warns += [f"{g.text()} inside a logging gap ({g.start_s / 3600:.2f}-{g.end_s / 3600:.2f} "
+              f"h); the change is placed at {g.switch_s / 3600:.2f} h, where "
+              f"{prep.switches_placed_by} fits the hour after the gap best (compare.fit.gaps)"
+              for g in prep.gap_switches]
     cv = {}
     if criteria.cv_blocks:
         from compare.fit.linear import local
@@ -401,10 +395,8 @@ def _measured(run: BenchRun, channels: list[str], grid_s: np.ndarray, fit_fracti
     if not 1 <= blocks <= 20:
         raise InputError("command line", "--blocks", f"{blocks} is outside 1..20",
                          "cut the run into 1 (one split) to 20 blocks, e.g. 5")
-    values = {}
-    for c in channels:
-        t, y = run.channel(c)
-        values[c] = resample(t, y, grid_s, criteria.gap_min_steps, logging_step_s(run.time_s))
+    step = logging_step_s(run.time_s)
+    values = {c: resample(*run.channel(c), grid_s, criteria.gap_min_steps, step) for c in channels}
     measured = Measured(grid_s, values, fit_fraction, blocks)
     for c in channels:
         if measured.mask(c, "fit").sum() < 10 or measured.mask(c, "validation").sum() < 5:

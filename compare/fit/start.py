@@ -75,8 +75,7 @@ class Start:
 
     def to_dict(self) -> dict:
         return {"prehistory_s": self.prehistory_s, "reached": self.reached,
-                "first_K": self.first_K,
-                "uniform_misfit_tolerances": self.uniform_misfit,
+                "first_K": self.first_K, "uniform_misfit_tolerances": self.uniform_misfit,
                 "misfit_tolerances": self.misfit}
 
 
@@ -85,9 +84,7 @@ def first_samples(run: BenchRun, channels: list[str], grid_s: np.ndarray) -> dic
     first interval: the state at the start (a median over the interval would blur it where
     the coolant acts within the first minute, as on the peer's dev-03)."""
     out = {}
-    for c in channels:
-        if c == "P1":
-            continue
+    for c in [c for c in channels if c != "P1"]:
         t, y = run.channel(c)
         if len(t) and t[0] <= grid_s[1]:
             out[c] = float(y[0])
