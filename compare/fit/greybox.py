@@ -18,21 +18,21 @@ import numpy as np
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.effects.base import CHANNELS
 from compare.fit.params import EXTRA_BASE_PARAMS, PREHISTORY, Param, base_params
-from lumped.blocks import Convection, FixedTemperature, varies_with_speed
+from lumped.blocks import Convection, FixedTemperature, conductance_at, varies_with_speed
 from lumped.build import build_network
 from lumped.simulation import LumpedModel
 from spindle.bench_inputs import Inputs, interval_heat_W
 from spindle.drive import Drive
 from spindle.errors import InputError
-from spindle.spec import Spec
+from spindle.spec import ContactLink, Spec
 from spindle.streaming import modal_recursion
+from spindle.stretch import stretch_axially
 
 ROTATING = ("shaft", "tool", "rotor")
-#: the base parameters that change the conductance matrix K (an effect declares its own)
-_K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact", "heat_capacity",
-             "axial_scale", "G_seat_W_K")
 #: the parameters that scale a group of the network's edges (films, contacts)
 _GROUPS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact")
+#: the base parameters that change the conductance matrix K (an effect declares its own)
+_K_PARAMS = (*_GROUPS, "heat_capacity", "axial_scale", "G_seat_W_K")
 
 
 def _geometric(x: np.ndarray, floor: float, rel: float) -> np.ndarray:
@@ -130,9 +130,7 @@ class GreyBox:
         if self.inputs.prehistory_s > 0:  # a moved start (compare.fit.start)
             out[PREHISTORY.name] = dc_replace(PREHISTORY, default=min(max(
                 self.inputs.prehistory_s / 3600.0, PREHISTORY.lo), PREHISTORY.hi))
-        for e, _ in self._effects():
-            for p in e.params:
-                out[p.name] = p
+        out.update({p.name: p for e, _ in self._effects() for p in e.params})
         return out
 
     def full_theta(self, theta: dict[str, float]) -> dict[str, float]:
@@ -153,9 +151,8 @@ class GreyBox:
             # split here as spindle.power.motor_losses splits it: rotor = share x loss,
             # stator = loss - rotor, the same floats
             whole = self._balances(f0, friction_exponent)
-            out = dict(whole)
-            out["rotor"] = rotor_share * whole["stator"]
-            out["stator"] = whole["stator"] - out["rotor"]
+            rotor = rotor_share * whole["stator"]
+            out = {**whole, "rotor": rotor, "stator": whole["stator"] - rotor}
             srcs = [k2 for k2 in self._cache if isinstance(k2, tuple) and k2[:1] == ("src",)
                     and k2[1] != "balances"]
             for k2 in srcs[:-7]:  # keep the last few: a Jacobian visits f0 and the split
@@ -178,11 +175,11 @@ class GreyBox:
                 # the number of distinct operating points (power-balance calls) small
                 k = (round(float(n), 3), round(float(M), 2),
                      None if np.isnan(P) else round(float(P), 2))
-                if k not in memo:  # P unknown (nan): the motor model gives the losses
-                    if k[2] is None:
-                        memo[k] = d.heat_W(k[0], k[1], None)
-                    else:  # measured P: standstill and P < P_mech handled as the bench does
-                        memo[k] = interval_heat_W(d, k[0], k[1], k[2])[0]
+                # P unknown (nan): the motor model gives the losses; measured P: standstill
+                # and P < P_mech handled as the bench does
+                if k not in memo:
+                    memo[k] = (d.heat_W(k[0], k[1], None) if k[2] is None
+                               else interval_heat_W(d, k[0], k[1], k[2])[0])
                 rows.append(memo[k])
             old = [k2 for k2 in self._cache if isinstance(k2, tuple)
                    and k2[:2] == ("src", "balances")]
@@ -199,9 +196,7 @@ class GreyBox:
         if key in self._cache:
             return self._cache[key]
         effects = self._effects()
-        options: dict = {}
-        for e, _ in effects:
-            options.update(e.network_options())
+        options = {k: v for e, _ in effects for k, v in e.network_options().items()}
         net = build_network(self.spec, self.nodes, **options)
         handles = {e.name: e.extend_network(net, self.spec, self.power_measured)
                    for e, _ in effects}
@@ -274,21 +269,17 @@ class GreyBox:
     def _model(self, theta: dict[str, float]) -> LumpedModel:
         """The structure's model with this parameter set's conductances (a new
         ThermalSystem over the same network; nothing is rebuilt)."""
-
         model, edge_group, handles = self._structure()
         base = model.system
-        effects = self._effects()
-        for e, _ in effects:
-            e.configure(handles[e.name], theta)
         owned: dict[str, float] = {}
-        for e, _ in effects:
+        for e, _ in self._effects():
+            e.configure(handles[e.name], theta)
             owned.update(e.edge_conductances(theta))
         # systems (and their cached modes) are kept per set of the parameters that enter the
         # matrices: a Jacobian column for a source or read-out parameter reuses them (the
         # effects' flows, shared by the systems, were configured for these values above)
-        k_names = self.matrix_params()
         kkey = ("system", self.nodes, self.effects, self._seats,
-                *(float(theta.get(k, 0.0)) for k in k_names))  # exact, as in sources
+                *(float(theta.get(k, 0.0)) for k in self.matrix_params()))  # exact, as in sources
         system = self._cache.get(kkey)
         if system is None:
             systems = [k for k in self._cache if isinstance(k, tuple) and k[:1] == ("system",)]
@@ -298,18 +289,16 @@ class GreyBox:
             scale = theta.get("axial_scale", 1.0)
             edge_exp, cap_exp = (self._stretch()[0][scale > 1.0] if scale != 1.0
                                  else (np.zeros(len(base.edges)), np.zeros(len(base.capacity))))
-            memo_key = ("conductance_memos", self.nodes, self.effects, self._seats)
-            if memo_key not in self._cache:  # one memo per edge, made once per structure
-                self._cache[memo_key] = [{} for _ in base.edges]
-            memos = self._cache[memo_key]
+            # one memo per edge, made once per structure
+            memos = self._cache.setdefault(("conductance_memos", self.nodes, self.effects,
+                                            self._seats), [{} for _ in base.edges])
             edges = []
             for k, (i, j, G, name) in enumerate(base.edges):
                 g = edge_group[k]
                 factor = (theta[g] if g is not None else 1.0) * scale ** edge_exp[k]
                 if factor != 1.0 or varies_with_speed(G):
                     G = _scaled(G, factor, memos[k])
-                if name in owned:
-                    G = owned[name]
+                G = owned.get(name, G)
                 if name.startswith("seat:"):
                     G = theta.get("G_seat_W_K", 0.0)
                 edges.append((i, j, G, name))
@@ -385,7 +374,6 @@ class GreyBox:
         sys = model.system
         inp = self.inputs
         n_int = len(inp.grid_s) - 1
-        effects = self._effects()
         U = self._input_matrix(th, sys)
         m = len(sys.source_names)
         n_K = self.conductance_speeds()
@@ -396,7 +384,7 @@ class GreyBox:
         has_p1 = "P1" in model.chain.rows
         if has_p1:
             rows.append(model.chain.rows["P1"])
-        extra = dict(extra_rows or {})
+        extra = extra_rows or {}
         rows.extend(extra.values())
         readout = np.array(rows)
         Y = np.empty((n_int + 1, len(rows)))
@@ -422,15 +410,13 @@ class GreyBox:
                     x = Phi @ x + Gam @ U[i]
                     Y[i + 1] = readout @ x
         out: dict[str, np.ndarray] = {n: Y[:, i] for i, n in enumerate(names)}
-        if extra:
-            out.update({n: Y[:, len(rows) - len(extra) + i] for i, n in enumerate(extra)})
-            Y = Y[:, :len(rows) - len(extra)]
+        out.update({n: Y[:, len(rows) - len(extra) + i] for i, n in enumerate(extra)})
         if has_p1:
-            out["P1"] = self._p1(th, Y[:, -1])
+            out["P1"] = self._p1(th, Y[:, len(names)])
         for c, d in (self.discrepancy or {}).items():
             if c in out:  # before a sensor's lag: a lagging sensor lags the whole signal
                 out[c] = out[c] + d
-        for e, channel in effects:
+        for e, channel in self._effects():
             out = e.as_measured(out, th, inp, channel)
         if "P1" in out and self.p1_reference_s is not None:
             out["P1"] = out["P1"] - np.interp(self.p1_reference_s, inp.grid_s, out["P1"])
@@ -451,8 +437,6 @@ def stretch_exponents(spec: Spec, nodes: int
     its inverse), the exponents e, per edge name and per block label, with which the plain
     network's conductances and capacities change from ``spec`` to the stretched spec (value
     ratio = factor^e), and the P1 chain's (its largest row entry's)."""
-    from lumped.blocks import conductance_at
-    from spindle.stretch import stretch_axially
 
     def plain(sp: Spec) -> LumpedModel:
         return LumpedModel(sp, network=build_network(sp, nodes))
@@ -476,12 +460,10 @@ def stretch_exponents(spec: Spec, nodes: int
         for (_, _, Ga, name), (_, _, Gb, _) in zip(ea, eb, strict=True):
             ga, gb = conductance_at(Ga, _STRETCH_RPM), conductance_at(Gb, _STRETCH_RPM)
             edge[name] = float(np.log(gb / ga) / log_f) if ga > 0 and gb > 0 else 0.0
-        cap = {}
-        for labs, ca, cb in zip(a.system.labels, a.system.capacity, b.system.capacity,
-                                strict=True):
-            if ca > 0 and cb > 0:
-                for lab in labs:
-                    cap[lab] = float(np.log(cb / ca) / log_f)
+        cap = {lab: float(np.log(cb / ca) / log_f)
+               for labs, ca, cb in zip(a.system.labels, a.system.capacity, b.system.capacity,
+                                       strict=True)
+               if ca > 0 and cb > 0 for lab in labs}
         chain = 0.0
         if "P1" in a.chain.rows:
             ra, rb = a.chain.rows["P1"], b.chain.rows["P1"]
@@ -525,8 +507,6 @@ def _edge_parts(block_name: str) -> set[str]:
 
 
 def _is_contact_link(spec: Spec, block_name: str) -> bool:
-    from spindle.spec import ContactLink
-
     parts = _edge_parts(block_name)
     return any(isinstance(lk, ContactLink) and set(lk.parts) == parts for lk in spec.links)
 
@@ -535,12 +515,12 @@ def _touches_stator(spec: Spec, block_name: str) -> bool:
     return any(spec.part(p).role == "stator" for p in _edge_parts(block_name))
 
 
-def _scaled(G, factor: float, memo: dict[float, float] | None = None):
+def _scaled(G, factor: float, memo: dict[float, float]):
     """``factor`` times the conductance G [W/K]; a G that varies with speed is read once per
     speed into ``memo`` (shared by every parameter set's system, as G is), so a new set of
     films costs a product, not the film correlation, at each of the run's speed levels."""
     if callable(G) and not isinstance(G, int | float):
-        return _Scaled(G, factor, {} if memo is None else memo)
+        return _Scaled(G, factor, memo)
     return float(G) * factor
 
 
@@ -553,8 +533,6 @@ class _Scaled:
     memo: dict[float, float] = field(compare=False, repr=False)
 
     def __call__(self, speed_rpm: float) -> float:
-        from lumped.blocks import conductance_at
-
         g = self.memo.get(speed_rpm)
         if g is None:
             g = self.memo[speed_rpm] = conductance_at(self.G, speed_rpm)
