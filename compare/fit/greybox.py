@@ -210,15 +210,7 @@ class GreyBox:
                     net.network.connect(c.port_b, cool_port)
         model = LumpedModel(self.spec, network=net)
         groups = film_groups(self.spec)
-        edge_group: list[str | None] = []
-        for _, _, _, name in model.system.edges:
-            if name.startswith("film:"):
-                edge_group.append(groups[name.split(":")[1]])
-            elif name.startswith("contact:") and _is_contact_link(self.spec, name):
-                edge_group.append("stator_contact" if _touches_stator(self.spec, name)
-                                  else "contact")
-            else:
-                edge_group.append(None)
+        edge_group = [_edge_group(self.spec, groups, e[3]) for e in model.system.edges]
         self._cache[key] = (model, edge_group, handles)
         return self._cache[key]
 
@@ -334,16 +326,14 @@ class GreyBox:
         """The state at grid[0] [K]: uniform at the inputs' start temperature, then the first
         interval's inputs ``u0`` (at ``speed_rpm``) held for ``prehistory_s`` [s], exact."""
         inp = self.inputs
-        x = np.full(sys.n_states, inp.T_start_K if inp.T_start_K is not None
-                    else inp.T_env_K[0])
+        x = np.full(sys.n_states, inp.T_start_K if inp.T_start_K is not None else inp.T_env_K[0])
         if prehistory_s <= 0:
             return x
         modal = None if sys.temperature_dependent else sys.modes(prehistory_s, speed_rpm)
         if modal is not None:
             a, Bm, to_modal, from_modal = modal
             return from_modal @ (a * (to_modal @ x) + Bm @ u0)
-        Phi, Gam = sys.discretize(prehistory_s, speed_rpm,
-                                  self._binned(u0[:len(sys.source_names)]))
+        Phi, Gam = sys.discretize(prehistory_s, speed_rpm, self._binned(u0[:len(sys.source_names)]))
         return Phi @ x + Gam @ u0
 
     def start_readings(self, theta: dict[str, float]):
@@ -391,13 +381,11 @@ class GreyBox:
         Y[0] = readout @ x
         dts = np.diff(inp.grid_s)
         # runs of equal (dt, speed): one set of modes and one modal recursion each
-        first = np.flatnonzero(np.r_[True, (dts[1:] != dts[:-1]) | (n_K[1:] != n_K[:-1])]
-                               )[:n_int]
+        first = np.flatnonzero(np.r_[True, (dts[1:] != dts[:-1]) | (n_K[1:] != n_K[:-1])])[:n_int]
         sys.prepare_modes(dts[first], n_K[first])
         bounds = [*first.tolist(), n_int]
         for k, j in zip(bounds[:-1], bounds[1:], strict=True):
-            modal = None if sys.temperature_dependent else sys.modes(float(dts[k]),
-                                                                      float(n_K[k]))
+            modal = None if sys.temperature_dependent else sys.modes(float(dts[k]), float(n_K[k]))
             if modal is not None:
                 a, Bm, to_modal, from_modal = modal
                 Yseg, z = modal_recursion(a, Bm, U[k:j], to_modal @ x, readout @ from_modal)
@@ -405,8 +393,7 @@ class GreyBox:
                 x = from_modal @ z
             else:  # a feedback of the heat on temperatures: its heat enters the matrices
                 for i in range(k, j):
-                    Phi, Gam = sys.discretize(float(dts[i]), float(n_K[i]),
-                                              self._binned(U[i, :m]))
+                    Phi, Gam = sys.discretize(float(dts[i]), float(n_K[i]), self._binned(U[i, :m]))
                     x = Phi @ x + Gam @ U[i]
                     Y[i + 1] = readout @ x
         out: dict[str, np.ndarray] = {n: Y[:, i] for i, n in enumerate(names)}
@@ -468,8 +455,7 @@ def stretch_exponents(spec: Spec, nodes: int
         if "P1" in a.chain.rows:
             ra, rb = a.chain.rows["P1"], b.chain.rows["P1"]
             k = int(np.argmax(np.abs(ra)))
-            chain = (float(np.log(rb[k] / ra[k]) / log_f) if ra[k] != 0 and rb[k] != 0
-                     else 0.0)
+            chain = float(np.log(rb[k] / ra[k]) / log_f) if ra[k] != 0 and rb[k] != 0 else 0.0
         out[longer] = (edge, cap, chain)
     return out
 
@@ -489,15 +475,10 @@ def _coolant_port(net):
 def film_groups(spec: Spec) -> dict[str, str]:
     """Surface name -> its film parameter: coolant, rotating or housing air."""
     roles = {p.name: p.role for p in spec.parts}
-    out = {}
-    for s in spec.surfaces:
-        if s.T_ref == "coolant":
-            out[s.name] = "h_coolant"
-        elif any(roles[p] in ROTATING for p in s.parts):
-            out[s.name] = "h_rotating"
-        else:
-            out[s.name] = "h_air"
-    return out
+    return {s.name: ("h_coolant" if s.T_ref == "coolant"
+                     else "h_rotating" if any(roles[p] in ROTATING for p in s.parts)
+                     else "h_air")
+            for s in spec.surfaces}
 
 
 def _edge_parts(block_name: str) -> set[str]:
@@ -506,13 +487,18 @@ def _edge_parts(block_name: str) -> set[str]:
     return {a.split("[")[0].split(".")[0], b.split("[")[0].split(".")[0]}
 
 
-def _is_contact_link(spec: Spec, block_name: str) -> bool:
+def _edge_group(spec: Spec, groups: dict[str, str], block_name: str) -> str | None:
+    """The parameter that scales the edge block ``block_name``: its film's group (``groups``,
+    :func:`film_groups`), ``contact`` for a contact link or ``stator_contact`` for one that
+    touches the stator; None for any other edge."""
+    if block_name.startswith("film:"):
+        return groups[block_name.split(":")[1]]
+    if not block_name.startswith("contact:"):
+        return None
     parts = _edge_parts(block_name)
-    return any(isinstance(lk, ContactLink) and set(lk.parts) == parts for lk in spec.links)
-
-
-def _touches_stator(spec: Spec, block_name: str) -> bool:
-    return any(spec.part(p).role == "stator" for p in _edge_parts(block_name))
+    if not any(isinstance(lk, ContactLink) and set(lk.parts) == parts for lk in spec.links):
+        return None
+    return "stator_contact" if any(spec.part(p).role == "stator" for p in parts) else "contact"
 
 
 def _scaled(G, factor: float, memo: dict[float, float]):

@@ -212,8 +212,7 @@ class ModelOnsets:
         ratios = [self.ratios[channel][scale.name]]
         for tau in grid[1:]:
             y = first_order_lag(self.t_s, self.outputs[channel], tau)
-            ratios.append(onset_ratio(self.t_s, y, self.steps[scale.name], scale,
-                                      self.criteria)[0])
+            ratios.append(onset_ratio(self.t_s, y, self.steps[scale.name], scale, self.criteria)[0])
         r = np.array(ratios)
         if not np.isfinite(ratio) or ratio >= r[0]:
             return 0.0
@@ -234,8 +233,7 @@ def model_onsets(gb, theta: dict[str, float], channels, criteria, sub: int = 6) 
     out = model.simulate(theta)
     t = model.inputs.grid_s
     n_end = np.concatenate([[model.inputs.speed_rpm[0]], model.inputs.speed_rpm])
-    steps = {sc.name: speed_steps(t, n_end, criteria, sc.quiet_s)
-             for sc in criteria.onset_scales}
+    steps = {sc.name: speed_steps(t, n_end, criteria, sc.quiet_s) for sc in criteria.onset_scales}
     fits = {c: {sc.name: onset_ratio(t, out[c], steps[sc.name], sc, criteria)[:2]
                 for sc in criteria.onset_scales} for c in channels if c in out}
     ratios = {c: {k: v[0] for k, v in f.items()} for c, f in fits.items()}

@@ -275,5 +275,4 @@ def front_parameter(test: EventTest, gb, theta: dict[str, float], criteria) -> d
     k, se = through_origin(np.array(D), np.array(X), np.array(S))
     if not np.isfinite(k):
         return None
-    return {"name": FRONT, "value": max(k, 0.0),
-            "ci95": [max(k - 1.96 * se, 0.0), k + 1.96 * se]}
+    return {"name": FRONT, "value": max(k, 0.0), "ci95": [max(k - 1.96 * se, 0.0), k + 1.96 * se]}
