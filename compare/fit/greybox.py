@@ -116,8 +116,7 @@ class GreyBox:
         link them to (G_seat_W_K). None on a water-cooled spec with every group."""
         key = ("inert", self.nodes)
         if key not in self._cache:
-            plain = GreyBox(self.spec, self.drive, self.inputs, self.nodes, _cache=self._cache)
-            inert = set(_GROUPS) - set(plain._structure()[1])
+            inert = set(_GROUPS) - set(self.plain()._structure()[1])
             if not self.spec.liquid_cooled:
                 inert.add("G_seat_W_K")
             self._cache[key] = frozenset(inert)

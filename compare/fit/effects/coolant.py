@@ -137,10 +137,9 @@ def load_response_test(run, gb, theta: dict[str, float], criteria) -> EventTest:
     base = gb.simulate(theta)
     probe = gb.variant(tuple(dict.fromkeys((*gb.effects, name))))
     r_probe = criteria.load_probe_R_K_W
-    with_r = probe.simulate({**theta, "R_adv_K_W": r_probe})
-    # the nuisance path: the rotor's share of the loss, raised by 10 %
-    cols = [(with_r, r_probe), (gb.simulate({**theta, "rotor_share": theta["rotor_share"] * 1.1}),
-                                0.1)]
+    cols = [(probe.simulate({**theta, "R_adv_K_W": r_probe}), r_probe),
+            # the nuisance path: the rotor's share of the loss, raised by 10 %
+            (gb.simulate({**theta, "rotor_share": theta["rotor_share"] * 1.1}), 0.1)]
     sens = {c: np.column_stack([(w[c] - base[c]) / d for w, d in cols]) for c in channels}
     blocks = []  # (residual, regressors, plateau start) of each block
     for a, b in plats:
