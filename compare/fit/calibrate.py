@@ -111,24 +111,16 @@ class Measured:
 
 # ---------------------------------------------------------------------- scaling of parameters
 def _to_z(p: Param, v: float) -> float:
-    if p.log:
-        return math.log(v)
-    return (v - p.lo) / (p.hi - p.lo)
+    return math.log(v) if p.log else (v - p.lo) / (p.hi - p.lo)
 
 
 def _from_z(p: Param, z: float) -> float:
-    if p.log:
-        return math.exp(z)
-    return p.lo + z * (p.hi - p.lo)
-
-
-def _bounds_z(p: Param) -> tuple[float, float]:
-    return (_to_z(p, p.lo), _to_z(p, p.hi))
+    return math.exp(z) if p.log else p.lo + z * (p.hi - p.lo)
 
 
 def z_bounds(params: Sequence[Param]) -> tuple[np.ndarray, np.ndarray]:
     """(lower, upper) bounds of ``params`` on their fitted scale."""
-    b = np.array([_bounds_z(p) for p in params], dtype=float).reshape(-1, 2)
+    b = np.array([(_to_z(p, p.lo), _to_z(p, p.hi)) for p in params], dtype=float).reshape(-1, 2)
     return b[:, 0], b[:, 1]
 
 
@@ -173,8 +165,7 @@ class Fit:
 
     def validation_score(self) -> float:
         """Weighted RMS over the validation window (tolerance units)."""
-        v = self.errors["validation"]
-        vals = [v[c]["rmse_w"] for c in v if v[c]["n"] > 0]
+        vals = [e["rmse_w"] for e in self.errors["validation"].values() if e["n"] > 0]
         return float(np.sqrt(np.mean(np.square(vals)))) if vals else math.nan
 
 
@@ -201,9 +192,8 @@ class Calibrator:
     workers: int = 1
 
     def set_floor(self, fit: Fit) -> None:
-        """The floor from the noise of ``fit``'s residual, estimated from its second
-        differences (var(d2 r) = 6 sigma^2 for white noise; the smooth model-form part hardly
-        enters them)."""
+        """The floor from the noise of ``fit``'s residual, estimated from its second differences
+        (var(d2 r) = 6 sigma^2 for white noise; the smooth model-form part hardly enters them)."""
         self.floor = {c: float(np.sqrt(np.var(np.diff(r, 2)) / 6.0)) if len(r) > 3 else 0.0
                       for c, r in self.residuals(fit.model, "all").items()}
 
@@ -236,12 +226,9 @@ class Calibrator:
 
     def _prior_terms(self, params: dict[str, Param], free: Sequence[str],
                      z: np.ndarray) -> np.ndarray:
-        out = []
-        for k, v in zip(free, z, strict=True):
-            p = params[k]
-            if self.prior and p.prior_sd and k in self.prior:
-                out.append((v - _to_z(p, self.prior[k])) / p.prior_sd)
-        return np.asarray(out)
+        return np.asarray([(v - _to_z(params[k], self.prior[k])) / params[k].prior_sd
+                           for k, v in zip(free, z, strict=True)
+                           if self.prior and params[k].prior_sd and k in self.prior])
 
     def residuals(self, out: dict[str, np.ndarray], window: str) -> dict[str, np.ndarray]:
         """Measured minus ``out`` per channel on ``window``'s samples [tolerances]."""
@@ -250,17 +237,13 @@ class Calibrator:
                 for c, m in masks.items()}
 
     def errors(self, out: dict[str, np.ndarray]) -> dict[str, dict[str, dict[str, float]]]:
-        errs: dict[str, dict[str, dict[str, float]]] = {}
-        for window in ("fit", "validation"):
-            errs[window] = {}
+        errs: dict[str, dict[str, dict[str, float]]] = {"fit": {}, "validation": {}}
+        for window, rows in errs.items():
             for c in self.channels:
                 m = self.measured.mask(c, window)
                 d = self.measured.values[c][m] - out[c][m]
-                if len(d) == 0:
-                    errs[window][c] = {"n": 0}
-                    continue
-                errs[window][c] = {**error_row(c, d),
-                                   "rmse_w": float(np.sqrt(np.mean(d * d)) / TOLERANCE[c])}
+                rows[c] = {"n": 0} if len(d) == 0 else {
+                    **error_row(c, d), "rmse_w": float(np.sqrt(np.mean(d * d)) / TOLERANCE[c])}
         return errs
 
     def fit(self, effects: tuple[str, ...] = (), free: Sequence[str] | None = None,
@@ -277,9 +260,8 @@ class Calibrator:
         for k in free:  # keep the start strictly inside the bounds
             p = params[k]
             theta[k] = min(max(theta[k], p.lo + 1e-9 * (p.hi - p.lo)), p.hi)
-        z0 = np.array([_to_z(params[k], theta[k]) for k in free])
         lo, hi = z_bounds([params[k] for k in free])
-        z0 = np.clip(z0, lo, hi)
+        z0 = np.clip(np.array([_to_z(params[k], theta[k]) for k in free]), lo, hi)
         nfev = 0
 
         def vec(z: np.ndarray) -> np.ndarray:
@@ -347,12 +329,12 @@ def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[st
     for i, k in enumerate(free):
         pr = params[k]
         lo_z, hi_z = z[i] - 1.96 * sd[i], z[i] + 1.96 * sd[i]
-        b_lo, b_hi = _bounds_z(pr)
+        b_lo, b_hi = _to_z(pr, pr.lo), _to_z(pr, pr.hi)
         ci[k] = (_from_z(pr, max(lo_z, b_lo)), _from_z(pr, min(hi_z, b_hi)))
         ident[k] = bool(np.isfinite(sd[i]) and 3.92 * sd[i] < (b_hi - b_lo))
         if ident[k] or p < 2 or not np.isfinite(sd[i]):
             continue
-        rho = np.nan_to_num(corr[i].copy())
+        rho = np.nan_to_num(corr[i])  # a copy
         rho[i] = 0.0
         j = int(np.argmax(np.abs(rho)))
         if 3.92 * sd[i] * np.sqrt(max(1.0 - rho[j] ** 2, 0.0)) < (b_hi - b_lo):
@@ -365,29 +347,22 @@ def _intervals(J: np.ndarray, r: np.ndarray, n: int, n_eff: float, free: list[st
 def at_bound(fit: Fit, effect_label: str, rel: float) -> list[str]:
     """The parameters of the effect ``effect_label`` whose calibrated value lies on the bound
     of its range away from the neutral value (within ``rel`` of the range)."""
-    out = []
-    for p in effect_of(effect_label).params:
-        v, tol = fit.theta[p.name], rel * (p.hi - p.lo)
-        if (p.hi != p.default and v >= p.hi - tol) or (p.lo != p.default and v <= p.lo + tol):
-            out.append(p.name)
-    return out
+    return [p.name for p in effect_of(effect_label).params
+            if (p.hi != p.default and fit.theta[p.name] >= p.hi - rel * (p.hi - p.lo))
+            or (p.lo != p.default and fit.theta[p.name] <= p.lo + rel * (p.hi - p.lo))]
 
 
 def parameters_table(fit: Fit) -> list[dict]:
     params = {**BASE_PARAMS, **EXTRA_BASE_PARAMS, PREHISTORY.name: PREHISTORY,
               **{p.name: p for e in LIBRARY.values() for p in e.params}}
-    rows = []
-    for k in fit.free:
-        p = params[k]
-        rows.append({"name": k, "unit": p.unit, "value": fit.theta[k],
-                     "ci95": list(fit.ci95[k]), "identifiable": fit.identifiable[k],
-                     "meaning": p.doc, "source": p.source})
-    return rows
+    return [{"name": k, "unit": params[k].unit, "value": fit.theta[k], "ci95": list(fit.ci95[k]),
+             "identifiable": fit.identifiable[k], "meaning": params[k].doc,
+             "source": params[k].source} for k in fit.free]
 
 
 def error_row(channel: str, d: np.ndarray) -> dict:
     """rmse, max, bias (channel unit at the edges: K or um) and within_tolerance of
-    differences ``d`` [SI]; the errors of Calibrator.errors and of cross_validate."""
+    differences ``d`` [SI]; the errors of Calibrator.errors and Local.cross_validation_report."""
     scale, unit = edge_scale(channel), edge_unit(channel, ascii=True)
     return {"rmse": float(np.sqrt(np.mean(d * d)) * scale),
             "max": float(np.max(np.abs(d)) * scale), "bias": float(np.mean(d) * scale),

@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from compare.fit.calibrate import block_index
+from compare.fit.calibrate import TOLERANCE, block_index
 from compare.fit.effects import Effect, hypothesis
 from compare.fit.effects.base import spread_heat
 from compare.fit.params import Param
@@ -41,13 +41,6 @@ NAME = "something_else"
 Q_MAX_W = 2000.0
 #: largest offset [tolerances]: ten tolerances, beyond which a sensor is broken, not off
 D_MAX_TOL = 10.0
-
-
-def _window(inputs, t0_s: float, t1_s: float) -> np.ndarray:
-    """1 on the intervals of ``inputs`` whose middle lies in [t0, t1), else 0."""
-    g = inputs.grid_s
-    mid = 0.5 * (g[1:] + g[:-1])
-    return ((mid >= t0_s) & (mid < t1_s)).astype(float)
 
 
 class WindowHeat(Effect):
@@ -68,7 +61,11 @@ class WindowHeat(Effect):
         spread_heat(net, part.masses, NAME, f"source:{NAME}")
 
     def heat(self, sources_W, theta, inputs):
-        return {**sources_W, NAME: theta["q_else_W"] * _window(inputs, self.t0_s, self.t1_s)}
+        # the heat flows on the grid's intervals whose middle lies in [t0, t1)
+        g = inputs.grid_s
+        mid = 0.5 * (g[1:] + g[:-1])
+        on = ((mid >= self.t0_s) & (mid < self.t1_s)).astype(float)
+        return {**sources_W, NAME: theta["q_else_W"] * on}
 
 
 @dataclass(frozen=True)
@@ -76,8 +73,7 @@ class Hypothesis:
     """One hypothesis of the scan: kind ("heat" or "offset"), where (a role or a channel), the
     window [s], its amplitude (W, or tolerances) and the likelihood it adds (the concentrated
     log-likelihood gain over the model it was scanned on, counted in effective samples), the
-    largest change it makes in a channel [tolerances], and how many hypotheses the scan
-    tried."""
+    largest change it makes in a channel [tolerances], and how many hypotheses the scan tried."""
 
     kind: str
     where: str
@@ -95,11 +91,6 @@ class Hypothesis:
         return f"{self.where} off by {self.amplitude:+.2f} tolerances, {span}"
 
 
-def _roles(spec, criteria) -> list[str]:
-    have = {p.role for p in spec.parts}
-    return [r for r in criteria.competitor_masses if r in have]
-
-
 def block_edges(grid_s: np.ndarray, step_s: float) -> np.ndarray:
     """The edges [s] of the scan's blocks over the run."""
     t0, t1 = float(grid_s[0]), float(grid_s[-1])
@@ -114,16 +105,14 @@ def block_responses(gb, theta: dict[str, float], effects: tuple[str, ...], role:
     ``theta`` (linear in the heat: the model with the block's heat minus the model without)."""
     probe = WindowHeat(role, 0.0, 0.0)  # an empty window until each block's is set below
     probe.name = f"{NAME}[probe {role}]"
-    lab = hypothesis(probe)
-    model = gb.variant((*effects, lab))
+    model = gb.variant((*effects, hypothesis(probe)))
     th = {**theta, "q_else_W": 1.0}
     base = model.simulate(th)
     out = np.empty((len(edges) - 1, len(channels), len(gb.inputs.grid_s)))
     for b in range(len(edges) - 1):
         probe.t0_s, probe.t1_s = edges[b], edges[b + 1]
         y = model.simulate(th)
-        for j, c in enumerate(channels):
-            out[b, j] = y[c] - base[c]
+        out[b] = [y[c] - base[c] for c in channels]
     return out
 
 
@@ -140,8 +129,7 @@ class Regressors:
     def column(self, h: Hypothesis) -> np.ndarray:
         """The hypothesis's column: its table's blocks from the one starting at t0 to the one
         ending at t1 (the window the scan fitted), summed."""
-        a = int(np.searchsorted(self.edges, h.t0_s - 1e-6))
-        b = int(np.searchsorted(self.edges, h.t1_s - 1e-6))
+        a, b = np.searchsorted(self.edges, [h.t0_s - 1e-6, h.t1_s - 1e-6])
         table = self.heat[h.where] if h.kind == "heat" else self.offset[h.where]
         return table[:, a:b].sum(axis=1)
 
@@ -151,59 +139,51 @@ def regressors(cal, fit, criteria) -> Regressors:
     responses are computed once per calibrator (at the first fit asked: the base), as the
     linearization's other columns hold the base parameters fixed."""
     from compare.fit.linear import residual_rows
-    from spindle.tolerances import channel_tolerance
 
-    memo = cal.memo.get("competitor")
-    if memo is not None:
-        return memo
+    if "competitor" in cal.memo:
+        return cal.memo["competitor"]
     channels = list(cal.channels)
     _, ch, pt, _ = residual_rows(cal, fit.model)
     edges = block_edges(cal.measured.grid_s, criteria.competitor_step_s)
-    tol = np.array([channel_tolerance(c) for c in channels])
+    tol = np.array([TOLERANCE[c] for c in channels])
+    roles = {p.role for p in cal.gb.spec.parts}
     heat = {}
-    for role in _roles(cal.gb.spec, criteria):
+    for role in (r for r in criteria.competitor_masses if r in roles):
         resp = block_responses(cal.gb, fit.theta, fit.effects, role, edges, channels)
         # the residual falls by the response: measured minus model
         heat[role] = -(resp[:, ch, pt] / tol[ch]).T
-    g = cal.measured.grid_s
-    block = block_index(edges, g[pt])
-    offset = {}
-    for j, c in enumerate(channels):
-        cols = np.zeros((len(pt), len(edges) - 1))
-        m = ch == j
-        cols[np.flatnonzero(m), block[m]] = -1.0
-        offset[c] = cols
-    reg = Regressors(edges, heat, offset)
-    cal.memo["competitor"] = reg
-    return reg
+    # an offset's column: -1 on its channel's rows in the block (the residual falls by it)
+    in_block = block_index(edges, cal.measured.grid_s[pt])[:, None] == np.arange(len(edges) - 1)
+    offset = {c: np.where((ch == j)[:, None] & in_block, -1.0, 0.0)
+              for j, c in enumerate(channels)}
+    cal.memo["competitor"] = Regressors(edges, heat, offset)
+    return cal.memo["competitor"]
 
 
-def _window_gram(X: np.ndarray, channel: np.ndarray, rows: np.ndarray, chans: np.ndarray,
-                 i_lo: np.ndarray, i_hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _window_gram(X: np.ndarray, masks: list[np.ndarray], i_lo: np.ndarray,
+                 i_hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """What the window fits of the column table ``X`` (rows, blocks) need of the table alone,
-    whatever the residual: each channel's row count over ``rows`` and each window's sum of
-    squares per channel, (windows, channels)."""
-    n = np.array([np.sum(rows & (channel == c)) for c in chans], dtype=float)
-    gram = np.empty((X.shape[1], X.shape[1], len(chans)))
-    for j, c in enumerate(chans):
-        m = rows & (channel == c)
+    whatever the residual: each channel's row count (``masks``: its rows, a boolean mask per
+    channel) and each window's sum of squares per channel, (windows, channels)."""
+    n = np.array([np.sum(m) for m in masks], dtype=float)
+    gram = np.empty((X.shape[1], X.shape[1], len(masks)))
+    for j, m in enumerate(masks):
         gram[:, :, j] = X[m].T @ X[m]
     C = np.pad(np.cumsum(np.cumsum(gram, axis=0), axis=1), ((1, 0), (1, 0), (0, 0)))
     return n, C[i_hi + 1, i_hi + 1] - C[i_lo, i_hi + 1] - C[i_hi + 1, i_lo] + C[i_lo, i_lo]
 
 
-def _window_fits(X: np.ndarray, R: np.ndarray, channel: np.ndarray, rows: np.ndarray,
-                 chans: np.ndarray, i_lo: np.ndarray, i_hi: np.ndarray,
-                 gram: tuple[np.ndarray, np.ndarray] | None = None):
+def _window_fits(X: np.ndarray, R: np.ndarray, masks: list[np.ndarray], i_lo: np.ndarray,
+                 i_hi: np.ndarray, gram: tuple[np.ndarray, np.ndarray] | None = None):
     """Every window [block i_lo, block i_hi] of the column table ``X`` (rows, blocks) fitted
-    alone by weighted least squares to each residual column of ``R`` (rows, draws): its
-    concentrated log-likelihood gain and its amplitude, each (windows, draws). ``gram``: the
-    table's :func:`_window_gram`, where it was computed once for many calls."""
-    n, den_w = gram if gram is not None else _window_gram(X, channel, rows, chans, i_lo, i_hi)
-    num = np.empty((X.shape[1], len(chans), R.shape[1]))
-    rss0 = np.empty((len(chans), R.shape[1]))
-    for j, c in enumerate(chans):
-        m = rows & (channel == c)
+    alone by weighted least squares to each residual column of ``R`` (rows, draws) over each
+    channel's rows (``masks``): its concentrated log-likelihood gain and its amplitude, each
+    (windows, draws). ``gram``: the table's :func:`_window_gram`, where it was computed once
+    for many calls."""
+    n, den_w = gram if gram is not None else _window_gram(X, masks, i_lo, i_hi)
+    num = np.empty((X.shape[1], len(masks), R.shape[1]))
+    rss0 = np.empty((len(masks), R.shape[1]))
+    for j, m in enumerate(masks):
         num[:, j] = X[m].T @ R[m]
         rss0[j] = np.sum(R[m] ** 2, axis=0)
     rss0 = np.maximum(rss0, 1e-300)
@@ -231,11 +211,11 @@ def scan(reg: Regressors, r: np.ndarray, channel: np.ndarray, rows: np.ndarray,
     linear least squares, its gain the concentrated log-likelihood gain per channel times
     ``shrink``, the effective samples' share), and how many hypotheses were tried."""
     i_lo, i_hi = np.triu_indices(len(reg.edges) - 1)
-    chans = np.unique(channel[rows])
+    masks = [rows & (channel == c) for c in np.unique(channel[rows])]
     found: list[Hypothesis] = []
     tried = 0
     for kind, where, X in _tables(reg):
-        gain, beta = _window_fits(X, r[:, None], channel, rows, chans, i_lo, i_hi)
+        gain, beta = _window_fits(X, r[:, None], masks, i_lo, i_hi)
         gain, beta = shrink * gain[:, 0], beta[:, 0]
         tried += int(np.isfinite(gain).sum())
         for k in np.argsort(-gain)[:top]:
@@ -244,9 +224,8 @@ def scan(reg: Regressors, r: np.ndarray, channel: np.ndarray, rows: np.ndarray,
             a, b = int(i_lo[k]), int(i_hi[k])
             col = X[:, a:b + 1].sum(axis=1)
             peak = float(np.max(np.abs(beta[k] * col))) if len(col) else 0.0
-            found.append(Hypothesis(kind, where, float(reg.edges[a]),
-                                    float(reg.edges[b + 1]), float(beta[k]),
-                                    float(gain[k]), peak, 0))
+            found.append(Hypothesis(kind, where, float(reg.edges[a]), float(reg.edges[b + 1]),
+                                    float(beta[k]), float(gain[k]), peak, 0))
     found.sort(key=lambda h: -h.gain)
     return [replace(h, tried=tried) for h in found[:top]], tried
 
@@ -265,16 +244,15 @@ def scan_threshold(reg: Regressors, channel: np.ndarray, rows: np.ndarray, alpha
         return math.inf
     draws = scan_null_draws(alpha, tail)
     i_lo, i_hi = np.triu_indices(len(reg.edges) - 1)
-    chans = np.unique(channel[rows])
-    tables = [(X, _window_gram(X, channel, rows, chans, i_lo, i_hi))
-              for _kind, _where, X in _tables(reg)]
+    masks = [rows & (channel == c) for c in np.unique(channel[rows])]
+    tables = [(X, _window_gram(X, masks, i_lo, i_hi)) for _kind, _where, X in _tables(reg)]
     rng = np.random.default_rng(seed)
     best = np.full(draws, -np.inf)
     for start in range(0, draws, 250):  # in chunks: the windows' table per draw is large
         noise = rng.standard_normal((len(channel), min(250, draws - start)))
         top = np.full(noise.shape[1], -np.inf)
         for X, gram in tables:
-            gain = _window_fits(X, noise, channel, rows, chans, i_lo, i_hi, gram)[0]
+            gain = _window_fits(X, noise, masks, i_lo, i_hi, gram)[0]
             top = np.maximum(top, gain.max(axis=0))
         best[start:start + noise.shape[1]] = top
     return float(2.0 * np.sort(best)[-tail])

@@ -18,21 +18,21 @@ import numpy as np
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.effects.base import CHANNELS
 from compare.fit.params import EXTRA_BASE_PARAMS, PREHISTORY, Param, base_params
-from lumped.blocks import Convection, FixedTemperature, varies_with_speed
+from lumped.blocks import Convection, FixedTemperature, conductance_at, varies_with_speed
 from lumped.build import build_network
 from lumped.simulation import LumpedModel
 from spindle.bench_inputs import Inputs, interval_heat_W
 from spindle.drive import Drive
 from spindle.errors import InputError
-from spindle.spec import Spec
+from spindle.spec import ContactLink, Spec
 from spindle.streaming import modal_recursion
+from spindle.stretch import stretch_axially
 
 ROTATING = ("shaft", "tool", "rotor")
-#: the base parameters that change the conductance matrix K (an effect declares its own)
-_K_PARAMS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact", "heat_capacity",
-             "axial_scale", "G_seat_W_K")
 #: the parameters that scale a group of the network's edges (films, contacts)
 _GROUPS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact")
+#: the base parameters that change the conductance matrix K (an effect declares its own)
+_K_PARAMS = (*_GROUPS, "heat_capacity", "axial_scale", "G_seat_W_K")
 
 
 def _geometric(x: np.ndarray, floor: float, rel: float) -> np.ndarray:
@@ -116,8 +116,7 @@ class GreyBox:
         link them to (G_seat_W_K). None on a water-cooled spec with every group."""
         key = ("inert", self.nodes)
         if key not in self._cache:
-            plain = GreyBox(self.spec, self.drive, self.inputs, self.nodes, _cache=self._cache)
-            inert = set(_GROUPS) - set(plain._structure()[1])
+            inert = set(_GROUPS) - set(self.plain()._structure()[1])
             if not self.spec.liquid_cooled:
                 inert.add("G_seat_W_K")
             self._cache[key] = frozenset(inert)
@@ -130,9 +129,7 @@ class GreyBox:
         if self.inputs.prehistory_s > 0:  # a moved start (compare.fit.start)
             out[PREHISTORY.name] = dc_replace(PREHISTORY, default=min(max(
                 self.inputs.prehistory_s / 3600.0, PREHISTORY.lo), PREHISTORY.hi))
-        for e, _ in self._effects():
-            for p in e.params:
-                out[p.name] = p
+        out.update({p.name: p for e, _ in self._effects() for p in e.params})
         return out
 
     def full_theta(self, theta: dict[str, float]) -> dict[str, float]:
@@ -153,9 +150,8 @@ class GreyBox:
             # split here as spindle.power.motor_losses splits it: rotor = share x loss,
             # stator = loss - rotor, the same floats
             whole = self._balances(f0, friction_exponent)
-            out = dict(whole)
-            out["rotor"] = rotor_share * whole["stator"]
-            out["stator"] = whole["stator"] - out["rotor"]
+            rotor = rotor_share * whole["stator"]
+            out = {**whole, "rotor": rotor, "stator": whole["stator"] - rotor}
             srcs = [k2 for k2 in self._cache if isinstance(k2, tuple) and k2[:1] == ("src",)
                     and k2[1] != "balances"]
             for k2 in srcs[:-7]:  # keep the last few: a Jacobian visits f0 and the split
@@ -178,11 +174,11 @@ class GreyBox:
                 # the number of distinct operating points (power-balance calls) small
                 k = (round(float(n), 3), round(float(M), 2),
                      None if np.isnan(P) else round(float(P), 2))
-                if k not in memo:  # P unknown (nan): the motor model gives the losses
-                    if k[2] is None:
-                        memo[k] = d.heat_W(k[0], k[1], None)
-                    else:  # measured P: standstill and P < P_mech handled as the bench does
-                        memo[k] = interval_heat_W(d, k[0], k[1], k[2])[0]
+                # P unknown (nan): the motor model gives the losses; measured P: standstill
+                # and P < P_mech handled as the bench does
+                if k not in memo:
+                    memo[k] = (d.heat_W(k[0], k[1], None) if k[2] is None
+                               else interval_heat_W(d, k[0], k[1], k[2])[0])
                 rows.append(memo[k])
             old = [k2 for k2 in self._cache if isinstance(k2, tuple)
                    and k2[:2] == ("src", "balances")]
@@ -199,9 +195,7 @@ class GreyBox:
         if key in self._cache:
             return self._cache[key]
         effects = self._effects()
-        options: dict = {}
-        for e, _ in effects:
-            options.update(e.network_options())
+        options = {k: v for e, _ in effects for k, v in e.network_options().items()}
         net = build_network(self.spec, self.nodes, **options)
         handles = {e.name: e.extend_network(net, self.spec, self.power_measured)
                    for e, _ in effects}
@@ -215,15 +209,7 @@ class GreyBox:
                     net.network.connect(c.port_b, cool_port)
         model = LumpedModel(self.spec, network=net)
         groups = film_groups(self.spec)
-        edge_group: list[str | None] = []
-        for _, _, _, name in model.system.edges:
-            if name.startswith("film:"):
-                edge_group.append(groups[name.split(":")[1]])
-            elif name.startswith("contact:") and _is_contact_link(self.spec, name):
-                edge_group.append("stator_contact" if _touches_stator(self.spec, name)
-                                  else "contact")
-            else:
-                edge_group.append(None)
+        edge_group = [_edge_group(self.spec, groups, e[3]) for e in model.system.edges]
         self._cache[key] = (model, edge_group, handles)
         return self._cache[key]
 
@@ -274,21 +260,17 @@ class GreyBox:
     def _model(self, theta: dict[str, float]) -> LumpedModel:
         """The structure's model with this parameter set's conductances (a new
         ThermalSystem over the same network; nothing is rebuilt)."""
-
         model, edge_group, handles = self._structure()
         base = model.system
-        effects = self._effects()
-        for e, _ in effects:
-            e.configure(handles[e.name], theta)
         owned: dict[str, float] = {}
-        for e, _ in effects:
+        for e, _ in self._effects():
+            e.configure(handles[e.name], theta)
             owned.update(e.edge_conductances(theta))
         # systems (and their cached modes) are kept per set of the parameters that enter the
         # matrices: a Jacobian column for a source or read-out parameter reuses them (the
         # effects' flows, shared by the systems, were configured for these values above)
-        k_names = self.matrix_params()
         kkey = ("system", self.nodes, self.effects, self._seats,
-                *(float(theta.get(k, 0.0)) for k in k_names))  # exact, as in sources
+                *(float(theta.get(k, 0.0)) for k in self.matrix_params()))  # exact, as in sources
         system = self._cache.get(kkey)
         if system is None:
             systems = [k for k in self._cache if isinstance(k, tuple) and k[:1] == ("system",)]
@@ -298,18 +280,16 @@ class GreyBox:
             scale = theta.get("axial_scale", 1.0)
             edge_exp, cap_exp = (self._stretch()[0][scale > 1.0] if scale != 1.0
                                  else (np.zeros(len(base.edges)), np.zeros(len(base.capacity))))
-            memo_key = ("conductance_memos", self.nodes, self.effects, self._seats)
-            if memo_key not in self._cache:  # one memo per edge, made once per structure
-                self._cache[memo_key] = [{} for _ in base.edges]
-            memos = self._cache[memo_key]
+            # one memo per edge, made once per structure
+            memos = self._cache.setdefault(("conductance_memos", self.nodes, self.effects,
+                                            self._seats), [{} for _ in base.edges])
             edges = []
             for k, (i, j, G, name) in enumerate(base.edges):
                 g = edge_group[k]
                 factor = (theta[g] if g is not None else 1.0) * scale ** edge_exp[k]
                 if factor != 1.0 or varies_with_speed(G):
                     G = _scaled(G, factor, memos[k])
-                if name in owned:
-                    G = owned[name]
+                G = owned.get(name, G)
                 if name.startswith("seat:"):
                     G = theta.get("G_seat_W_K", 0.0)
                 edges.append((i, j, G, name))
@@ -345,16 +325,14 @@ class GreyBox:
         """The state at grid[0] [K]: uniform at the inputs' start temperature, then the first
         interval's inputs ``u0`` (at ``speed_rpm``) held for ``prehistory_s`` [s], exact."""
         inp = self.inputs
-        x = np.full(sys.n_states, inp.T_start_K if inp.T_start_K is not None
-                    else inp.T_env_K[0])
+        x = np.full(sys.n_states, inp.T_start_K if inp.T_start_K is not None else inp.T_env_K[0])
         if prehistory_s <= 0:
             return x
         modal = None if sys.temperature_dependent else sys.modes(prehistory_s, speed_rpm)
         if modal is not None:
             a, Bm, to_modal, from_modal = modal
             return from_modal @ (a * (to_modal @ x) + Bm @ u0)
-        Phi, Gam = sys.discretize(prehistory_s, speed_rpm,
-                                  self._binned(u0[:len(sys.source_names)]))
+        Phi, Gam = sys.discretize(prehistory_s, speed_rpm, self._binned(u0[:len(sys.source_names)]))
         return Phi @ x + Gam @ u0
 
     def start_readings(self, theta: dict[str, float]):
@@ -385,7 +363,6 @@ class GreyBox:
         sys = model.system
         inp = self.inputs
         n_int = len(inp.grid_s) - 1
-        effects = self._effects()
         U = self._input_matrix(th, sys)
         m = len(sys.source_names)
         n_K = self.conductance_speeds()
@@ -396,20 +373,18 @@ class GreyBox:
         has_p1 = "P1" in model.chain.rows
         if has_p1:
             rows.append(model.chain.rows["P1"])
-        extra = dict(extra_rows or {})
+        extra = extra_rows or {}
         rows.extend(extra.values())
         readout = np.array(rows)
         Y = np.empty((n_int + 1, len(rows)))
         Y[0] = readout @ x
         dts = np.diff(inp.grid_s)
         # runs of equal (dt, speed): one set of modes and one modal recursion each
-        first = np.flatnonzero(np.r_[True, (dts[1:] != dts[:-1]) | (n_K[1:] != n_K[:-1])]
-                               )[:n_int]
+        first = np.flatnonzero(np.r_[True, (dts[1:] != dts[:-1]) | (n_K[1:] != n_K[:-1])])[:n_int]
         sys.prepare_modes(dts[first], n_K[first])
         bounds = [*first.tolist(), n_int]
         for k, j in zip(bounds[:-1], bounds[1:], strict=True):
-            modal = None if sys.temperature_dependent else sys.modes(float(dts[k]),
-                                                                      float(n_K[k]))
+            modal = None if sys.temperature_dependent else sys.modes(float(dts[k]), float(n_K[k]))
             if modal is not None:
                 a, Bm, to_modal, from_modal = modal
                 Yseg, z = modal_recursion(a, Bm, U[k:j], to_modal @ x, readout @ from_modal)
@@ -417,20 +392,17 @@ class GreyBox:
                 x = from_modal @ z
             else:  # a feedback of the heat on temperatures: its heat enters the matrices
                 for i in range(k, j):
-                    Phi, Gam = sys.discretize(float(dts[i]), float(n_K[i]),
-                                              self._binned(U[i, :m]))
+                    Phi, Gam = sys.discretize(float(dts[i]), float(n_K[i]), self._binned(U[i, :m]))
                     x = Phi @ x + Gam @ U[i]
                     Y[i + 1] = readout @ x
         out: dict[str, np.ndarray] = {n: Y[:, i] for i, n in enumerate(names)}
-        if extra:
-            out.update({n: Y[:, len(rows) - len(extra) + i] for i, n in enumerate(extra)})
-            Y = Y[:, :len(rows) - len(extra)]
+        out.update({n: Y[:, len(rows) - len(extra) + i] for i, n in enumerate(extra)})
         if has_p1:
-            out["P1"] = self._p1(th, Y[:, -1])
+            out["P1"] = self._p1(th, Y[:, len(names)])
         for c, d in (self.discrepancy or {}).items():
             if c in out:  # before a sensor's lag: a lagging sensor lags the whole signal
                 out[c] = out[c] + d
-        for e, channel in effects:
+        for e, channel in self._effects():
             out = e.as_measured(out, th, inp, channel)
         if "P1" in out and self.p1_reference_s is not None:
             out["P1"] = out["P1"] - np.interp(self.p1_reference_s, inp.grid_s, out["P1"])
@@ -451,8 +423,6 @@ def stretch_exponents(spec: Spec, nodes: int
     its inverse), the exponents e, per edge name and per block label, with which the plain
     network's conductances and capacities change from ``spec`` to the stretched spec (value
     ratio = factor^e), and the P1 chain's (its largest row entry's)."""
-    from lumped.blocks import conductance_at
-    from spindle.stretch import stretch_axially
 
     def plain(sp: Spec) -> LumpedModel:
         return LumpedModel(sp, network=build_network(sp, nodes))
@@ -476,18 +446,15 @@ def stretch_exponents(spec: Spec, nodes: int
         for (_, _, Ga, name), (_, _, Gb, _) in zip(ea, eb, strict=True):
             ga, gb = conductance_at(Ga, _STRETCH_RPM), conductance_at(Gb, _STRETCH_RPM)
             edge[name] = float(np.log(gb / ga) / log_f) if ga > 0 and gb > 0 else 0.0
-        cap = {}
-        for labs, ca, cb in zip(a.system.labels, a.system.capacity, b.system.capacity,
-                                strict=True):
-            if ca > 0 and cb > 0:
-                for lab in labs:
-                    cap[lab] = float(np.log(cb / ca) / log_f)
+        cap = {lab: float(np.log(cb / ca) / log_f)
+               for labs, ca, cb in zip(a.system.labels, a.system.capacity, b.system.capacity,
+                                       strict=True)
+               if ca > 0 and cb > 0 for lab in labs}
         chain = 0.0
         if "P1" in a.chain.rows:
             ra, rb = a.chain.rows["P1"], b.chain.rows["P1"]
             k = int(np.argmax(np.abs(ra)))
-            chain = (float(np.log(rb[k] / ra[k]) / log_f) if ra[k] != 0 and rb[k] != 0
-                     else 0.0)
+            chain = float(np.log(rb[k] / ra[k]) / log_f) if ra[k] != 0 and rb[k] != 0 else 0.0
         out[longer] = (edge, cap, chain)
     return out
 
@@ -507,15 +474,10 @@ def _coolant_port(net):
 def film_groups(spec: Spec) -> dict[str, str]:
     """Surface name -> its film parameter: coolant, rotating or housing air."""
     roles = {p.name: p.role for p in spec.parts}
-    out = {}
-    for s in spec.surfaces:
-        if s.T_ref == "coolant":
-            out[s.name] = "h_coolant"
-        elif any(roles[p] in ROTATING for p in s.parts):
-            out[s.name] = "h_rotating"
-        else:
-            out[s.name] = "h_air"
-    return out
+    return {s.name: ("h_coolant" if s.T_ref == "coolant"
+                     else "h_rotating" if any(roles[p] in ROTATING for p in s.parts)
+                     else "h_air")
+            for s in spec.surfaces}
 
 
 def _edge_parts(block_name: str) -> set[str]:
@@ -524,23 +486,26 @@ def _edge_parts(block_name: str) -> set[str]:
     return {a.split("[")[0].split(".")[0], b.split("[")[0].split(".")[0]}
 
 
-def _is_contact_link(spec: Spec, block_name: str) -> bool:
-    from spindle.spec import ContactLink
-
+def _edge_group(spec: Spec, groups: dict[str, str], block_name: str) -> str | None:
+    """The parameter that scales the edge block ``block_name``: its film's group (``groups``,
+    :func:`film_groups`), ``contact`` for a contact link or ``stator_contact`` for one that
+    touches the stator; None for any other edge."""
+    if block_name.startswith("film:"):
+        return groups[block_name.split(":")[1]]
+    if not block_name.startswith("contact:"):
+        return None
     parts = _edge_parts(block_name)
-    return any(isinstance(lk, ContactLink) and set(lk.parts) == parts for lk in spec.links)
+    if not any(isinstance(lk, ContactLink) and set(lk.parts) == parts for lk in spec.links):
+        return None
+    return "stator_contact" if any(spec.part(p).role == "stator" for p in parts) else "contact"
 
 
-def _touches_stator(spec: Spec, block_name: str) -> bool:
-    return any(spec.part(p).role == "stator" for p in _edge_parts(block_name))
-
-
-def _scaled(G, factor: float, memo: dict[float, float] | None = None):
+def _scaled(G, factor: float, memo: dict[float, float]):
     """``factor`` times the conductance G [W/K]; a G that varies with speed is read once per
     speed into ``memo`` (shared by every parameter set's system, as G is), so a new set of
     films costs a product, not the film correlation, at each of the run's speed levels."""
     if callable(G) and not isinstance(G, int | float):
-        return _Scaled(G, factor, {} if memo is None else memo)
+        return _Scaled(G, factor, memo)
     return float(G) * factor
 
 
@@ -553,8 +518,6 @@ class _Scaled:
     memo: dict[float, float] = field(compare=False, repr=False)
 
     def __call__(self, speed_rpm: float) -> float:
-        from lumped.blocks import conductance_at
-
         g = self.memo.get(speed_rpm)
         if g is None:
             g = self.memo[speed_rpm] = conductance_at(self.G, speed_rpm)

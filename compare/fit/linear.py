@@ -53,32 +53,25 @@ class Local:
     prior_rows: np.ndarray  # (free,) prior_scale / sd, 0 where no prior
     prior_z: np.ndarray  # (free,) prior centre on the fitted scale (z0 where none)
 
-    def _system(self, rows: np.ndarray, extra: np.ndarray | None):
-        A = self.J[rows]
-        if extra is not None:
-            A = np.hstack([A, extra[rows]])
-        k = A.shape[1]
-        kb = self.J.shape[1]
-        P = np.zeros((kb, k))
-        P[:, :kb] = np.diag(self.prior_rows)
-        bp = -self.prior_rows * (self.z0 - self.prior_z)
-        keep = self.prior_rows > 0
-        return np.vstack([A, P[keep]]), np.concatenate([-self.r0[rows], bp[keep]])
-
     def step(self, rows: np.ndarray, extra: np.ndarray | None = None,
              extra_bounds: Sequence[tuple[float, float]] = ()) -> np.ndarray:
         """The step over ``rows`` (boolean mask) with ``extra`` columns (rows, m) bounded by
         ``extra_bounds``: the change of the free parameters' z, then the extra amplitudes."""
         from scipy.optimize import lsq_linear
 
-        A, b = self._system(rows, extra)
+        A = self.J[rows] if extra is None else np.hstack([self.J[rows], extra[rows]])
+        keep = self.prior_rows > 0
+        # the priors' rows act on the base parameters alone, not on the extra columns
+        P = np.pad(np.diag(self.prior_rows)[keep], ((0, 0), (0, A.shape[1] - len(keep))))
+        bp = -self.prior_rows * (self.z0 - self.prior_z)
         lo = np.concatenate([self.lo - self.z0, [a for a, _ in extra_bounds]])
         hi = np.concatenate([self.hi - self.z0, [c for _, c in extra_bounds]])
         # a parameter sitting on a bound can only move inside
         lo, hi = np.minimum(lo, 0.0), np.maximum(hi, 0.0)
         if A.shape[1] == 0:
             return np.zeros(0)
-        return lsq_linear(A, b, bounds=(lo, hi), method="bvls" if A.shape[1] < 30 else "trf",
+        return lsq_linear(np.vstack([A, P]), np.concatenate([-self.r0[rows], bp[keep]]),
+                          bounds=(lo, hi), method="bvls" if A.shape[1] < 30 else "trf",
                           lsmr_tol="auto").x
 
     def residual(self, delta: np.ndarray, extra: np.ndarray | None = None) -> np.ndarray:
@@ -92,8 +85,7 @@ class Local:
     def _prior_terms(self, delta: np.ndarray) -> np.ndarray:
         """The priors' residuals after the step ``delta`` (prior_scale / sd times the distance
         from the prior centre on the fitted scale; 0 where no prior)."""
-        kb = self.J.shape[1]
-        return self.prior_rows * (self.z0 + delta[:kb] - self.prior_z)
+        return self.prior_rows * (self.z0 + delta[:len(self.z0)] - self.prior_z)
 
     def theta_after(self, delta: np.ndarray) -> dict[str, float]:
         """The parameter values of the fit with its free parameters moved by the step
@@ -123,8 +115,7 @@ class Local:
         ``delta`` against this model's own, counted in the fit's effective samples (the
         likelihood of compare.fit.calibrate)."""
         rows = self.in_fit
-        shrink = self.fit.sample_share
-        return ((self.loglik(r1, rows) - self.loglik(self.r0, rows)) * shrink
+        return ((self.loglik(r1, rows) - self.loglik(self.r0, rows)) * self.fit.sample_share
                 - (self.penalty(delta) - self.penalty(np.zeros_like(delta))))
 
     def gain(self, extra: np.ndarray | None = None,
@@ -136,10 +127,9 @@ class Local:
 
     def held_out(self, blocks: int, extra: np.ndarray | None = None,
                  extra_bounds: Sequence[tuple[float, float]] = ()) -> np.ndarray:
-        """Blocked cross-validation, one step per fold: each of ``blocks`` equal blocks of the
-        run held out, the step (with the ``extra`` columns, as :meth:`step`) fitted on the rest
-        (every window); the residual of every row where its block was held out
-        [tolerances]."""
+        """Blocked cross-validation, one step per fold: each of ``blocks`` equal blocks of the run
+        held out, the step (with the ``extra`` columns, as :meth:`step`) fitted on the rest (every
+        window); the residual of every row where its block was held out [tolerances]."""
         meas = self.cal.measured
         edges = np.linspace(meas.grid_s[0], meas.grid_s[-1], blocks + 1)
         block = block_index(edges, meas.grid_s[self.point])
@@ -155,10 +145,6 @@ class Local:
         return {c: float(np.sqrt(np.mean(held[self.channel == j] ** 2)))
                 for j, c in enumerate(self.cal.channels) if (self.channel == j).any()}
 
-    def cross_validate(self, blocks: int) -> dict[str, float]:
-        """Per channel, the RMS of the held-out residual [tolerances] (:meth:`held_out`)."""
-        return self.rms_by_channel(self.held_out(blocks))
-
     def cross_validation_report(self, blocks: int) -> dict:
         """:meth:`held_out` pooled per channel as the report shows it: RMS, max, bias (the
         channel's unit at the edges), the share within the tolerance."""
@@ -173,15 +159,12 @@ def residual_rows(cal: Calibrator, model: dict[str, np.ndarray]
     """(residual [tolerances], channel index, grid index, in the fit window) of every valid
     sample of the run, channel after channel."""
     meas = cal.measured
-    fit_points = meas.fit_points()
-    r, ch, pt, f = [], [], [], []
-    for j, c in enumerate(cal.channels):
-        idx = np.flatnonzero(meas.mask(c, "all"))
-        r.append((meas.values[c][idx] - model[c][idx]) / TOLERANCE[c])
-        ch.append(np.full(len(idx), j))
-        pt.append(idx)
-        f.append(fit_points[idx])
-    return np.concatenate(r), np.concatenate(ch), np.concatenate(pt), np.concatenate(f)
+    idx = [np.flatnonzero(meas.mask(c, "all")) for c in cal.channels]
+    r = np.concatenate([(meas.values[c][i] - model[c][i]) / TOLERANCE[c]
+                        for c, i in zip(cal.channels, idx, strict=True)])
+    ch = np.concatenate([np.full(len(i), j) for j, i in enumerate(idx)])
+    pt = np.concatenate(idx)
+    return r, ch, pt, meas.fit_points()[pt]
 
 
 def local(cal: Calibrator, fit: Fit) -> Local:
@@ -193,17 +176,14 @@ def local(cal: Calibrator, fit: Fit) -> Local:
     z0 = np.array([_to_z(params[k], fit.theta[k]) for k in free])
     lo, hi = z_bounds([params[k] for k in free])
     J = np.empty((len(r0), len(free)))
-    for i, k in enumerate(free):
-        # step inside the bounds (a parameter on its upper bound steps down)
-        h = STEP if z0[i] + STEP <= hi[i] else -STEP
-        th = dict(fit.theta)
-        th[k] = _from_z(params[k], z0[i] + h)
-        r1 = residual_rows(cal, gb.simulate(th))[0]
-        J[:, i] = (r1 - r0) / h
     prior_rows = np.zeros(len(free))
     prior_z = z0.copy()
     for i, k in enumerate(free):
         p = params[k]
+        # step inside the bounds (a parameter on its upper bound steps down)
+        h = STEP if z0[i] + STEP <= hi[i] else -STEP
+        r1 = residual_rows(cal, gb.simulate({**fit.theta, k: _from_z(p, z0[i] + h)}))[0]
+        J[:, i] = (r1 - r0) / h
         if cal.prior and p.prior_sd and k in cal.prior:
             prior_rows[i] = cal.prior_scale / p.prior_sd
             prior_z[i] = _to_z(p, cal.prior[k])
@@ -255,17 +235,14 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
     params = effect_of(label).params
     lo, hi = z_bounds(params)
     z_n = np.array([_to_z(p, p.default) for p in params])
-    z = np.array([_to_z(p, (start or {}).get(p.name, p.lo + 0.1 * (p.hi - p.lo)
-                                                 if p.lo >= 0 else 0.1 * p.hi))
-                  for p in params])
-    z = np.clip(z, lo, hi)
-    rows = loc.in_fit
+    z = np.clip([_to_z(p, (start or {}).get(p.name, p.lo + 0.1 * (p.hi - p.lo)
+                                            if p.lo >= 0 else 0.1 * p.hi))
+                 for p in params], lo, hi)
     kb = loc.J.shape[1]
 
     def at(zv: np.ndarray) -> np.ndarray:
-        th = dict(fit.theta)
-        th.update({p.name: _from_z(p, float(v)) for p, v in zip(params, zv, strict=True)})
-        return residual_rows(cal, gb.simulate(th))[0]
+        own = {p.name: _from_z(p, float(v)) for p, v in zip(params, zv, strict=True)}
+        return residual_rows(cal, gb.simulate({**fit.theta, **own}))[0]
 
     simulated: dict[bytes, np.ndarray] = {}
 
@@ -296,7 +273,7 @@ def fit_effect(loc: Local, label: str, start: dict[str, float] | None = None,
             break
         # the base parameters' step from the current model and the effect's from z
         shifted = replace(loc, r0=r_z)
-        step = shifted.step(rows, cols, list(zip(lo - z, hi - z, strict=True)))
+        step = shifted.step(loc.in_fit, cols, list(zip(lo - z, hi - z, strict=True)))
         for _ in range(30):
             z_new = np.clip(z + step[kb:], lo, hi)
             if finite(z_new):
@@ -328,7 +305,6 @@ def effect_held_out(loc: Local, ef: EffectFit, blocks: int) -> dict[str, float]:
     Gauss-Newton step per fold on the base parameters and the effect's (its columns at its
     estimate): per channel, the RMS of the held-out residual [tolerances]."""
     around = replace(loc, r0=ef.residual, z0=loc.z0 + ef.delta)
-    params = effect_of(ef.label).params
-    lo, hi = z_bounds(params)
+    lo, hi = z_bounds(effect_of(ef.label).params)
     held = around.held_out(blocks, ef.columns, list(zip(lo - ef.z, hi - ef.z, strict=True)))
     return around.rms_by_channel(held)

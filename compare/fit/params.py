@@ -28,7 +28,7 @@ own parameters are declared by the effect (compare.fit.effects).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from spindle.drive import Drive
 from spindle.drive_file import FRICTION_REF_RPM
@@ -123,14 +123,11 @@ def base_params(drive: Drive) -> dict[str, Param]:
     """:data:`BASE_PARAMS` with the spec's own values of the drive's parameters as defaults
     (prior centres): f0 of its bearing sets (when they share one; else the default stands)
     and the rotor's share of the motor loss."""
-    from dataclasses import replace as dc_replace
-
     out = dict(BASE_PARAMS)
     f0s = {float(b.f0) for b in drive.bearings.values()}
     if len(f0s) == 1:
-        out["f0"] = dc_replace(out["f0"], default=f0s.pop())
-    out["rotor_share"] = dc_replace(out["rotor_share"],
-                                    default=float(drive.motor.rotor_loss_share))
+        out["f0"] = replace(out["f0"], default=f0s.pop())
+    out["rotor_share"] = replace(out["rotor_share"], default=float(drive.motor.rotor_loss_share))
     return out
 
 

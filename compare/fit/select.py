@@ -59,9 +59,8 @@ def model_changes(criteria: Mapping[str, bool | None]) -> bool:
 
 @dataclass
 class Judgement:
-    """One candidate in one round: its refit and each named criterion's outcome (None where
-    the criterion was not asked), and the route it qualified by ("signature", "open loop")
-    or None."""
+    """One candidate in one round: its refit and each named criterion's outcome (None where the
+    criterion was not asked), and the route it qualified by ("signature", "open loop") or None."""
 
     label: str
     round: int
@@ -79,13 +78,11 @@ class Judgement:
         # withdrawn after the selection, its gain the null's shortfall, or short of what
         # both routes ask
         if (c.get("final_model_adequate") is False or c.get("null_at_optimum") is False
-                or not c["material"]
-                or c["signature"] is False or not c["significant"]):
+                or not c["material"] or c["signature"] is False or not c["significant"]):
             return None
         if c["signature"]:
             return "signature"
-        return ("open loop" if all(c.get(k) for k in OPEN_LOOP) and model_changes(c)
-                else None)
+        return "open loop" if all(c.get(k) for k in OPEN_LOOP) and model_changes(c) else None
 
     @property
     def qualifies(self) -> bool:
@@ -172,7 +169,7 @@ class Selection:
 
 def _own(label: str) -> tuple[str, ...]:
     """The channels a candidate acts on (a per-channel effect: its channel)."""
-    name, channel = parse_label(label)
+    channel = parse_label(label)[1]
     return (channel,) if channel else effect_of(label).channels
 
 
@@ -186,22 +183,19 @@ def _cv_excess(cv: dict[str, float], floor: Mapping[str, float] | None,
 def _signature_start(label: str, signature) -> dict[str, float] | None:
     """The effect's parameters as its signature test estimates them, where it does."""
     par = signature.parameter if signature is not None and signature.applies else None
-    if not par:
-        return None
-    p = next((q for q in effect_of(label).params if q.name == par["name"]), None)
+    p = next((q for q in effect_of(label).params if par and q.name == par["name"]), None)
     if p is None:
         return None
     return {p.name: min(max(par["value"], p.lo + 1e-6 * (p.hi - p.lo)), p.hi)}
 
 
 def signature_outcome(signature, alpha: float) -> bool | None:
-    """True where the signature test is significant at ``alpha``; None where it does not
-    apply (or there is none); False where it applies and is not significant: its own test
-    could look for the effect and did not find it, so an attribution of a misfit to it is a
-    guess, and weak evidence ends in 'nothing named' rather than a name. False as well
-    where the run holds its conditions but its log is too sparse to read them
-    (``unreadable``): the evidence that would tell the effect from the base's misfit is
-    missing, so the open loop does not name it alone."""
+    """True where the signature test is significant at ``alpha``; None where it does not apply (or
+    there is none); False where it applies and is not significant: its own test could look for the
+    effect and did not find it, so an attribution of a misfit to it is a guess, and weak evidence
+    ends in 'nothing named' rather than a name. False as well where the run holds its conditions
+    but its log is too sparse to read them (``unreadable``): the evidence that would tell the
+    effect from the base's misfit is missing, so the open loop does not name it alone."""
     if signature is not None and signature.unreadable:
         return False
     if signature is None or not signature.applies:
@@ -224,12 +218,11 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
            progress: Callable[[str], None] | None = None,
            unknown_inputs: Sequence[tuple[float, float]] = ()) -> Selection:
     """Forward selection of ``candidates`` (labels) from the calibrated ``base`` (module
-    docstring); ``signatures``: reads the run's signature tests (by label) at a base model,
-    called again where the selection replaces the base, since a test may read the base's
-    values (compare.fit.signatures.Context). ``unknown_inputs``: spans
-    [t0, t1) [s] where the run's inputs are not known (a logging gap and the settling after
-    it): something else is not looked for there, since the model's misfit there says nothing
-    but that the inputs are not known."""
+    docstring); ``signatures``: reads the run's signature tests (by label) at a base model, called
+    again where the selection replaces the base, since a test may read the base's values
+    (compare.fit.signatures.Context). ``unknown_inputs``: spans [t0, t1) [s] where the run's
+    inputs are not known (a logging gap and the settling after it): something else is not looked
+    for there, since the model's misfit there says nothing but that the inputs are not known."""
     say = progress or (lambda _m: None)
     read = signatures or (lambda _fit: {})
     sig = dict(read(base))
@@ -238,8 +231,8 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
     judged: list[Judgement] = []
     withdrawn: set[str] = set()
     reg = regressors(cal, base, criteria)
-    loc = local(cal, current)
     while True:
+        loc = local(cal, current)
         rnd = judged[-1].round + 1 if judged else 1
         have = {parse_label(e)[0] for e in current.effects}
         pending = [c for c in candidates if parse_label(c)[0] not in have and c not in withdrawn]
@@ -264,11 +257,10 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
                         reg = regressors(cal, base, criteria)
                         say("reading the effects' signatures again at the better base")
                         sig = dict(read(base))
-                    current, loc = again, local(cal, again)
+                    current = again
                     continue
             steps.append(Step(best, current))
             current = best.fit
-            loc = local(cal, current)
             continue
         # a withdrawn effect's failure says nothing of the candidates judged with it: the
         # selection goes on from the model before it, without it
@@ -276,10 +268,9 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         if gone is None:
             break
         withdrawn.add(gone)
-        current, loc = kept, local(cal, kept)
+        current = kept
     say("fitting something else on the final model")
-    return Selection(base, steps, judged, verdict_on(loc, reg, criteria,
-                                                     unknown_inputs=unknown_inputs), sig)
+    return Selection(base, steps, judged, verdict_on(loc, reg, criteria, unknown_inputs), sig)
 
 
 def _fit_candidates(loc: Local, pending: Sequence[str], sig: Mapping[str, object], rnd: int,
@@ -298,8 +289,7 @@ def _fit_candidates(loc: Local, pending: Sequence[str], sig: Mapping[str, object
         if tries:
             fits[lab] = max(tries, key=lambda f: f.gain)
         else:
-            say(f"round {rnd}: {lab} makes the model run away wherever it was tried; "
-                "not judged")
+            say(f"round {rnd}: {lab} makes the model run away wherever it was tried; not judged")
     return fits
 
 
@@ -312,19 +302,19 @@ def _judge_round(loc: Local, fits: Mapping, sig: Mapping[str, object], criteria:
         return []
     current = loc.fit
     say(f"round {rnd}: fitting something else")
-    shrink = current.sample_share
     found, _ = scan(reg, loc.r0, loc.channel, loc.in_fit & known_inputs(loc, unknown_inputs),
-                    shrink)
+                    current.sample_share)
     # the null of every test: the current model refitted by the same step without a
     # candidate (a nonlinear fit stopped short of its optimum leaves the step a gain of
     # its own, which is no candidate's)
-    null = NullStep.of(loc)
+    gain, delta = loc.gain()
+    null = NullStep(gain, delta, loc.residual(delta))
     g_gain = joint_gain(loc, reg, found) - null.gain
     # every candidate's gain over the null, penalised by half ln(n_eff) per parameter (BIC)
     pen = 0.5 * math.log(max(current.n_eff, 2.0))
     penalised = {lab: f.gain - null.gain - pen * len(effect_of(lab).params)
                  for lab, f in fits.items()}
-    cv_now = loc.cross_validate(criteria.cv_blocks) if criteria.cv_blocks else None
+    cv_now = loc.rms_by_channel(loc.held_out(criteria.cv_blocks)) if criteria.cv_blocks else None
     margin = criteria.distinct_margin()
     out = []
     for lab, ef in fits.items():
@@ -352,21 +342,19 @@ def joins_first(qualified: Sequence[Judgement]) -> Judgement:
 
 def refit(cal: Calibrator, loc: Local, ef, criteria: Criteria) -> tuple[Fit, str]:
     """The nonlinear fit of the current model (``loc.fit``, linearized as ``loc``) with the
-    candidate ``ef`` (its compare.fit.linear.EffectFit) added, started twice: at the
-    linearized step (the base parameters moved by its delta) and at the current model with
-    only the effect's values added.
-    The better log-posterior (counted in ``current``'s effective samples, as every gain of
-    the selection) is kept, with the start it came from ("step" or "nested"). The step
-    extrapolates the linearization over the whole change, and where the base must move far it
-    can land in another basin of the least squares than the one the current model is in; the
-    second start is the nested model's own optimum, from which the effect only adds."""
+    candidate ``ef`` (its compare.fit.linear.EffectFit) added, started twice: at the linearized
+    step (the base parameters moved by its delta) and at the current model with only the effect's
+    values added. The better log-posterior (Fit.log_posterior, in the current model's effective
+    samples) is kept, with the start it came from ("step" or "nested"). The step extrapolates the
+    linearization over the whole change, and where the base must move far it can land in another
+    basin of the least squares than the current model's; the second start is the nested model's
+    own optimum, from which the effect only adds."""
     current = loc.fit
-    shrink = current.sample_share
     starts = {"step": {**loc.theta_after(ef.delta), **ef.values},
               "nested": {**current.theta, **ef.values}}
     fits = {name: cal.fit(current.effects + (ef.label,), start=start,
                           max_nfev=criteria.refit_nfev) for name, start in starts.items()}
-    best = max(fits, key=lambda k: fits[k].log_posterior(shrink))
+    best = max(fits, key=lambda k: fits[k].log_posterior(current.sample_share))
     return fits[best], best
 
 
@@ -374,11 +362,10 @@ def null_from(cal: Calibrator, current: Fit, joined: Fit, criteria: Criteria
               ) -> tuple[Fit, float]:
     """The current model (``current``, without the candidate) refitted from where ``joined``
     (it with the candidate) ended, the candidate's own values dropped, and its log-posterior
-    gain over ``current`` (counted in ``current``'s effective samples, as every gain of the
-    selection). A likelihood-ratio test holds only where the null is at its optimum: a
-    candidate's refit can move the base into a better basin than its calibration found, and
-    its gain is then the null's shortfall, which the null without it gains as well
-    (Criteria.null_from_candidate)."""
+    gain over ``current`` (in ``current``'s effective samples, as in :func:`refit`). A
+    likelihood-ratio test holds only where the null is at its optimum: a candidate's refit can
+    move the base into a better basin than its calibration found, and its gain is then the
+    null's shortfall, which the null without it gains as well (Criteria.null_from_candidate)."""
     shrink = current.sample_share
     again = cal.fit(current.effects, start={k: v for k, v in joined.theta.items()
                                             if k in current.theta},
@@ -388,12 +375,11 @@ def null_from(cal: Calibrator, current: Fit, joined: Fit, criteria: Criteria
 
 def withdraw_unsupported(steps: list[Step], final: Fit,
                          criteria: Criteria) -> tuple[Fit, str | None]:
-    """Criteria.open_loop_adequate_model: where the ``final`` model misses the tolerance of
-    one of an open-loop step's own channels on held-out data, the first such step and every
-    step after it are withdrawn (``steps`` is cut; their judgements' ``final_model_adequate``
-    set False). A misfit on a channel the effect does not act on leaves its likelihood ratio
-    as it was. Returns the model that remains and the first withdrawn step's label (None:
-    nothing withdrawn)."""
+    """Criteria.open_loop_adequate_model: where the ``final`` model misses the tolerance of one of
+    an open-loop step's own channels on held-out data, the first such step and every step after it
+    are withdrawn (``steps`` is cut; their judgements' ``final_model_adequate`` set False). A
+    misfit on a channel the effect does not act on leaves its likelihood ratio as it was. Returns
+    the model that remains and the first withdrawn step's label (None: nothing withdrawn)."""
     misses = held_out_misses(final.errors) if criteria.open_loop_adequate_model else {}
     first = next((i for i, s in enumerate(steps) if s.judgement.route == "open loop"
                   and set(_own(s.label)) & set(misses)), None)
@@ -412,15 +398,13 @@ SHIFT_BOUNDS = (0.0, 2.0)
 
 
 def complements(loc: Local, a, b, margin: float) -> bool:
-    """Whether candidates ``a`` and ``b`` (compare.fit.linear.EffectFit) each add a
-    significant gain over the other (a log-likelihood gain above ``margin``:
-    Criteria.distinct_margin, one degree of freedom at alpha): each enters as the
-    amplitude of its fitted shift, jointly with the base's step on the linearized model
-    ``loc``. Such candidates explain different parts of the run, so neither is an
-    alternative to the other (Criteria.distinct_among_alternatives)."""
+    """Whether candidates ``a`` and ``b`` (compare.fit.linear.EffectFit) each add a significant
+    gain over the other (a log-likelihood gain above ``margin``: Criteria.distinct_margin, one
+    degree of freedom at alpha): each enters as the amplitude of its fitted shift, jointly with
+    the base's step on the linearized model ``loc``. Such candidates explain different parts of
+    the run, so neither is an alternative to the other (Criteria.distinct_among_alternatives)."""
     ca, cb = a.shift[:, None], b.shift[:, None]
-    g_a = loc.gain(ca, [SHIFT_BOUNDS])[0]
-    g_b = loc.gain(cb, [SHIFT_BOUNDS])[0]
+    g_a, g_b = (loc.gain(c, [SHIFT_BOUNDS])[0] for c in (ca, cb))
     g_ab = loc.gain(np.hstack([ca, cb]), [SHIFT_BOUNDS, SHIFT_BOUNDS])[0]
     return bool(g_ab - g_a > margin and g_ab - g_b > margin)
 
@@ -434,39 +418,31 @@ class NullStep:
     delta: np.ndarray
     residual: np.ndarray
 
-    @classmethod
-    def of(cls, loc: Local) -> NullStep:
-        gain, delta = loc.gain()
-        return cls(gain, delta, loc.residual(delta))
-
 
 def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
           competitor: float, rival: float, cv_now: dict | None, rnd: int,
           null: NullStep, complements_: Sequence[str] = ()) -> Judgement:
     """The named criteria of one candidate fitted on the linearized model (module
     docstring). ``penalised``: its gain over the ``null`` (the current model refitted by the
-    same step, :class:`NullStep`) less half ln(n_eff) per
-    parameter; ``competitor`` and ``rival``: the same of the competitor's best hypothesis and
-    of the best other candidate on its channels that is an alternative to it, the others
-    (``complements_``) being its complements (:func:`complements`)."""
+    same step, :class:`NullStep`) less half ln(n_eff) per parameter; ``competitor`` and
+    ``rival``: the same of the competitor's best hypothesis and of the best other candidate on
+    its channels that is an alternative to it, the others (``complements_``) being its
+    complements (:func:`complements`)."""
     from scipy.stats import chi2
 
     cal = loc.cal
-    k = len(effect_of(ef.label).params)
     gain = ef.gain - null.gain
     lr = max(2.0 * gain, 0.0)
-    pv = float(chi2.sf(lr, k))
+    pv = float(chi2.sf(lr, len(effect_of(ef.label).params)))
     own = _own(ef.label)
     rows = np.isin(loc.channel, [cal.channels.index(c) for c in own if c in cal.channels])
     peak = float(np.max(np.abs(ef.shift[rows]))) if rows.any() else 0.0
     # what the fitted model's prediction moves by against the null, the base's
     # re-adjustment around the effect included
     net = float(np.max(np.abs(null.residual[rows] - ef.residual[rows]))) if rows.any() else 0.0
-    margin = criteria.distinct_margin()
     # the largest |prior z| of the base parameters without the candidate and with it
     z_null = float(np.max(np.abs(loc.prior_sds(null.delta)), initial=0.0))
     z_with = float(np.max(np.abs(loc.prior_sds(ef.delta)), initial=0.0))
-    z_crit = criteria.implausible_z()
     out: dict[str, bool | None] = {
         "significant": pv < criteria.alpha,
         "material": peak >= criteria.material_peak,
@@ -474,10 +450,10 @@ def judge(loc: Local, ef, signature, criteria: Criteria, penalised: float,
         "predicts": None,
         "changes_prediction": (net >= criteria.material_peak
                                if criteria.open_loop_material_change else None),
-        "restores_plausible_base": (z_null > z_crit >= z_with
+        "restores_plausible_base": (z_null > criteria.implausible_z() >= z_with
                                     if criteria.plausible_base_route else None),
         "beats_something_else": bool(penalised >= competitor),
-        "distinct": bool(penalised >= rival + margin),
+        "distinct": bool(penalised >= rival + criteria.distinct_margin()),
         "null_at_optimum": None,  # asked of the candidate that joins, after its refit
         "final_model_adequate": None,  # asked of the open loop's names after the selection
     }
@@ -503,11 +479,9 @@ def verdict_on(loc: Local, reg, criteria: Criteria,
     white noise: compare.fit.competitor.scan_threshold) and material; and, whatever was
     named, where the final model misses a tolerance on held-out data (:func:`held_out_misses`,
     Criteria.held_out_misfit_unexplained)."""
-    rows = np.ones(len(loc.r0), dtype=bool)
-    r = loc.residual(loc.step(rows))
+    r = loc.residual(loc.step(np.ones(len(loc.r0), dtype=bool)))
     rows = known_inputs(loc, unknown_inputs)
-    shrink = loc.fit.sample_share
-    found, _ = scan(reg, r, loc.channel, rows, shrink, top=1)
+    found, _ = scan(reg, r, loc.channel, rows, loc.fit.sample_share, top=1)
     h = found[0] if found else None
     lr = 2.0 * h.gain if h is not None else 0.0
     threshold = (scan_threshold(reg, loc.channel, rows, criteria.alpha, criteria.scan_null_tail)

@@ -24,9 +24,11 @@ temperatures in K, power in W.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+
+from lumped.elastic import first_order_lag
 
 
 @dataclass(frozen=True)
@@ -115,12 +117,8 @@ def speed_steps(t_s: np.ndarray, speed_rpm: np.ndarray, criteria,
     steps = [Step(float(0.5 * (t[g[0]] + t[g[-1] + 1])), float(n[g[0]]), float(n[g[-1] + 1]))
              for g in groups]
     times = np.array([s.t_s for s in steps])
-    keep = []
-    for s in steps:
-        others = times[(times != s.t_s)]
-        if not np.any((others > s.t_s + quiet_s[0]) & (others < s.t_s + quiet_s[1])):
-            keep.append(s)
-    return keep
+    return [s for s in steps if not np.any((times != s.t_s) & (times > s.t_s + quiet_s[0])
+                                           & (times < s.t_s + quiet_s[1]))]
 
 
 def line_fit(t: np.ndarray, y: np.ndarray, window: tuple[float, float], t0: float, criteria
@@ -181,12 +179,9 @@ def onset_ratio(t_s: np.ndarray, y: np.ndarray, steps: list[Step], scale: OnsetS
 def fine_inputs(inputs, sub: int = 6):
     """``inputs`` (compare.fit.greybox.Inputs) with every interval cut into ``sub`` equal
     ones holding the same values: the model's response between its grid points."""
-    from dataclasses import replace
-
     g = inputs.grid_s
-    fine = np.concatenate([np.linspace(a, b, sub + 1)[:-1] for a, b in zip(g[:-1], g[1:],
-                                                                            strict=True)]
-                          + [g[-1:]])
+    pieces = [np.linspace(a, b, sub + 1)[:-1] for a, b in zip(g[:-1], g[1:], strict=True)]
+    fine = np.concatenate([*pieces, g[-1:]])
 
     def rep(v: np.ndarray) -> np.ndarray:
         return np.repeat(np.asarray(v), sub)
@@ -213,14 +208,11 @@ class ModelOnsets:
         """The first-order lag time constant [s] that brings the model's onset ratio of
         ``channel`` at ``scale`` down to ``ratio`` (0 when it is already at or below; the
         grid's longest lag when even that does not)."""
-        from lumped.elastic import first_order_lag
-
         grid = self.criteria.lag_grid_s
         ratios = [self.ratios[channel][scale.name]]
         for tau in grid[1:]:
             y = first_order_lag(self.t_s, self.outputs[channel], tau)
-            ratios.append(onset_ratio(self.t_s, y, self.steps[scale.name], scale,
-                                      self.criteria)[0])
+            ratios.append(onset_ratio(self.t_s, y, self.steps[scale.name], scale, self.criteria)[0])
         r = np.array(ratios)
         if not np.isfinite(ratio) or ratio >= r[0]:
             return 0.0
@@ -241,8 +233,7 @@ def model_onsets(gb, theta: dict[str, float], channels, criteria, sub: int = 6) 
     out = model.simulate(theta)
     t = model.inputs.grid_s
     n_end = np.concatenate([[model.inputs.speed_rpm[0]], model.inputs.speed_rpm])
-    steps = {sc.name: speed_steps(t, n_end, criteria, sc.quiet_s)
-             for sc in criteria.onset_scales}
+    steps = {sc.name: speed_steps(t, n_end, criteria, sc.quiet_s) for sc in criteria.onset_scales}
     fits = {c: {sc.name: onset_ratio(t, out[c], steps[sc.name], sc, criteria)[:2]
                 for sc in criteria.onset_scales} for c in channels if c in out}
     ratios = {c: {k: v[0] for k, v in f.items()} for c, f in fits.items()}
@@ -279,8 +270,7 @@ class Segment:
 
     def settled_W(self) -> tuple[float, float]:
         """(mean, standard error) of the power over the segment's second half."""
-        mean, se, _ = self.mean_W(0.5 * self.duration_s, self.duration_s + 1.0)
-        return mean, se
+        return self.mean_W(0.5 * self.duration_s, self.duration_s + 1.0)[:2]
 
 
 def segments(run, criteria) -> list[Segment]:

@@ -36,8 +36,7 @@ def register(effect: Effect) -> Effect:
     if not effect.name or effect.name in LIBRARY:
         raise ValueError(f"an effect needs a name of its own, not {effect.name!r}")
     taken = {p.name for e in LIBRARY.values() for p in e.params}
-    clash = [p.name for p in effect.params if p.name in taken]
-    if clash:
+    if clash := [p.name for p in effect.params if p.name in taken]:
         raise ValueError(f"{effect.name}: parameter names {clash} are another effect's")
     LIBRARY[effect.name] = effect
     return effect
@@ -51,9 +50,7 @@ def unregister(name: str) -> None:
 def effect_of(text: str) -> Effect:
     """The effect of a candidate label (``sensor_lag(T2)`` -> the lag), or a hypothesis
     outside the library (:data:`HYPOTHESES`)."""
-    if text in HYPOTHESES:
-        return HYPOTHESES[text]
-    return LIBRARY[parse_label(text)[0]]
+    return HYPOTHESES[text] if text in HYPOTHESES else LIBRARY[parse_label(text)[0]]
 
 
 def hypothesis(effect: Effect) -> str:

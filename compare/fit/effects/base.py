@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from compare.fit.params import Param
+from lumped.blocks import PrescribedHeatFlow
 
 if TYPE_CHECKING:
     from spindle.loads import LoadCase
@@ -155,8 +156,6 @@ class Effect:
 def spread_heat(net, masses, source: str, prefix: str) -> None:
     """Heat flows of ``source`` into ``masses`` of the lumped network ``net``, shared by
     their heat capacities (block names ``prefix:mass``)."""
-    from lumped.blocks import PrescribedHeatFlow
-
     total = sum(m.block.C_J_K for m in masses)
     for m in masses:
         q = net.network.add(PrescribedHeatFlow(f"{prefix}:{m.name}", source=source,

@@ -39,8 +39,7 @@ class CentrifugalShortening(Effect):
     def signature(self, ctx) -> dict:
         if "P1" not in ctx.channels:
             return {}
-        return {self.name: jump_test(*ctx.run.channel("P1"), ctx.steps(),
-                                     ctx.criteria)}
+        return {self.name: jump_test(*ctx.run.channel("P1"), ctx.steps(), ctx.criteria)}
 
     def draw(self, rng):
         return {"scale": float(rng.uniform(8.0, 15.0))}
@@ -53,10 +52,8 @@ class CentrifugalShortening(Effect):
         return {"P1": lambda ts: scale * reference.centrifugal_m(case, ts, "P1")}
 
     def measure(self, t_s, columns, truth, channel):
-        out = dict(columns)
         n = np.nan_to_num(columns["speed_rpm"])
-        out["P1"] = columns["P1"] - truth["c_cf_um_krpm2"] * 1e-6 * (n / 1000.0) ** 2
-        return out
+        return {**columns, "P1": columns["P1"] - truth["c_cf_um_krpm2"] * 1e-6 * (n / 1000.0) ** 2}
 
 
 def jump_test(t_s: np.ndarray, p1_m: np.ndarray, steps, criteria) -> EventTest:

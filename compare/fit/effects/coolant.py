@@ -137,12 +137,11 @@ def load_response_test(run, gb, theta: dict[str, float], criteria) -> EventTest:
     base = gb.simulate(theta)
     probe = gb.variant(tuple(dict.fromkeys((*gb.effects, name))))
     r_probe = criteria.load_probe_R_K_W
-    with_r = probe.simulate({**theta, "R_adv_K_W": r_probe})
-    # the nuisance path: the rotor's share of the loss, raised by 10 %
-    cols = [(with_r, r_probe), (gb.simulate({**theta, "rotor_share": theta["rotor_share"] * 1.1}),
-                                0.1)]
+    cols = [(probe.simulate({**theta, "R_adv_K_W": r_probe}), r_probe),
+            # the nuisance path: the rotor's share of the loss, raised by 10 %
+            (gb.simulate({**theta, "rotor_share": theta["rotor_share"] * 1.1}), 0.1)]
     sens = {c: np.column_stack([(w[c] - base[c]) / d for w, d in cols]) for c in channels}
-    E, X, P = [], [], []
+    blocks = []  # (residual, regressors, plateau start) of each block
     for a, b in plats:
         for c in channels:
             tc, yc = run.channel(c)
@@ -150,10 +149,8 @@ def load_response_test(run, gb, theta: dict[str, float], criteria) -> EventTest:
             e = yc[m] - np.interp(tc[m], grid, base[c])
             Xc = np.column_stack([np.interp(tc[m], grid, s) for s in sens[c].T])
             eb, Xb = _block_rows(tc[m], e, Xc, a, criteria)
-            E.append(eb)
-            X.append(Xb)
-            P.append(np.full(len(eb), a))
-    E, X, P = np.concatenate(E), np.vstack(X), np.concatenate(P)
+            blocks.append((eb, Xb, np.full(len(eb), a)))
+    E, X, P = (np.concatenate(parts) for parts in zip(*blocks, strict=True))
     keys = np.unique(P)
     if len(keys) < criteria.load_min_plateaus:  # plateaus lost in the logging gaps
         return _not_applicable(len(keys), "too few logged blocks in the load plateaus")
@@ -174,10 +171,8 @@ def load_response_test(run, gb, theta: dict[str, float], criteria) -> EventTest:
     if not (np.isfinite(se_R) and se_R > 0):
         return _not_applicable(m, "the plateaus do not determine it")
     z = R / se_R
-    rows = [{"t_s": a, "t_end_s": b} for a, b in plats]
-    test = EventTest(name, ", ".join(channels), R, se_R, z, float(student.sf(z, m - 1)), m,
-                     "K/W", MEANING, per_step=rows)
     q = float(student.ppf(0.975, m - 1))
-    test.parameter = {"name": "R_adv_K_W", "value": max(R, 0.0),
-                      "ci95": [max(R - q * se_R, 0.0), R + q * se_R]}
-    return test
+    return EventTest(name, ", ".join(channels), R, se_R, z, float(student.sf(z, m - 1)), m,
+                     "K/W", MEANING, per_step=[{"t_s": a, "t_end_s": b} for a, b in plats],
+                     parameter={"name": "R_adv_K_W", "value": max(R, 0.0),
+                                "ci95": [max(R - q * se_R, 0.0), R + q * se_R]})

@@ -39,9 +39,7 @@ class FixtureExpansion(Effect):
         return {}
 
     def measure(self, t_s, columns, truth, channel):
-        out = dict(columns)
         env = columns["T_env_K"]
         env0 = env[np.isfinite(env)][0]
-        out["P1"] = columns["P1"] + truth["k_fix_um_K"] * 1e-6 * np.where(
-            np.isfinite(env), env - env0, 0.0)
-        return out
+        return {**columns, "P1": columns["P1"] + truth["k_fix_um_K"] * 1e-6 * np.where(
+            np.isfinite(env), env - env0, 0.0)}

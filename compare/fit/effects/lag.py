@@ -32,8 +32,7 @@ class SensorLag(Effect):
 
     def as_measured(self, out, theta, inputs, channel):
         if channel in out and theta["tau_s"] > 0:
-            out = dict(out)
-            out[channel] = first_order_lag(inputs.grid_s, out[channel], theta["tau_s"])
+            out = {**out, channel: first_order_lag(inputs.grid_s, out[channel], theta["tau_s"])}
         return out
 
     def signature(self, ctx) -> dict:
@@ -67,13 +66,11 @@ class SensorLag(Effect):
         return {}
 
     def measure(self, t_s, columns, truth, channel):
-        out = dict(columns)
         x = columns[channel]
         ok = np.isfinite(x)
         y = np.full_like(x, np.nan)
         y[ok] = first_order_lag(t_s[ok], x[ok], float(truth["tau_s"]))
-        out[channel] = y
-        return out
+        return {**columns, channel: y}
 
 
 def lag_test(channel: str, t_s: np.ndarray, y: np.ndarray, steps: dict, model_ratios: dict,

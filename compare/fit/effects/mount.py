@@ -9,6 +9,7 @@ from dataclasses import replace
 
 from compare.fit.effects.base import Effect
 from compare.fit.params import Param
+from lumped.blocks import Convection, FixedTemperature
 from spindle.loads import SpeedTable
 
 
@@ -24,15 +25,12 @@ class MountConduction(Effect):
             "the spec lacks")
 
     def extend_network(self, net, spec, power_measured):
-        from lumped.blocks import Convection, FixedTemperature
-
         hous = [p for p in net.parts.values() if p.part.role == "housing"][0]
         amb = next(b for b in net.network.blocks if isinstance(b, FixedTemperature)
                    and b.source == "ambient")
         c = net.network.add(Convection("mount", Gc_W_K=1.0))  # set per parameter set
         net.network.connect(hous.masses[-1].block.port, c.port_a)
         net.network.connect(c.port_b, amb.port)
-        return None
 
     def edge_conductances(self, theta):
         return {"mount": theta.get("G_mount_W_K", 0.0)}

@@ -20,6 +20,7 @@ import numpy as np
 from compare.fit.effects.base import Effect, Feedback
 from compare.fit.params import Param
 from compare.fit.signatures import EventTest, through_origin
+from lumped.blocks import PrescribedHeatFlow
 from spindle.drive_file import MOTOR_SOURCES
 from spindle.loads import TimeSeries
 
@@ -50,8 +51,6 @@ class BearingPreload(Effect):
         return {"bearing_tc_1_K": 1.0}  # set per parameter set
 
     def extend_network(self, net, spec, power_measured):
-        from lumped.blocks import PrescribedHeatFlow
-
         feedback = [(b, param_of(spec, b.source)) for b in net.network.blocks
                     if isinstance(b, PrescribedHeatFlow) and b.across is not None]
         return feedback, (_drag_flows(net) if power_measured else [])
@@ -81,17 +80,14 @@ class BearingPreload(Effect):
         return {FRONT: k, REAR: k}
 
     def feedback(self, thermal, spec, truth):
-        pts, names = [], []
-        for p in spec.parts:
-            if p.role not in ("front_bearing", "rear_bearing"):
-                continue
-            for sec in p.sections:
-                if sec.name in ("inner_ring", "outer_ring"):
-                    z = 0.5 * (sec.z_start + sec.z_end)
-                    pts.append((z, 0.5 * float(sec.r_in(z) + sec.r_out(z))))
-                    names.append(f"{p.name}.{sec.name}")
+        rings = [(p.name, sec) for p in spec.parts if p.role in ("front_bearing", "rear_bearing")
+                 for sec in p.sections if sec.name in ("inner_ring", "outer_ring")]
+        pts = []
+        for _, sec in rings:  # each ring's mid-point
+            z = 0.5 * (sec.z_start + sec.z_end)
+            pts.append((z, 0.5 * float(sec.r_in(z) + sec.r_out(z))))
         P = thermal.probe_matrix(np.array(pts).T).toarray()
-        functionals = {n: P[i] for i, n in enumerate(names)}
+        functionals = {f"{p}.{sec.name}": row for (p, sec), row in zip(rings, P, strict=True)}
         bearings = bearing_sources(spec)
         ks = [_k_of(spec, h, truth) for h in bearings]
 
@@ -145,8 +141,6 @@ def _drag_flows(net) -> list[tuple]:
     T_out) from that motor mass (w the source's fraction of the motor loss, set per parameter
     set; k set with the preload's own flows). Returns (negative flow, constant flow, motor
     source, s, the bearing's preload parameter) per pair."""
-    from lumped.blocks import PrescribedHeatFlow
-
     masses = {m.name: m for pm in net.parts.values() for m in pm.masses}
     motor = [b for b in net.network.blocks
              if isinstance(b, PrescribedHeatFlow) and b.source in MOTOR_SOURCES]
@@ -184,11 +178,8 @@ def ring_drag_W(gb, theta: dict[str, float]) -> dict[str, np.ndarray]:
             rows[f"ring:{src.name}"] = r
             names.append(src.name)
     out = gb.simulate(theta, extra_rows=rows)
-    res = {}
-    for n in names:
-        q = np.concatenate([heat[n][:1], heat[n]])  # the heat of the interval ending here
-        res[n] = q * out[f"ring:{n}"]
-    return res
+    # at a grid point, the heat of the interval ending there
+    return {n: np.concatenate([heat[n][:1], heat[n]]) * out[f"ring:{n}"] for n in names}
 
 
 def model_drift_of(gb, theta: dict[str, float], criteria, front_only: bool = False):
@@ -284,5 +275,4 @@ def front_parameter(test: EventTest, gb, theta: dict[str, float], criteria) -> d
     k, se = through_origin(np.array(D), np.array(X), np.array(S))
     if not np.isfinite(k):
         return None
-    return {"name": FRONT, "value": max(k, 0.0),
-            "ci95": [max(k - 1.96 * se, 0.0), k + 1.96 * se]}
+    return {"name": FRONT, "value": max(k, 0.0), "ci95": [max(k - 1.96 * se, 0.0), k + 1.96 * se]}

@@ -57,9 +57,8 @@ class WindageLoss(Effect):
         t = np.asarray(src.time_s)
         c = truth["c_w_W_krpm3"]
         extra = c * (np.asarray(case.speed_rpm(t + 1e-6)) / 1000.0) ** 3
-        case = case.with_sources({rotor[0]: TimeSeries(tuple(t), tuple(np.asarray(src.values)
-                                                                        + extra),
-                                                        src.interpolation)})
+        values = tuple(np.asarray(src.values) + extra)
+        case = case.with_sources({rotor[0]: TimeSeries(tuple(t), values, src.interpolation)})
         # a drag the motor supplies: the logged electrical power carries it
         return case, {"power_W": lambda ts: c * (np.asarray(case.speed_rpm(ts), dtype=float)
                                                  / 1000.0) ** 3}
@@ -97,20 +96,18 @@ def cube_test(segs, criteria, drifting: bool = False) -> EventTest:
     power drifts at constant speed (``drifting``: its levels are not settled)."""
     from scipy.stats import t as student
 
-    levels: list[list[tuple[float, float]]] = []
-    speeds: list[float] = []
+    levels: list[list[tuple[float, float]]] = []  # per speed level, its (speed, power) pairs
     for s in segs:
         if not s.no_load or s.duration_s < criteria.level_min_s:
             continue
         P, _ = s.settled_W()
         if not np.isfinite(P):
             continue
-        for k, n in enumerate(speeds):
-            if abs(n - s.speed_rpm) <= criteria.level_rpm:
-                levels[k].append((s.speed_rpm, P))
+        for lv in levels:  # joins the first level within level_rpm of its first speed
+            if abs(lv[0][0] - s.speed_rpm) <= criteria.level_rpm:
+                lv.append((s.speed_rpm, P))
                 break
         else:
-            speeds.append(s.speed_rpm)
             levels.append([(s.speed_rpm, P)])
     n = np.array([np.mean([v[0] for v in lv]) for lv in levels]) / 1e3
     P = np.array([np.mean([v[1] for v in lv]) for lv in levels])
@@ -132,9 +129,8 @@ def cube_test(segs, criteria, drifting: bool = False) -> EventTest:
     cov = s2 * np.linalg.inv(A.T @ A)
     c, se = float(coef[3]), math.sqrt(float(cov[3, 3]))
     tval = c / se
-    test = EventTest("windage_loss", "power", c, se, tval, float(student.sf(tval, dof)), len(n),
-                     "W/krpm^3", meaning, per_step=rows)
     q = float(student.ppf(0.975, dof))
-    test.parameter = {"name": "c_w_W_krpm3", "value": max(c, 0.0),
-                      "ci95": [max(c - q * se, 0.0), c + q * se]}
-    return test
+    return EventTest("windage_loss", "power", c, se, tval, float(student.sf(tval, dof)), len(n),
+                     "W/krpm^3", meaning, per_step=rows,
+                     parameter={"name": "c_w_W_krpm3", "value": max(c, 0.0),
+                                "ci95": [max(c - q * se, 0.0), c + q * se]})
