@@ -109,6 +109,9 @@ from compare.cli import _terminate
 from compare.forked import ForkedColumns
 
 signal.signal(signal.SIGTERM, _terminate)  # as the command line has it
+# Ctrl-C as a foreground command has it: a test runner started as a background job of a
+# shell without job control inherits SIGINT ignored (POSIX), and so would this process
+signal.signal(signal.SIGINT, signal.default_int_handler)
 pids = sys.argv[1]
 
 def slow(x):
@@ -151,8 +154,7 @@ def test_a_signal_to_the_process_group_ends_the_fit_and_its_children_quietly(tmp
     try:
         err = proc.communicate(timeout=20)[1]
     except subprocess.TimeoutExpired:
-        # where it hangs, for the next reader: every thread's stack (once seen under load,
-        # not reproduced in 230 repeats; docs/fit-history.md "2026-12-01 (24)")
+        # where it hangs, for the next reader: every thread's stack
         os.kill(proc.pid, signal.SIGUSR1)
         time.sleep(1.0)
         os.killpg(proc.pid, signal.SIGKILL)
