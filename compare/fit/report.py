@@ -107,7 +107,7 @@ def verdict_lines(doc: dict) -> list[str]:
     """The verdict in sentences: what was found, then the error before and after."""
     v = doc["verdict"]
     place = place_text(v.get("residual"))  # where an unexplained residual lives
-    where = f"{v.get('where')}" + (f"; {place}" if place else "")
+    where = str(v.get("where")) + (f"; {place}" if place else "")
     lines = []
     if v["kind"] == "named":
         for e in doc["effects"]:

@@ -84,7 +84,9 @@ def first_samples(run: BenchRun, channels: list[str], grid_s: np.ndarray) -> dic
     first interval: the state at the start (a median over the interval would blur it where
     the coolant acts within the first minute, as on the peer's dev-03)."""
     out = {}
-    for c in [c for c in channels if c != "P1"]:
+    for c in channels:
+        if c == "P1":
+            continue
         t, y = run.channel(c)
         if len(t) and t[0] <= grid_s[1]:
             out[c] = float(y[0])
