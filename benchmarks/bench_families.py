@@ -16,6 +16,8 @@ effect and its size, the noise and sampling; ``synth --mismatch``):
 - ``clean``: none;
 - ``outside``: one cause outside the library (compare.synth.outside), drawn uniformly;
 - ``two``: two different effects of the library together;
+- ``mixed``: one effect of the library and one cause outside it together (each drawn
+  uniformly): the library's effect should be named and something else said to remain;
 - ``peers``: the peer's runs in the folders of ``--peers`` (a fixed set, each fitted once).
 
 ``--geometry RADIAL AXIAL`` draws the runs from another spindle: the spec's radii times
@@ -63,7 +65,8 @@ ROOT = Path(__file__).resolve().parents[1]
 #: the peer's runs, kept in the repository (tests/data/peer-runs/README.md)
 PEER_RUNS = ROOT / "tests" / "data" / "peer-runs"
 CYCLES = ("random", "random-loaded", "random-ramped-load")
-FAMILIES = ("effect", "clean", "outside", "two")
+#: appended in this order: a family's index seeds its draws, so the earlier families' runs stay
+FAMILIES = ("effect", "clean", "outside", "two", "mixed")
 #: the size every effect of the peer's runs has (tests/data/peer-runs/bench-runs-2/README.md:
 #: "every effect moves some channel by at least 1.5 K or 2 um"): the rates are also given on
 #: the drawn runs whose every effect (or cause outside the library) is at least that large
@@ -140,6 +143,8 @@ def draw(family: str, seed: int, spec=None) -> tuple[list[str], str]:
         return [str(rng.choice(acting(OUTSIDE)))], cycle
     if family == "two":
         return [str(x) for x in rng.choice(acting(LIBRARY), size=2, replace=False)], cycle
+    if family == "mixed":
+        return [str(rng.choice(acting(LIBRARY))), str(rng.choice(acting(OUTSIDE)))], cycle
     return ["clean"], cycle
 
 
@@ -298,6 +303,13 @@ def summary(rows: list[dict]) -> list[str]:
                 lambda r: r["verdict"] in ("named", "base adequate"))
     out += rate("both effects named (two-effect runs)", lambda r: r["right"],
                 lambda r: r["kind"] == "effects")
+    out += rate("the library's effect named first, beside a cause outside it",
+                lambda r: r["first"], lambda r: r["kind"] == "effect+outside")
+    out += rate("  ... named alone, and something else said to remain", lambda r: r["right"],
+                lambda r: r["kind"] == "effect+outside")
+    out += rate("  ... something else said to remain, whatever is named",
+                lambda r: r["unexplained"], lambda r: r["kind"] == "effect+outside")
+    out += _beside_lines(rows)
     out += rate("the verdict right as a whole", lambda r: r["right"], lambda r: True)
     names = sorted({r["truth"] for r in rows if r["kind"] == "effect"})
     for name in names:
@@ -321,6 +333,22 @@ def summary(rows: list[dict]) -> list[str]:
             out.append(f"fit time{label}: median {times[len(times) // 2]:.0f} s, max "
                        f"{times[-1]:.0f} s over {len(times)} runs")
     return out
+
+
+def _beside_lines(rows: list[dict]) -> list[str]:
+    """Per cause outside the library, of the runs that hold it beside a library effect: how
+    many named that effect first, and how many said something else remains."""
+    from compare.fit.effects import LIBRARY
+
+    mixed = [r for r in rows if r["kind"] == "effect+outside"]
+    causes = sorted({c for r in mixed for c in r["truth"] if c not in LIBRARY})
+    out = [f"  {'beside':24} runs  effect named first  something else said  a wrong name"]
+    for cause in causes:
+        mine = [r for r in mixed if cause in r["truth"]]
+        out.append(f"    {cause:22} {len(mine):4d}  {sum(bool(r['first']) for r in mine):18d}  "
+                   f"{sum(r['unexplained'] for r in mine):19d}  "
+                   f"{sum(r['wrong'] for r in mine):11d}")
+    return out if causes else []
 
 
 def missed_lines(rows: list[dict], families: list[str]) -> list[str]:

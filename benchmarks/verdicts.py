@@ -57,14 +57,17 @@ def judge_verdict(truth, named: list[str], unexplained: bool) -> dict:
     - ``first``: the first name is a true effect (runs with an effect only);
     - ``false_second``: a second name that is not a true effect after a right first one;
     - ``wrong``: some name is not a true effect (on any run);
-    - ``kind``: "control", "outside", "effect" or "effects".
+    - ``kind``: "control", "outside", "effect", "effects" or "effect+outside" (a list with
+      a cause outside the library beside the library's effects: right where it names those
+      and says something else remains).
     """
     from compare.fit.effects import LIBRARY
 
     if truth in (None, "none", "clean"):
         kind, true = "control", []
     elif isinstance(truth, list | tuple):
-        kind, true = "effects", list(truth)
+        true = [t for t in truth if t in LIBRARY]
+        kind = "effects" if len(true) == len(truth) else "effect+outside"
     elif truth in LIBRARY:
         kind, true = "effect", [truth]
     else:
@@ -74,7 +77,8 @@ def judge_verdict(truth, named: list[str], unexplained: bool) -> dict:
         right = not named and (unexplained or kind == "control")
         first = None
     else:
-        right = set(named) == set(true) and len(named) == len(true)
+        right = (set(named) == set(true) and len(named) == len(true)
+                 and (unexplained or kind != "effect+outside"))
         first = bool(named) and named[0] in true
     second = (bool(first) and len(named) > 1 and named[1] not in true) if first else False
     return {"kind": kind, "right": right, "first": first, "false_second": second,
@@ -93,7 +97,7 @@ def missed_by(doc: dict, truth) -> list[str] | None:
 
     verdict = judge_verdict(truth, [e["name"] for e in doc["effects"]],
                             bool(doc["verdict"]["unexplained"]))
-    if verdict["kind"] not in ("effect", "effects") or verdict["first"]:
+    if verdict["kind"] not in ("effect", "effects", "effect+outside") or verdict["first"]:
         return None
     true = set(truth) if isinstance(truth, list | tuple) else {truth}
     mine = [c for c in doc.get("candidates", [])

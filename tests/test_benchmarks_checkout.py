@@ -180,3 +180,36 @@ def test_the_ambient_shifted_copy_moves_the_ambient_alone(monkeypatch, tmp_path)
         np.testing.assert_array_equal(logged, ~np.isnan(b.columns[name]))
         want = col + 1e-5 if name == "T_env_C" else col
         np.testing.assert_allclose(b.columns[name][logged], want[logged], rtol=0, atol=1e-12)
+
+
+def test_the_mixed_family_is_judged_by_its_library_effect_and_what_remains(monkeypatch):
+    """bench_families' ``mixed`` runs carry one library effect and one cause outside the
+    library (compare.synth.outside): right is that effect named alone *and* something else
+    said to remain; a name that is not the library's effect is wrong; appending the family
+    left the other families' draws as the committed rows (docs/figures/fit-families.json,
+    written before it existed) record them."""
+    import json
+
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import bench_families
+    from verdicts import judge_verdict
+
+    from compare.fit.effects import LIBRARY
+    from compare.synth.outside import OUTSIDE
+
+    truth = ["fixture_expansion", "electronics_drift"]
+    assert judge_verdict(truth, ["fixture_expansion"], True) == {
+        "kind": "effect+outside", "right": True, "first": True, "false_second": False,
+        "wrong": False}
+    assert not judge_verdict(truth, ["fixture_expansion"], False)["right"]
+    assert judge_verdict(truth, ["mount_conduction"], True)["wrong"]
+    assert not judge_verdict(truth, [], True)["right"]
+    for seed in range(1, 51):
+        (effect, cause), _ = bench_families.draw("mixed", seed)
+        assert effect in LIBRARY and cause in OUTSIDE
+    rows = json.loads((ROOT / "docs" / "figures" / "fit-families.json").read_text("utf-8"))
+    drawn = [r for r in rows if r["family"] in ("effect", "two")]
+    assert drawn
+    for r in drawn:
+        effects, _ = bench_families.draw(r["family"], int(r["run"].rsplit("-", 1)[1]))
+        assert (effects if r["family"] == "two" else effects[0]) == r["truth"], r["run"]

@@ -55,7 +55,8 @@ def test_the_criteria_rows_are_the_table_the_fit_runs_with():
 @pytest.mark.parametrize("block, name", [("families", "fit-families.txt"),
                                          ("held-out", "fit-families-held-out.txt"),
                                          ("perturb", "perturb-peers.txt"),
-                                         ("start", "fit-start.txt")])
+                                         ("start", "fit-start.txt"),
+                                         ("mixed", "fit-families-mixed.txt")])
 def test_the_generalisation_figures_are_the_benchmarks_file(block, name):
     generated = (ROOT / "docs" / "figures" / name).read_text(encoding="utf-8")
     block = _block(block).strip()
@@ -268,6 +269,24 @@ def test_the_readme_quotes_the_measured_rates():
     summary = (ROOT / "docs" / "figures" / "fit-families.txt").read_text(encoding="utf-8")
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     assert readme_fit_rates(summary) in readme, readme_fit_rates(summary)
+
+
+def readme_mixed_rates(summary: str) -> str:
+    """The README's sentence on runs with a library effect and a cause outside it, from
+    docs/figures/fit-families-mixed.txt."""
+    wk, wn, _, _, _ = _rate(summary, "a wrong effect named (any run)")
+    fk, fn, _, _, _ = _rate(summary, "the library's effect named first, beside a cause outside it")
+    uk, un, _, _, _ = _rate(summary, "  ... something else said to remain, whatever is named")
+    assert wn == fn == un
+    return (f"On {fn} runs that hold a library effect and a cause outside it together, it named "
+            f"a wrong cause on {wk}, the library's effect first on {fk}, and said that something "
+            f"else remains on {uk}")
+
+
+def test_the_readme_quotes_the_mixed_rates():
+    summary = (ROOT / "docs" / "figures" / "fit-families-mixed.txt").read_text(encoding="utf-8")
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    assert readme_mixed_rates(summary) in readme, readme_mixed_rates(summary)
 
 
 def test_a_summary_of_saved_rows_names_the_call_that_made_them(tmp_path):
