@@ -535,3 +535,21 @@ def test_the_other_spindles_table_is_its_files():
     from tests.docs_blocks import assert_block
 
     assert_block("docs/fit.md", "geometry", geometry_table())
+
+
+def test_the_event_probes_prose_is_its_figures_file():
+    """docs/fit.md's sentence on the probe of judging the library beside the competitor's
+    event (docs/fit-history.md "2026-12-02 (25)") from its figures file."""
+    import json
+
+    doc = json.loads((ROOT / "docs" / "figures" / "fit-probe-condition-on-event.json")
+                     .read_text(encoding="utf-8"))
+    probed = [r for r in doc["runs"] if r["probed"]]
+    gained = [r for r in probed if r["right_name_gained"]]
+    words = {1: "one", 2: "two", 3: "three", 4: "four", 5: "five"}
+    assert {r["family"] for r in gained} == {"mixed"}
+    assert not any(r["wrong_name_beside"] for r in probed)
+    assert not any(r["named_beside_event"] for r in probed if r["family"] != "mixed")
+    text = " ".join(DOC.split())
+    assert (f"It named the right effect on {words[len(gained)]} of the mixed runs it could act "
+            "on and nothing elsewhere") in text
