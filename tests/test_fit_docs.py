@@ -265,12 +265,6 @@ def readme_fit_rates(summary: str) -> str:
             f"library ({op} %).")
 
 
-def test_the_readme_quotes_the_measured_rates():
-    summary = (ROOT / "docs" / "figures" / "fit-families.txt").read_text(encoding="utf-8")
-    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
-    assert readme_fit_rates(summary) in readme, readme_fit_rates(summary)
-
-
 def readme_mixed_rates(summary: str) -> str:
     """The README's sentence on runs with a library effect and a cause outside it, from
     docs/figures/fit-families-mixed.txt."""
@@ -283,10 +277,12 @@ def readme_mixed_rates(summary: str) -> str:
             f"else remains on {uk}")
 
 
-def test_the_readme_quotes_the_mixed_rates():
-    summary = (ROOT / "docs" / "figures" / "fit-families-mixed.txt").read_text(encoding="utf-8")
+@pytest.mark.parametrize("name, sentence", [("fit-families.txt", readme_fit_rates),
+                                            ("fit-families-mixed.txt", readme_mixed_rates)])
+def test_the_readme_quotes_the_measured_rates(name, sentence):
+    summary = (ROOT / "docs" / "figures" / name).read_text(encoding="utf-8")
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
-    assert readme_mixed_rates(summary) in readme, readme_mixed_rates(summary)
+    assert sentence(summary) in readme, sentence(summary)
 
 
 def test_a_summary_of_saved_rows_names_the_call_that_made_them(tmp_path):
