@@ -67,7 +67,8 @@ def judge_verdict(truth, named: list[str], unexplained: bool) -> dict:
         kind, true = "control", []
     elif isinstance(truth, list | tuple):
         true = [t for t in truth if t in LIBRARY]
-        kind = "effects" if len(true) == len(truth) else "effect+outside"
+        kind = ("effects" if len(true) == len(truth) else "effect+outside" if true
+                else "outside")
     elif truth in LIBRARY:
         kind, true = "effect", [truth]
     else:

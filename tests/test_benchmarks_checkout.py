@@ -204,6 +204,8 @@ def test_the_mixed_family_is_judged_by_its_library_effect_and_what_remains(monke
     assert not judge_verdict(truth, ["fixture_expansion"], False)["right"]
     assert judge_verdict(truth, ["mount_conduction"], True)["wrong"]
     assert not judge_verdict(truth, [], True)["right"]
+    # causes outside the library alone, however many: an outside run
+    assert judge_verdict(["sensor_drift", "electronics_drift"], [], True)["kind"] == "outside"
     for seed in range(1, 51):
         (effect, cause), _ = bench_families.draw("mixed", seed)
         assert effect in LIBRARY and cause in OUTSIDE
