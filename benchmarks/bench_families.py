@@ -305,9 +305,10 @@ def summary(rows: list[dict]) -> list[str]:
                 lambda r: r["kind"] == "effects")
     out += rate("the library's effect named first, beside a cause outside it",
                 lambda r: r["first"], lambda r: r["kind"] == "effect+outside")
-    out += rate("  ... named alone, and something else said to remain", lambda r: r["right"],
-                lambda r: r["kind"] == "effect+outside")
-    out += rate("  ... something else said to remain, whatever is named",
+    # named as rates of their own: a line "  ... x" is a family's share of the rate above it
+    out += rate("the library's effect named alone, something else said to remain",
+                lambda r: r["right"], lambda r: r["kind"] == "effect+outside")
+    out += rate("something else said to remain, beside a cause outside the library",
                 lambda r: r["unexplained"], lambda r: r["kind"] == "effect+outside")
     out += _beside_lines(rows)
     out += rate("the verdict right as a whole", lambda r: r["right"], lambda r: True)

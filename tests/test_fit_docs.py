@@ -270,7 +270,8 @@ def readme_mixed_rates(summary: str) -> str:
     docs/figures/fit-families-mixed.txt."""
     wk, wn, _, _, _ = _rate(summary, "a wrong effect named (any run)")
     fk, fn, _, _, _ = _rate(summary, "the library's effect named first, beside a cause outside it")
-    uk, un, _, _, _ = _rate(summary, "  ... something else said to remain, whatever is named")
+    uk, un, _, _, _ = _rate(summary, "something else said to remain, beside a cause outside the "
+                                     "library")
     assert wn == fn == un
     return (f"On {fn} runs that hold a library effect and a cause outside it together, it named "
             f"a wrong cause on {wk}, the library's effect first on {fk}, and said that something "
