@@ -216,6 +216,52 @@ def test_outside_causes_of_a_window_act_only_in_it(tmp_path, spl):
     assert np.nanmean(draft.columns["T1_C"][late] - clean.columns["T1_C"][late]) > 0.1
 
 
+def test_a_rising_rotor_loss_moves_heat_and_leaves_the_power(tmp_path, spl):
+    """compare.synth.losslaw's rotor_loss_rise: at a speed n the rotor gains share_rise (n /
+    6000 rpm)^2 of the motor's no-load loss at n from the stator, whatever the load, and at
+    standstill nothing; the two sources' sum is unchanged to round-off (1e-9 of the loss), and
+    so is the logged power (the same seed gives the same power column): the loss moved, it
+    did not grow. The stator warms less and the shaft (P1 grows with the rotor's heat) more
+    than on the clean run."""
+    from compare.synth.bench import synth
+    from compare.synth.losslaw import LOSS_LAWS, RISE_AT_RPM
+    from spindle.bench import read_bench
+    from spindle.drive import cycle_load_case, spindle_cycle
+
+    spec, drive = spl
+    case = cycle_load_case(spec, spindle_cycle(spec, "random-loaded", 3), drive)
+    moved, extra = LOSS_LAWS["rotor_loss_rise"].synth_case(case, spec, {"share_rise": 0.3})
+    assert extra == {}
+    t = np.linspace(0.0, case.duration_s, 4001)
+    n = np.asarray(case.speed_rpm(t + 1e-6))
+    before = {k: np.asarray(case.sources[k](t + 1e-6)) for k in ("rotor", "stator")}
+    after = {k: np.asarray(moved.sources[k](t + 1e-6)) for k in ("rotor", "stator")}
+    total = before["rotor"] + before["stator"]
+    np.testing.assert_allclose(after["rotor"] + after["stator"], total,
+                               atol=1e-9 * total.max())
+    no_load = np.array([sum(drive.heat_W(float(v), 0.0, None)[k] for k in ("rotor", "stator"))
+                        for v in n])
+    expected = np.minimum(0.3 * (n / RISE_AT_RPM) ** 2 * no_load, before["stator"])
+    np.testing.assert_allclose(after["rotor"] - before["rotor"], expected,
+                               atol=1e-9 * total.max())
+    assert np.all(after["rotor"][n == 0.0] == before["rotor"][n == 0.0])
+
+    cycle = tmp_path / "c.toml"
+    cycle.write_text('[cycle]\nname = "c"\ndescription = "2 h"\nsource = "test"\n'
+                     'steps = [ { speed_rpm = 6000.0, duration_h = 2.0 } ]\n'
+                     '[ambient]\nT_C = 20.0\n[coolant]\nT_C = 20.0\n')
+    runs = {}
+    for name in ("clean", "rotor_loss_rise"):
+        synth(spec, str(cycle), name, 3, tmp_path / f"{name}.csv", level=0,
+              truths={"rotor_loss_rise": {"share_rise": 0.3}})
+        runs[name] = read_bench(tmp_path / f"{name}.csv")
+    clean, law = runs["clean"], runs["rotor_loss_rise"]
+    np.testing.assert_array_equal(law.columns["power_kW"], clean.columns["power_kW"])
+    late = clean.time_s > 3600.0
+    assert np.nanmean(law.columns["T_stator_C"][late] - clean.columns["T_stator_C"][late]) < 0
+    assert np.nanmean(law.columns["P1_um"][late] - clean.columns["P1_um"][late]) > 0
+
+
 def test_log_on_change_reports_by_exception(tmp_path):
     """The on-change logger of the drawn runs: a channel that holds still reports on its
     heartbeat only, one that moves reports each time it leaves its dead band, a scan where

@@ -17,11 +17,12 @@ if TYPE_CHECKING:
 def _cmd_synth(args: argparse.Namespace, progress: Progress) -> int:
     from compare.fit.effects import LIBRARY
     from compare.synth.bench import synth
+    from compare.synth.losslaw import LOSS_LAWS
     from compare.synth.outside import OUTSIDE
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
-    known = [*LIBRARY, "clean", *OUTSIDE]
+    known = [*LIBRARY, "clean", *OUTSIDE, *LOSS_LAWS]
     bad = [e for e in args.effect if e not in known]
     if bad:
         raise InputError("command line", "--effect", f"unknown effect '{bad[0]}'",
@@ -52,6 +53,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     sy = subparsers.add_parser("synth", help="a synthetic bench run from the FEM reference with one "
                         "effect injected; the truth goes to RUN.truth.json")
     from compare.fit.effects import LIBRARY
+    from compare.synth.losslaw import LOSS_LAWS
     from compare.synth.outside import OUTSIDE
 
     sy.add_argument("--spec", default="spl2782",
@@ -65,7 +67,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     sy.add_argument("--effect", default=["clean"], nargs="+", metavar="EFFECT",
                     help="effects to inject, together: clean (none, the default), the fit's "
                          f"library ({', '.join(LIBRARY)}) or causes outside it "
-                         f"({', '.join(OUTSIDE)}, which fit should report unexplained)")
+                         f"({', '.join(OUTSIDE)}, which fit should report unexplained) or "
+                         f"loss laws the spec lacks ({', '.join(LOSS_LAWS)}, for which fit "
+                         "should name nothing)")
     sy.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0,
                     help="random seed: the effect's magnitude, the noise and sampling, and "
                          "with --mismatch or a random cycle their draws (default 0)")

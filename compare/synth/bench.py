@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from compare.fit.effects import LIBRARY
+from compare.synth.losslaw import LOSS_LAWS
 from compare.synth.outside import OUTSIDE
 from spindle.loads import LoadCase
 from spindle.spec import Spec
@@ -36,12 +37,13 @@ NOISE = {"T1_C": (0.03, 0.01), "T2_C": (0.03, 0.01), "T_stator_C": (0.1, 0.1),
 
 
 def kind_of(name: str):
-    """The effect (library) or the cause outside it of a synthetic run's ``name``."""
-    if name in LIBRARY:
-        return LIBRARY[name]
-    if name in OUTSIDE:
-        return OUTSIDE[name]
-    raise ValueError(f"unknown effect {name!r}: use {', '.join([*LIBRARY, 'clean', *OUTSIDE])}")
+    """The effect (library), the cause outside it or the loss law (compare.synth.losslaw) of
+    a synthetic run's ``name``."""
+    for kinds in (LIBRARY, OUTSIDE, LOSS_LAWS):
+        if name in kinds:
+            return kinds[name]
+    raise ValueError(f"unknown effect {name!r}: use "
+                     f"{', '.join([*LIBRARY, 'clean', *OUTSIDE, *LOSS_LAWS])}")
 
 
 def draw_truth(effect: str, rng: np.random.Generator) -> dict:
