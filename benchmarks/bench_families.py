@@ -18,6 +18,9 @@ effect and its size, the noise and sampling; ``synth --mismatch``):
 - ``two``: two different effects of the library together;
 - ``mixed``: one effect of the library and one cause outside it together (each drawn
   uniformly): the library's effect should be named and something else said to remain;
+- ``losslaw``: no effect, but a loss law the spec lacks (compare.synth.losslaw, drawn
+  uniformly: the rotor's share of the motor losses rising with speed), which the base's one
+  loss split cannot follow: a control (nothing should be named) whose base is off;
 - ``peers``: the peer's runs in the folders of ``--peers`` (a fixed set, each fitted once).
 
 ``--geometry RADIAL AXIAL`` draws the runs from another spindle: the spec's radii times
@@ -66,7 +69,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PEER_RUNS = ROOT / "tests" / "data" / "peer-runs"
 CYCLES = ("random", "random-loaded", "random-ramped-load")
 #: appended in this order: a family's index seeds its draws, so the earlier families' runs stay
-FAMILIES = ("effect", "clean", "outside", "two", "mixed")
+FAMILIES = ("effect", "clean", "outside", "two", "mixed", "losslaw")
 #: the size every effect of the peer's runs has (tests/data/peer-runs/bench-runs-2/README.md:
 #: "every effect moves some channel by at least 1.5 K or 2 um"): the rates are also given on
 #: the drawn runs whose every effect (or cause outside the library) is at least that large
@@ -130,6 +133,7 @@ def draw(family: str, seed: int, spec=None) -> tuple[list[str], str]:
     import numpy as np
 
     from compare.fit.effects import LIBRARY
+    from compare.synth.losslaw import LOSS_LAWS
     from compare.synth.outside import OUTSIDE
 
     def acting(kinds: dict) -> list[str]:
@@ -145,6 +149,8 @@ def draw(family: str, seed: int, spec=None) -> tuple[list[str], str]:
         return [str(x) for x in rng.choice(acting(LIBRARY), size=2, replace=False)], cycle
     if family == "mixed":
         return [str(rng.choice(acting(LIBRARY))), str(rng.choice(acting(OUTSIDE)))], cycle
+    if family == "losslaw":
+        return [str(rng.choice(acting(LOSS_LAWS)))], cycle
     return ["clean"], cycle
 
 
@@ -184,7 +190,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
         sizes = effect_sizes(doc)
         if case.family == "outside":
             truth = "unexplained"
-        elif truth == "clean":
+        elif truth == "clean" or case.family == "losslaw":  # a control: nothing to name
             truth = None
     t_synth = time.perf_counter() - t0
     if synth_only:
@@ -282,10 +288,15 @@ def summary(rows: list[dict]) -> list[str]:
 
     out += rate("true effect named first (runs with an effect)", lambda r: r["first"],
                 lambda r: r["kind"] in ("effect", "effects"))
-    out += rate("nothing named on clean runs", lambda r: not r["named"],
-                lambda r: r["kind"] == "control")
-    out += rate("'unexplained' on clean runs (a false alarm)", lambda r: r["unexplained"],
-                lambda r: r["kind"] == "control")
+    def clean(r: dict) -> bool:  # a control whose spindle follows the spec's loss laws
+        return r["kind"] == "control" and r["family"] != "losslaw"
+
+    out += rate("nothing named on clean runs", lambda r: not r["named"], clean)
+    out += rate("'unexplained' on clean runs (a false alarm)", lambda r: r["unexplained"], clean)
+    out += rate("nothing named, a loss law the spec lacks", lambda r: not r["named"],
+                lambda r: r["family"] == "losslaw")
+    out += rate("'unexplained' beside a loss law the spec lacks", lambda r: r["unexplained"],
+                lambda r: r["family"] == "losslaw")
     out += floor_rate("true effect named first", lambda r: r["first"],
                       lambda r: r["kind"] in ("effect", "effects"))
     out += rate("unexplained, nothing named (runs outside the library)", lambda r: r["right"],

@@ -215,3 +215,29 @@ def test_the_mixed_family_is_judged_by_its_library_effect_and_what_remains(monke
     for r in drawn:
         effects, _ = bench_families.draw(r["family"], int(r["run"].rsplit("-", 1)[1]))
         assert (effects if r["family"] == "two" else effects[0]) == r["truth"], r["run"]
+
+
+def test_the_losslaw_family_is_a_control_drawn_beside_the_others(monkeypatch):
+    """bench_families' ``losslaw`` runs carry no effect but a loss law the spec lacks
+    (compare.synth.losslaw): judged as controls (right is nothing named, whatever the verdict
+    says of the base), and appending the family left the mixed family's draws as its
+    committed rows (docs/figures/fit-families-mixed.json, written before it) record them."""
+    import json
+
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import bench_families
+    from verdicts import judge_verdict
+
+    from compare.synth.losslaw import LOSS_LAWS
+
+    for seed in range(1, 51):
+        (law,), _ = bench_families.draw("losslaw", seed)
+        assert law in LOSS_LAWS
+    assert judge_verdict(None, [], True)["right"] and judge_verdict(None, [], False)["right"]
+    assert judge_verdict(None, ["windage_loss"], False)["wrong"]
+    rows = json.loads((ROOT / "docs" / "figures" / "fit-families-mixed.json")
+                      .read_text("utf-8"))
+    assert rows
+    for r in rows:
+        effects, _ = bench_families.draw("mixed", int(r["run"].rsplit("-", 1)[1]))
+        assert effects == r["truth"], r["run"]
