@@ -20,6 +20,13 @@ by the likelihood they add; the best few are then fitted jointly with the base p
 one Gauss-Newton step (:func:`joint_gain`, compare.fit.linear), as the effects are.
 Its significance is a Monte Carlo test of the scan's largest statistic
 (:func:`scan_threshold`): the same scan on white noise gives the critical value.
+
+Beside the events, something else can be a law of the inputs for the whole run: **a heat
+into the rotor or a bearing rising with speed** as a power of it (:class:`SpeedHeat`, the
+drive supplying it: an amplitude and an exponent), which a motor whose loss split moves with
+speed or a friction law the spec lacks leaves. These are fitted beside the candidates, are
+never named, and an effect the open loop names must be distinct from them as from the
+library's other effects (Criteria.law_rivals).
 """
 
 from __future__ import annotations
@@ -31,8 +38,9 @@ import numpy as np
 
 from compare.fit.calibrate import TOLERANCE, block_index
 from compare.fit.effects import Effect, hypothesis
-from compare.fit.effects.base import spread_heat
+from compare.fit.effects.base import heat_from_motor, spread_heat
 from compare.fit.params import Param
+from spindle.drive_file import FRICTION_REF_RPM
 
 #: the name every competitor hypothesis's label starts with (a report reads it)
 NAME = "something_else"
@@ -66,6 +74,45 @@ class WindowHeat(Effect):
         mid = 0.5 * (g[1:] + g[:-1])
         on = ((mid >= self.t0_s) & (mid < self.t1_s)).astype(float)
         return {**sources_W, NAME: theta["q_else_W"] * on}
+
+
+class SpeedHeat(Effect):
+    """A heat into the first part of ``role`` of q (n / FRICTION_REF_RPM)^k [W], which the
+    drive supplies: a law of the speed for the whole run that no effect of the library
+    explains (a rotor share of the motor losses that moves with speed, a friction law the
+    spec lacks). Windage is one such law, with k = 3 into the rotor; only its signature, the
+    drag in the logged power, tells it from the others."""
+
+    channels = ("T1", "T2", "T_stator", "P1")
+
+    def __init__(self, role: str):
+        self.role = role
+        self.name = f"{NAME}[a heat into the {role} rising with speed]"
+        self.explanation = (f"a heat into the {role} that rises with speed as a power of it, "
+                            "which no effect of the library explains")
+        self.params = (Param("q_law_W", "W", 0.0, 0.0, LAW_MAX_W, f"the heat into the {role} "
+                             f"at {FRICTION_REF_RPM:g} rpm", log=False),
+                       Param("k_law", "-", 2.0, 0.0, 4.0, "its exponent of the speed",
+                             log=False))
+
+    def extend_network(self, net, spec, power_measured):
+        part = next(p for p in net.parts.values() if p.part.role == self.role)
+        spread_heat(net, part.masses, f"law:{self.role}", f"source:law:{self.role}")
+
+    def heat(self, sources_W, theta, inputs):
+        n = np.maximum(np.asarray(inputs.speed_rpm, dtype=float), 0.0)
+        w = theta["q_law_W"] * (n / FRICTION_REF_RPM) ** theta["k_law"]
+        return heat_from_motor(sources_W, f"law:{self.role}", w, inputs.power_kW)
+
+
+#: largest heat [W] of a law at the reference speed: a fifth of the SPL2782's 5 kW losses
+LAW_MAX_W = 1000.0
+#: the laws of the speed, by the role of the part they heat (the parts the drive's heat
+#: reaches first)
+LAWS: dict[str, str] = {r: hypothesis(SpeedHeat(r))
+                        for r in ("rotor", "front_bearing", "rear_bearing")}
+#: where each law's fit starts: a tenth of its range, at the middle exponent
+LAW_START = {"q_law_W": 0.1 * LAW_MAX_W, "k_law": 2.0}
 
 
 @dataclass(frozen=True)

@@ -58,6 +58,7 @@ class Criteria:
     material_peak: float
     open_loop_material_change: bool
     plausible_base_route: bool
+    law_rivals: bool
     cv_blocks: int
     cv_gain: float
     held_out_misfit_unexplained: bool

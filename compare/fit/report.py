@@ -125,6 +125,13 @@ def verdict_lines(doc: dict) -> list[str]:
                       if e["criteria"].get("changes_prediction") is False
                       and e["criteria"].get("restores_plausible_base") else ""))
             lines.append(f"Named: {e['label']}, {vals}. Evidence: {how}.")
+            look = effect_of(e["label"]).look_alike
+            if look and e["route"] != "signature":  # the name holds only so far
+                sig = (doc.get("signatures") or {}).get(e["label"]) or {}
+                lines.append(f"Not told apart: {e['label']} and {look} leave the same mark in "
+                             "the channels, and the signature that tells them apart does not "
+                             "apply to this run"
+                             + (f" ({sig['meaning']})" if sig.get("meaning") else "") + ".")
         if v["unexplained"]:
             lines.append(f"Something else remains: {where}.")
     elif v["kind"] == "unexplained" and v.get("basis") == "held-out misfit":
@@ -159,6 +166,7 @@ def verdict_lines(doc: dict) -> list[str]:
             f"Too small to matter: the likeliest event the library lacks, {se['where']}, is "
             f"significant ({stat}) but moves no channel by more than "
             f"{h['peak_tolerances']:.2g} tolerances.")
+    lines += _law_lines(doc)
     # one that joined after a withdrawn effect is withdrawn with it and may be named again
     named = {e["label"] for e in doc["effects"]}
     gone = list(dict.fromkeys(c["candidate"] for c in doc.get("candidates", [])
@@ -180,6 +188,29 @@ def verdict_lines(doc: dict) -> list[str]:
                      "every test are the better fit's.")
     lines.append(f"Validation error before -> after: {_change_text(doc)}.")
     return lines
+
+
+def _law_lines(doc: dict) -> list[str]:
+    """Where a law of the speed the library lacks (compare.fit.competitor.SpeedHeat) stopped
+    an effect that fitted, significant and material, a sentence naming the law's fit and the
+    effects it stopped (each round's first)."""
+    stopped: dict[str, list[str]] = {}
+    fitted: dict[str, dict] = {}
+    for c in doc.get("candidates", []):
+        law, crit = c.get("law"), c["criteria"]
+        if (law and crit.get("beats_something_else") is False and crit["significant"]
+                and crit["material"] and c["candidate"] not in stopped.get(law["label"], [])):
+            stopped.setdefault(law["label"], []).append(c["candidate"])
+            fitted.setdefault(law["label"], law["values"])
+    out = []
+    for label, effects in stopped.items():
+        v = fitted[label]
+        what = effect_of(label).explanation.split(" that ")[0]
+        out.append(f"A law the library lacks: {what} as {v['q_law_W']:.0f} W (n / 3000 rpm)^"
+                   f"{v['k_law']:.1f} explains the run better than {', '.join(effects)} by "
+                   "more than one degree of freedom's margin, so "
+                   f"{'it is' if len(effects) == 1 else 'they are'} not named.")
+    return out
 
 
 #: the inputs' names in sentences (compare.fit.run diagnoses the residual against these)

@@ -37,7 +37,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from compare.fit.calibrate import Calibrator, Fit, over_tolerance
-from compare.fit.competitor import Hypothesis, joint_gain, regressors, scan, scan_threshold
+from compare.fit.competitor import (
+    LAW_START,
+    LAWS,
+    Hypothesis,
+    joint_gain,
+    regressors,
+    scan,
+    scan_threshold,
+)
 from compare.fit.criteria import Criteria
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.linear import Local, effect_held_out, fit_effect, local
@@ -231,12 +239,19 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
     judged: list[Judgement] = []
     withdrawn: set[str] = set()
     reg = regressors(cal, base, criteria)
+    roles = {p.role for p in cal.gb.spec.parts}
+    laws = [lab for role, lab in LAWS.items() if role in roles] if criteria.law_rivals else []
     while True:
         loc = local(cal, current)
         rnd = judged[-1].round + 1 if judged else 1
         have = {parse_label(e)[0] for e in current.effects}
         pending = [c for c in candidates if parse_label(c)[0] not in have and c not in withdrawn]
         fits = _fit_candidates(loc, pending, sig, rnd, say)
+        for lab in laws if fits else []:  # rivals of distinct, never judged or named
+            say(f"round {rnd}: fitting {lab}")
+            law = fit_effect(loc, lab, LAW_START)
+            if law is not None:
+                fits[lab] = law
         round_judged = _judge_round(loc, fits, sig, criteria, reg, unknown_inputs, rnd, say)
         judged += round_judged
         qualified = [j for j in round_judged if j.qualifies]
@@ -314,10 +329,19 @@ def _judge_round(loc: Local, fits: Mapping, sig: Mapping[str, object], criteria:
     pen = 0.5 * math.log(max(current.n_eff, 2.0))
     penalised = {lab: f.gain - null.gain - pen * len(effect_of(lab).params)
                  for lab, f in fits.items()}
-    cv_now = loc.rms_by_channel(loc.held_out(criteria.cv_blocks)) if criteria.cv_blocks else None
     margin = criteria.distinct_margin()
+    # something else: the scan's events, or a law of the speed for the whole run (never a
+    # complement: what it explains, no effect of the library needs to). A law nests
+    # windage's, so it stops an effect only where it is better by a significant margin
+    laws = {lab: penalised.pop(lab) for lab in list(penalised) if lab in LAWS.values()}
+    competitor = max([g_gain - 3 * pen, *(v - margin for v in laws.values())])
+    law = max(laws, key=laws.get, default=None)  # the likeliest, where it is the competitor
+    law = law if law is not None and laws[law] - margin >= g_gain - 3 * pen else None
+    cv_now = loc.rms_by_channel(loc.held_out(criteria.cv_blocks)) if criteria.cv_blocks else None
     out = []
     for lab, ef in fits.items():
+        if lab in laws:
+            continue
         near = {other: v for other, v in penalised.items() if other != lab
                 and parse_label(other)[0] != parse_label(lab)[0]
                 and set(_own(other)) & set(_own(lab))}
@@ -326,8 +350,10 @@ def _judge_round(loc: Local, fits: Mapping, sig: Mapping[str, object], criteria:
                 and v + margin > penalised[lab]
                 and complements(loc, ef, fits[other], margin)]
         rival = max((v for other, v in near.items() if other not in comp), default=-math.inf)
-        out.append(judge(loc, ef, sig.get(lab), criteria, penalised[lab], g_gain - 3 * pen,
+        out.append(judge(loc, ef, sig.get(lab), criteria, penalised[lab], competitor,
                          rival, cv_now, rnd, null, comp))
+        if law is not None:
+            out[-1].figures["law"] = {"label": law, "values": fits[law].values}
     return out
 
 

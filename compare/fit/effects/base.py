@@ -69,6 +69,10 @@ class Effect:
     in_conductance: tuple[str, ...] = ()
     #: what the verdict says to look at in the spindle or its spec when the effect is named
     hint: str = ""
+    #: a cause outside the library that leaves the same footprint in the measured channels
+    #: (a clause): the effect is then named only on its signature, which tells the two apart
+    #: (Criteria.look_alike_needs_signature)
+    look_alike: str = ""
     #: acts on the measurement alone (a recorded run can carry it injected: compare.synth.inject)
     measurement_only: bool = False
     #: acts through the coolant, so a spindle needs a coolant film (Spec.liquid_cooled)
@@ -161,6 +165,31 @@ def spread_heat(net, masses, source: str, prefix: str) -> None:
         q = net.network.add(PrescribedHeatFlow(f"{prefix}:{m.name}", source=source,
                                                share=m.block.C_J_K / total))
         net.network.connect(m.block.port, q.port)
+
+
+def heat_from_motor(sources_W: dict[str, np.ndarray], name: str, heat_W: np.ndarray,
+                    power_kW: np.ndarray) -> dict[str, np.ndarray]:
+    """The heat sources [W per interval] with ``heat_W`` into the source ``name``. A heat the
+    drive supplies (a drag) is already in the measured electrical power, which the power
+    balance booked as motor loss: where the power is measured it is taken from the motor
+    sources (stator and rotor in proportion; at most what they hold), so the total heat stays
+    the measured one; where it is not (nan: a cycle's motor model gives the losses) it comes
+    on top."""
+    from spindle.drive_file import MOTOR_SOURCES
+
+    w = np.asarray(heat_W, dtype=float)
+    measured = ~np.isnan(np.asarray(power_kW, dtype=float))
+    motor = [k for k in MOTOR_SOURCES if k in sources_W]
+    out = dict(sources_W)
+    if motor and measured.any():
+        total = sum(sources_W[k] for k in motor)
+        take = np.where(measured, np.minimum(w, total), 0.0)
+        keep = np.divide(total - take, total, out=np.ones_like(total), where=total > 0)
+        for k in motor:
+            out[k] = sources_W[k] * keep
+        w = np.where(measured, take, w)
+    out[name] = w
+    return out
 
 
 def label(effect: str, channel: str | None = None) -> str:

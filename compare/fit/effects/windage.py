@@ -12,10 +12,9 @@ import math
 
 import numpy as np
 
-from compare.fit.effects.base import Effect, spread_heat
+from compare.fit.effects.base import Effect, heat_from_motor, spread_heat
 from compare.fit.params import Param
 from compare.fit.signatures import EventTest
-from spindle.drive_file import MOTOR_SOURCES
 from spindle.loads import TimeSeries
 
 
@@ -30,6 +29,11 @@ class WindageLoss(Effect):
                     "0.5 W/krpm^3; up to a few W with a rough or finned rotor"),)
     hint = ("air friction of the rotor and shaft (the air gap, the rotor's ends, the nose's "
             "labyrinth): a loss the motor model lacks")
+    # the motor supplies windage's drag, so the logged power holds it; a loss split that
+    # moves heat into the rotor at speed changes where the heat goes, not how much
+    look_alike = ("a rotor share of the motor losses that rises with speed (eddy currents in "
+                  "the magnets and their sleeve), which heats the rotor as windage does but "
+                  "adds nothing to the logged power")
 
     def extend_network(self, net, spec, power_measured):
         rotor = [p for p in net.parts.values() if p.part.role == "rotor"]
@@ -67,26 +71,10 @@ class WindageLoss(Effect):
 def from_motor(sources_W: dict[str, np.ndarray], c_W_krpm3: float, speed_rpm: np.ndarray,
                power_kW: np.ndarray) -> dict[str, np.ndarray]:
     """The heat sources [W] per interval with a windage loss c (n / 1000 rpm)^3 [W] into the
-    rotor (source ``windage``).
-
-    Windage is a drag torque the motor supplies, so where the electrical power is measured it
-    is already in it: the power balance, which knows no windage, booked it as motor loss. There
-    the windage heat is taken from the motor sources (stator and rotor in proportion; at most
-    what they hold), and the total heat stays the measured one. Where the power is not
-    measured (nan: a cycle's motor model gives the losses) it comes on top."""
+    rotor (source ``windage``), a drag the motor supplies (compare.fit.effects.base.
+    heat_from_motor)."""
     w = c_W_krpm3 * (np.asarray(speed_rpm, dtype=float) / 1000.0) ** 3
-    measured = ~np.isnan(np.asarray(power_kW, dtype=float))
-    motor = [k for k in MOTOR_SOURCES if k in sources_W]
-    out = dict(sources_W)
-    if motor and measured.any():
-        total = sum(sources_W[k] for k in motor)
-        take = np.where(measured, np.minimum(w, total), 0.0)
-        keep = np.divide(total - take, total, out=np.ones_like(total), where=total > 0)
-        for k in motor:
-            out[k] = sources_W[k] * keep
-        w = np.where(measured, take, w)
-    out["windage"] = w
-    return out
+    return heat_from_motor(sources_W, "windage", w, power_kW)
 
 
 def cube_test(segs, criteria, drifting: bool = False) -> EventTest:
