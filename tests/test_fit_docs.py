@@ -56,7 +56,9 @@ def test_the_criteria_rows_are_the_table_the_fit_runs_with():
                                          ("held-out", "fit-families-held-out.txt"),
                                          ("perturb", "perturb-peers.txt"),
                                          ("start", "fit-start.txt"),
-                                         ("mixed", "fit-families-mixed.txt")])
+                                         ("mixed", "fit-families-mixed.txt"),
+                                         ("losslaw", "fit-families-losslaw.txt"),
+                                         ("trade-law-rivals", "fit-trade-law-rivals.txt")])
 def test_the_generalisation_figures_are_the_benchmarks_file(block, name):
     generated = (ROOT / "docs" / "figures" / name).read_text(encoding="utf-8")
     block = _block(block).strip()
@@ -278,7 +280,23 @@ def readme_mixed_rates(summary: str) -> str:
             f"else remains on {uk}")
 
 
+def readme_losslaw_rates(summary: str) -> str:
+    """The README's sentence on runs with a loss law the spec lacks, from
+    docs/figures/fit-families-losslaw.txt and the same runs' rows fitted without the laws
+    (fit-families-losslaw-without-laws.json)."""
+    import json
+
+    wk, wn, _, _, _ = _rate(summary, "a wrong effect named (any run)")
+    before = json.loads((ROOT / "docs" / "figures" / "fit-families-losslaw-without-laws.json")
+                        .read_text(encoding="utf-8"))
+    assert len(before) == int(wn)
+    return (f"On {wn} runs from spindles whose motor's loss split moves with speed, a law no "
+            f"spec states, it named a wrong cause on {wk} (on {sum(r['wrong'] for r in before)}"
+            " before it weighed such laws as something else;")
+
+
 @pytest.mark.parametrize("name, sentence", [("fit-families.txt", readme_fit_rates),
+                                            ("fit-families-losslaw.txt", readme_losslaw_rates),
                                             ("fit-families-mixed.txt", readme_mixed_rates)])
 def test_the_readme_quotes_the_measured_rates(name, sentence):
     summary = (ROOT / "docs" / "figures" / name).read_text(encoding="utf-8")
@@ -562,3 +580,38 @@ def test_the_readmes_clause_on_mixed_runs_holds():
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     assert "it more often names nothing than the effect" in readme
     assert sum(not r["named"] for r in rows) > sum(bool(r["first"]) for r in rows)
+
+
+def test_the_law_rivals_trade_reads_as_measured():
+    """docs/fit.md "A motor whose loss split moves with speed": its prose on the trade, against
+    docs/figures/fit-trade-law-rivals.txt (per family: the runs fitted without and with the
+    laws, and every run whose verdict moved)."""
+    text = (ROOT / "docs" / "figures" / "fit-trade-law-rivals.txt").read_text("utf-8")
+    moved = re.findall(r"^  (\S+) .* right (True|False) -> (True|False)$", text, re.M)
+    elsewhere = [run for run, _, _ in moved if not run.startswith("losslaw-")]
+    assert elsewhere == ["two-6"]
+    wrong = re.search(r"^losslaw +(\d+) runs .* wrong (\d+) -> (\d+) ", text, re.M).groups()
+    runs = {f: int(n) for f, n in re.findall(r"^(\w+) +(\d+) runs", text, re.M) if f != "all"}
+    prose = " ".join((ROOT / "docs" / "fit.md").read_text(encoding="utf-8").split())
+    assert (f"the wrong names fall from {wrong[1]} to {wrong[2]} of {wrong[0]}") in prose
+    others = runs["effect"] + runs["clean"] + runs["outside"] + runs["peers"]
+    assert (f"No verdict moved on the main set's {others} other runs, the peer's "
+            f"{runs['peers']} among them, nor on the {runs['mixed']} mixed runs.") in prose
+
+
+def test_the_probes_beside_the_law_rivals_read_as_measured():
+    """docs/fit.md's two mends not adopted, against their figures files: windage only on its
+    signature (wrong names on the runs that hold a windage loss) and a rotor share that moves
+    with speed in the base (verdicts moved, of the runs fitted)."""
+    import json
+
+    figures = ROOT / "docs" / "figures"
+    told = json.loads((figures / "fit-probe-told-apart.json").read_text("utf-8"))["rows"]
+    share = json.loads((figures / "fit-probe-rotor-share-exponent.json").read_text("utf-8"))
+    moved = [r for r in share["rows"] if (r["named_before"], r["verdict_before"])
+             != (r["named_after"], r["verdict_after"])]
+    prose = " ".join((ROOT / "docs" / "fit.md").read_text(encoding="utf-8").split())
+    assert (f"on {len(told)} runs that hold a windage loss, a preload or a lag of P1 took up "
+            f"its heat on {sum(r['wrong_after'] for r in told)}") in prose
+    assert f"on {len(moved)} of {len(share['rows'])} runs" in prose
+    assert all(r["truth"] in ("windage_loss", "coolant_dynamics") for r in moved)
