@@ -24,9 +24,9 @@ Its significance is a Monte Carlo test of the scan's largest statistic
 Beside the events, something else can be a law of the inputs for the whole run: **a heat
 into the rotor or a bearing rising with speed** as a power of it (:class:`SpeedHeat`, the
 drive supplying it: an amplitude and an exponent), which a motor whose loss split moves with
-speed or a friction law the spec lacks leaves. These are fitted beside the candidates, are
-never named, and an effect the open loop names must be distinct from them as from the
-library's other effects (Criteria.law_rivals).
+speed or a friction law the spec lacks leaves. These are fitted beside the candidates and
+never named; one that explains the run better than a candidate by the distinct margin is the
+something else the candidate does not beat (Criteria.law_rivals).
 """
 
 from __future__ import annotations

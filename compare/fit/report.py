@@ -192,8 +192,8 @@ def verdict_lines(doc: dict) -> list[str]:
 
 def _law_lines(doc: dict) -> list[str]:
     """Where a law of the speed the library lacks (compare.fit.competitor.SpeedHeat) stopped
-    an effect that fitted, significant and material, a sentence naming the law's fit and the
-    effects it stopped (each round's first)."""
+    an effect that fitted, significant and material, a sentence naming the law's fit (as
+    first fitted) and the effects it stopped."""
     stopped: dict[str, list[str]] = {}
     fitted: dict[str, dict] = {}
     for c in doc.get("candidates", []):

@@ -14,7 +14,8 @@ is docs/fit.md, step 4):
   name an effect the fit does not want on its signature alone); one that applies and is not
   vetoes the effect on both routes;
 - or **the open loop**, where none applies: ``predicts`` (blocked cross-validation),
-  ``beats_something_else`` (BIC), ``distinct`` from every alternative on its channels
+  ``beats_something_else`` (BIC; the scan's events and the laws of the speed,
+  compare.fit.competitor.SpeedHeat), ``distinct`` from every alternative on its channels
   (:func:`complements` are none), and :func:`model_changes`.
 
 One qualifying candidate joins the model (:func:`joins_first`: a signature's before the open
@@ -247,7 +248,7 @@ def select(cal: Calibrator, base: Fit, candidates: Sequence[str], criteria: Crit
         have = {parse_label(e)[0] for e in current.effects}
         pending = [c for c in candidates if parse_label(c)[0] not in have and c not in withdrawn]
         fits = _fit_candidates(loc, pending, sig, rnd, say)
-        for lab in laws if fits else []:  # rivals of distinct, never judged or named
+        for lab in laws if fits else []:  # something else: never judged or named
             say(f"round {rnd}: fitting {lab}")
             law = fit_effect(loc, lab, LAW_START)
             if law is not None:
