@@ -264,9 +264,10 @@ def test_the_verdict_says_which_law_stopped_which_effects():
                           cand("mount_conduction", significant=False),
                           cand("fixture_expansion", beats=True), cand("windage_loss")]}
     said = [x for x in verdict_lines(doc) if x.startswith("A law the library lacks")]
-    assert said == ["A law the library lacks: a heat into the rotor as 52 W (n / 3000 rpm)^3.6 "
-                    "explains the run better than windage_loss, bearing_preload by more than "
-                    "one degree of freedom's margin, so they are not named."]
+    assert said == ["A law the library lacks, a heat into the rotor of 52 W (n / 3000 "
+                    "rpm)^3.6, explains the run better than these 2 effects of the library, by "
+                    "more than one degree of freedom's margin, so none is named for it: "
+                    "windage_loss, bearing_preload."]
 
 
 def test_a_held_out_misfit_with_nothing_named_is_unexplained_and_says_where():
@@ -699,8 +700,8 @@ def test_an_open_loop_name_with_a_look_alike_says_what_it_is_not_told_apart_from
     lines = verdict_lines(doc("windage_loss", "open loop"))
     assert lines[1] == ("Not told apart: windage_loss and "
                         f"{LIBRARY['windage_loss'].look_alike} leave the same mark in the "
-                        "channels, and the signature that tells them apart does not apply to "
-                        "this run (the n^3 term (not applicable)).")
+                        "channels; its signature tells them apart and does not apply to this "
+                        "run: the n^3 term (not applicable).")
     for label, route in (("windage_loss", "signature"), ("mount_conduction", "open loop")):
         assert not any(x.startswith("Not told apart") for x in verdict_lines(doc(label, route)))
 

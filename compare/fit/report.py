@@ -129,9 +129,9 @@ def verdict_lines(doc: dict) -> list[str]:
             if look and e["route"] != "signature":  # the name holds only so far
                 sig = (doc.get("signatures") or {}).get(e["label"]) or {}
                 lines.append(f"Not told apart: {e['label']} and {look} leave the same mark in "
-                             "the channels, and the signature that tells them apart does not "
-                             "apply to this run"
-                             + (f" ({sig['meaning']})" if sig.get("meaning") else "") + ".")
+                             "the channels; its signature tells them apart and does not apply "
+                             "to this run" + (f": {sig['meaning']}" if sig.get("meaning") else "")
+                             + ".")
         if v["unexplained"]:
             lines.append(f"Something else remains: {where}.")
     elif v["kind"] == "unexplained" and v.get("basis") == "held-out misfit":
@@ -206,10 +206,12 @@ def _law_lines(doc: dict) -> list[str]:
     for label, effects in stopped.items():
         v = fitted[label]
         what = effect_of(label).explanation.split(" that ")[0]
-        out.append(f"A law the library lacks: {what} as {v['q_law_W']:.0f} W (n / 3000 rpm)^"
-                   f"{v['k_law']:.1f} explains the run better than {', '.join(effects)} by "
-                   "more than one degree of freedom's margin, so "
-                   f"{'it is' if len(effects) == 1 else 'they are'} not named.")
+        out.append(f"A law the library lacks, {what} of {v['q_law_W']:.0f} W (n / 3000 "
+                   f"rpm)^{v['k_law']:.1f}, explains the run better than "
+                   f"{'this effect' if len(effects) == 1 else f'these {len(effects)} effects'}"
+                   " of the library, by more than one degree of freedom's margin, so "
+                   f"{'it is' if len(effects) == 1 else 'none is'} named for it: "
+                   f"{', '.join(effects)}.")
     return out
 
 

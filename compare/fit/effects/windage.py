@@ -32,8 +32,7 @@ class WindageLoss(Effect):
     # the motor supplies windage's drag, so the logged power holds it; a loss split that
     # moves heat into the rotor at speed changes where the heat goes, not how much
     look_alike = ("a rotor share of the motor losses that rises with speed (eddy currents in "
-                  "the magnets and their sleeve), which heats the rotor as windage does but "
-                  "adds nothing to the logged power")
+                  "the magnets and their sleeve)")
 
     def extend_network(self, net, spec, power_measured):
         rotor = [p for p in net.parts.values() if p.part.role == "rotor"]
