@@ -594,6 +594,9 @@ def test_the_law_rivals_trade_reads_as_measured():
     runs = {f: int(n) for f, n in re.findall(r"^(\w+) +(\d+) runs", text, re.M) if f != "all"}
     prose = " ".join((ROOT / "docs" / "fit.md").read_text(encoding="utf-8").split())
     assert (f"the wrong names fall from {wrong[1]} to {wrong[2]} of {wrong[0]}") in prose
+    held = (ROOT / "docs" / "figures" / "fit-trade-law-rivals-held-out.txt").read_text("utf-8")
+    h = re.search(r"^losslaw +(\d+) runs .* wrong (\d+) -> (\d+) ", held, re.M).groups()
+    assert f"the wrong names fall from {h[1]} to {h[2]} of {h[0]}." in prose
     others = runs["effect"] + runs["clean"] + runs["outside"] + runs["peers"]
     assert (f"No verdict moved on the main set's {others} other runs, the peer's "
             f"{runs['peers']} among them, nor on the {runs['mixed']} mixed runs.") in prose
