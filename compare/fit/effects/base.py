@@ -29,6 +29,7 @@ import numpy as np
 
 from compare.fit.params import Param
 from lumped.blocks import PrescribedHeatFlow
+from spindle.drive_file import MOTOR_SOURCES
 
 if TYPE_CHECKING:
     from spindle.loads import LoadCase
@@ -69,9 +70,9 @@ class Effect:
     in_conductance: tuple[str, ...] = ()
     #: what the verdict says to look at in the spindle or its spec when the effect is named
     hint: str = ""
-    #: a cause outside the library that leaves the same footprint in the measured channels
-    #: (a clause): the effect is then named only on its signature, which tells the two apart
-    #: (Criteria.look_alike_needs_signature)
+    #: a cause outside the library that leaves the same mark in the measured channels (a noun
+    #: phrase): where the open loop names the effect, the verdict says the two are not told
+    #: apart there (its signature, where it applies, tells them apart)
     look_alike: str = ""
     #: acts on the measurement alone (a recorded run can carry it injected: compare.synth.inject)
     measurement_only: bool = False
@@ -175,8 +176,6 @@ def heat_from_motor(sources_W: dict[str, np.ndarray], name: str, heat_W: np.ndar
     sources (stator and rotor in proportion; at most what they hold), so the total heat stays
     the measured one; where it is not (nan: a cycle's motor model gives the losses) it comes
     on top."""
-    from spindle.drive_file import MOTOR_SOURCES
-
     w = np.asarray(heat_W, dtype=float)
     measured = ~np.isnan(np.asarray(power_kW, dtype=float))
     motor = [k for k in MOTOR_SOURCES if k in sources_W]
