@@ -17,10 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from compare.fit.calibrate import TOLERANCE, Fit, at_bound, over_tolerance, parameters_table
+from compare.fit.competitor import LAWS
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.params import BASE_PARAMS, base_params, default_theta
 from compare.report import html_figure, html_page, html_table
 from spindle.drive import drive_for
+from spindle.drive_file import FRICTION_REF_RPM
 from spindle.outputs import jsonable
 from spindle.tolerances import edge_absolute, edge_scale, edge_unit
 
@@ -202,11 +204,12 @@ def _law_lines(doc: dict) -> list[str]:
                 and crit["material"] and c["candidate"] not in stopped.get(law["label"], [])):
             stopped.setdefault(law["label"], []).append(c["candidate"])
             fitted.setdefault(law["label"], law["values"])
+    role = {lab: r for r, lab in LAWS.items()}
     out = []
     for label, effects in stopped.items():
         v = fitted[label]
-        what = effect_of(label).explanation.split(" that ")[0]
-        out.append(f"A law the library lacks, {what} of {v['q_law_W']:.0f} W (n / 3000 "
+        out.append(f"A law the library lacks, a heat into the {role[label]} of "
+                   f"{v['q_law_W']:.0f} W (n / {FRICTION_REF_RPM:g} "
                    f"rpm)^{v['k_law']:.1f}, explains the run better than "
                    f"{'this effect' if len(effects) == 1 else f'these {len(effects)} effects'}"
                    " of the library, by more than one degree of freedom's margin, so "

@@ -20,11 +20,12 @@ from __future__ import annotations
 import numpy as np
 
 from compare.fit.effects.base import Effect
+from spindle.cycles import RANDOM_MAX_SPEED_RPM
 from spindle.loads import TimeSeries
 
-#: the speed [rpm] at which the drawn rise of the rotor's share is reached: the family's
-#: cycles run up to 6000-8000 rpm
-RISE_AT_RPM = 6000.0
+#: the speed [rpm] at which the drawn rise of the rotor's share is reached: the drawn cycles'
+#: top speed
+RISE_AT_RPM = RANDOM_MAX_SPEED_RPM
 
 
 def _motor_source(spec, role: str) -> str:
