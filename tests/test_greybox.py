@@ -239,6 +239,34 @@ def test_effects_through_the_coolant_are_not_tried_on_an_air_cooled_spindle(tmp_
     assert "leave coolant_dynamics out" in capsys.readouterr().err
 
 
+def test_heat_moved_into_a_rotor_needs_a_rotor_source(tmp_path, capsys):
+    """windage_loss and rotor_loss_rise put their synthetic heat on the source of the part
+    whose role is rotor (and the loss law takes it from the stator's): on a spec whose rotor
+    loss sits on the shaft synth had ended with an internal error (an empty list indexed, a
+    StopIteration); now it refuses them with exit 2 before any work, nothing written. The fit
+    still tries windage there (it heats the rotor part's masses, which the spec has)."""
+    from compare.synth.losslaw import LOSS_LAWS
+
+    text = (Path(__file__).resolve().parents[1] / "spindle" / "data" / "specs"
+            / "spl2782.toml").read_text("utf-8")
+    moved = text.replace('name = "rotor"\npart = "rotor"', 'name = "rotor"\npart = "shaft"')
+    assert moved != text
+    spec_file = tmp_path / "rotor-on-shaft.toml"
+    spec_file.write_text(moved, encoding="utf-8")
+    spec = load_spec(spec_file)
+    assert not LIBRARY["windage_loss"].missing_in(spec)  # the fit's candidate stays
+    run = tmp_path / "run.csv"
+    for effect in ("windage_loss", *LOSS_LAWS):
+        assert LIBRARY.get(effect, LOSS_LAWS.get(effect)).missing_in(spec, synth=True)
+        assert main(["synth", "--spec", str(spec_file), "--effect", effect, "--out",
+                     str(run)]) == 2
+        err = capsys.readouterr().err
+        assert f'{effect} needs a heat source on a part with role = "rotor"' in err
+        assert "choose another effect" in err and not run.exists()
+    assert not any(e.missing_in(load_spec("spl2782"), synth=True)
+                   for e in {**LIBRARY, **LOSS_LAWS}.values())
+
+
 OWN_SPECS = Path(__file__).resolve().parent / "data" / "own-specs"
 
 

@@ -265,7 +265,7 @@ def synth(spec: Spec, cycle_name: str, effect: str | Sequence[str], seed: int, o
                          "give clean alone, or the effects without it")
     names = [n for n in names if n != "clean"]
     for n in names:
-        lacks = kind_of(n).missing_in(spec)
+        lacks = kind_of(n).missing_in(spec, synth=True)
         if lacks:  # before any work: it would act on nothing, or on a port that is not there
             raise InputError(spec.path, "effect", f"{n} needs {lacks}, which the spec lacks",
                              "choose another effect, or a spec that has it")

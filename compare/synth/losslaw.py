@@ -35,6 +35,7 @@ def _motor_source(spec, role: str) -> str:
 
 class RotorLossRise(Effect):
     name = "rotor_loss_rise"
+    synth_sources = ("rotor", "stator")  # it moves loss from the one to the other
 
     def draw(self, rng):
         """The share of the motor's no-load loss that moves to the rotor at

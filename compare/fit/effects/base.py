@@ -79,12 +79,19 @@ class Effect:
     #: acts through the coolant, so a spindle needs a coolant film (Spec.liquid_cooled)
     needs_coolant: bool = False
 
-    def missing_in(self, spec: Spec) -> str:
+    #: roles of the parts whose heat source its synthetic injection (synth_case) changes
+    synth_sources: tuple[str, ...] = ()
+
+    def missing_in(self, spec: Spec, synth: bool = False) -> str:
         """What the spindle ``spec`` lacks for this effect to act ("" where nothing): one that
         cannot act on a spindle is no candidate of its fit, and no synthetic run of it can
-        carry it."""
+        carry it; with ``synth``, also the heat sources its injection changes."""
         if self.needs_coolant and not spec.liquid_cooled:
             return 'a coolant film (a [[surfaces]] entry with T_ref = "coolant")'
+        roles = {spec.part(h.part).role for h in spec.heat_sources if h.part}
+        lacking = [r for r in (self.synth_sources if synth else ()) if r not in roles]
+        if lacking:
+            return " and ".join(f'a heat source on a part with role = "{r}"' for r in lacking)
         return ""
 
     # ------------------------------------------------------------------ the grey box

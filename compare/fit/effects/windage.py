@@ -29,6 +29,7 @@ class WindageLoss(Effect):
                     "0.5 W/krpm^3; up to a few W with a rough or finned rotor"),)
     hint = ("air friction of the rotor and shaft (the air gap, the rotor's ends, the nose's "
             "labyrinth): a loss the motor model lacks")
+    synth_sources = ("rotor",)  # its synthetic heat rides on the rotor's source
     # the motor supplies windage's drag, so the logged power holds it; a loss split that
     # moves heat into the rotor at speed changes where the heat goes, not how much
     look_alike = ("a rotor share of the motor losses that rises with speed (eddy currents in "
