@@ -381,6 +381,10 @@ class CrossPeak:
     lag_s: float  # [s]
     ccf: float  # dimensionless, signed
     band: float  # pointwise half-width at the diagnosis' alpha
+    #: the largest |ccf| at lags >= 0 alone (the residual at or after the signal, as a
+    #: response to it can be): its lag [s] and value
+    lag_after_s: float = 0.0
+    ccf_after: float = 0.0
 
     @property
     def beyond_band(self) -> bool:
@@ -388,7 +392,8 @@ class CrossPeak:
 
     def to_dict(self) -> dict[str, Any]:
         return jsonable({"name": self.name, "kind": self.kind, "lag": self.lag, "lag_s": self.lag_s,
-                       "ccf": self.ccf, "band": self.band, "beyond_band": self.beyond_band})
+                       "ccf": self.ccf, "band": self.band, "beyond_band": self.beyond_band,
+                       "lag_after_s": self.lag_after_s, "ccf_after": self.ccf_after})
 
 
 @dataclass(frozen=True)
@@ -404,10 +409,11 @@ class ChannelDiagnostics:
     whiteness: Whiteness
     cross: list[CrossPeak] = field(default_factory=list)
 
-    def best(self, kind: str) -> CrossPeak | None:
-        """The input (``kind="input"``) or signature with the largest |ccf|, None if none."""
+    def best(self, kind: str, after: bool = False) -> CrossPeak | None:
+        """The input (``kind="input"``) or signature with the largest |ccf| (``after``: at
+        lags >= 0 alone), None if none."""
         peaks = [c for c in self.cross if c.kind == kind]
-        return max(peaks, key=lambda c: abs(c.ccf)) if peaks else None
+        return max(peaks, key=lambda c: abs(c.ccf_after if after else c.ccf)) if peaks else None
 
     def to_dict(self) -> dict[str, Any]:
         return jsonable({"name": self.name, "n": self.n, "rmse": self.rmse, "max_abs": self.max_abs,
@@ -499,7 +505,9 @@ def diagnose(residuals: Mapping[str, Any], dt_s: float,
                     continue  # a constant input (a run at standstill) follows no residual
                 ls, cc, band = cross_correlation(a, x, max_lag, alpha, detrend)
                 lag, val = peak_lag(ls, cc)
-                cross.append(CrossPeak(sname, kind, lag, lag * dt_s, val, band))
+                lag_after, val_after = peak_lag(ls[ls >= 0], cc[ls >= 0])
+                cross.append(CrossPeak(sname, kind, lag, lag * dt_s, val, band,
+                                       lag_after * dt_s, val_after))
         except ValueError as e:
             raise ValueError(f"channel {name}: {e}") from e
         channels[name] = ChannelDiagnostics(name, int(s["n"]), float(s["rmse"]), float(s["max"]),

@@ -327,6 +327,38 @@ def test_an_unexplained_verdict_says_which_channel_and_which_input():
     assert residual_place(rep)["rms_tolerances"] < 0.1
 
 
+def test_a_residual_that_leads_an_input_is_not_said_to_follow_it():
+    """The input named in "unexplained, where" is the largest cross-correlation at lags >= 0
+    (compare.residuals.CrossPeak.ccf_after): a residual that leads an input is no response to
+    it. The verdict had said "follows the speed most closely (127 min before it)" on a
+    coolant-flow drop (outside-2). Here T2's residual is the speed's step two hours early: the
+    diagnostics' peak over both signs stays at -120 min for the residual table, and the
+    verdict's sentence names no input at a negative lag."""
+    from types import SimpleNamespace
+
+    from compare.fit.calibrate import TOLERANCE
+    from compare.fit.report import place_text, residual_place
+    from compare.residuals import diagnose
+
+    g = np.arange(0.0, 8 * 3600.0 + 1.0, 60.0)
+    speed = np.where((g >= 4 * 3600.0) & (g < 5 * 3600.0), 4000.0, 0.0)
+    rng = np.random.default_rng(1)
+    residual = {"T2": np.where((g >= 2 * 3600.0) & (g < 3 * 3600.0), 2.0, 0.0)
+                + 0.05 * rng.standard_normal(len(g))}
+    diag = diagnose(residual, 60.0, {"speed": speed}, alpha=0.01)
+    peak = diag.channels["T2"].best("input")
+    assert peak.lag_s == -7200.0 and peak.ccf > 0.9  # both signs: the residual leads
+    assert peak.lag_after_s >= 0.0 and abs(peak.ccf_after) < 0.5 * peak.ccf
+    measured = SimpleNamespace(grid_s=g, values={"T2": residual["T2"] * TOLERANCE["T2"]},
+                               mask=lambda c, w: g >= 0.0)
+    rep = SimpleNamespace(measured=measured, channels=["T2"], diagnostics_after=diag,
+                          selection=SimpleNamespace(final=SimpleNamespace(
+                              model={"T2": np.zeros(len(g))})))
+    place = residual_place(rep, 2 * 3600.0, 3 * 3600.0)
+    assert place["lag_s"] is None or place["lag_s"] >= 0.0
+    assert "before it" not in place_text(place)
+
+
 def test_something_else_is_not_looked_for_where_the_inputs_are_not_known():
     """A logging gap with an operating change inside: what ran in the gap is a guess until the
     response to it has settled, so the rows from the gap's start to an hour after its end

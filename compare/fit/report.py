@@ -226,7 +226,8 @@ def residual_place(rep, t0_s: float | None = None, t1_s: float | None = None) ->
     """Where the final model's residual lives: the channel whose RMS in tolerances is largest
     over [t0, t1) [s] (default: the validation window), that RMS, and the input its residual
     follows most closely over the whole run (the largest cross-correlation of the residual
-    diagnostics, with its lag [s]). None where no channel has samples there."""
+    diagnostics at lags >= 0, with its lag [s]: a residual that leads an input is no response
+    to it). None where no channel has samples there."""
     m, final = rep.measured, rep.selection.final
     g = m.grid_s
     if t0_s is None:
@@ -240,9 +241,9 @@ def residual_place(rep, t0_s: float | None = None, t1_s: float | None = None) ->
     c = max(rms, key=rms.get)
     out = {"channel": c, "rms_tolerances": rms[c], "input": None, "lag_s": None, "ccf": None}
     diag = rep.diagnostics_after.channels.get(c)
-    peak = diag.best("input") if diag is not None else None
-    if peak is not None and peak.beyond_band:
-        out.update(input=peak.name, lag_s=peak.lag_s, ccf=peak.ccf)
+    peak = diag.best("input", after=True) if diag is not None else None
+    if peak is not None and abs(peak.ccf_after) > peak.band:
+        out.update(input=peak.name, lag_s=peak.lag_after_s, ccf=peak.ccf_after)
     return out
 
 
@@ -254,8 +255,7 @@ def place_text(place: dict | None) -> str:
             "tolerances RMS there)")
     if place["input"]:
         lag = place["lag_s"]
-        when = ("at once" if abs(lag) < 1 else
-                f"{abs(lag) / 60:.0f} min {'after' if lag > 0 else 'before'} it")
+        when = "at once" if lag < 1 else f"{lag / 60:.0f} min after it"
         text += (f" and follows {_INPUT_WORDS.get(place['input'], place['input'])} most "
                  f"closely ({when}, correlation {place['ccf']:+.2f})")
     return text
