@@ -56,6 +56,7 @@ from pathlib import Path
 from verdicts import (
     fit_outcome,
     judge_verdict,
+    located,
     missed_by,
     named_text,
     run_verdicts,
@@ -170,7 +171,8 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
     t0 = time.perf_counter()
     if case.path:
         run, truth = Path(case.path), case.truth
-        sizes = effect_sizes(case.truth_doc or {})
+        truth_doc = case.truth_doc or {}
+        sizes = effect_sizes(truth_doc)
     else:
         effects, cycle = draw(case.family, case.seed, spec)
         run = Path(case.cache) / f"{case.family}-{case.seed}.csv"
@@ -185,9 +187,9 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             if not thinned.exists():
                 log_on_change(run, thinned)
             run = thinned
-        doc = json.loads(sidecar.read_text(encoding="utf-8"))
-        truth = doc["effect"]
-        sizes = effect_sizes(doc)
+        truth_doc = json.loads(sidecar.read_text(encoding="utf-8"))
+        truth = truth_doc["effect"]
+        sizes = effect_sizes(truth_doc)
         if case.family == "outside":
             truth = "unexplained"
         elif truth == "clean" or case.family == "losslaw":  # a control: nothing to name
@@ -220,6 +222,7 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             "fit_s": rep.runtime_s, "synth_s": t_synth, "sizes": sizes,
             "on_change": bool(not case.path and logs_on_change(case.family, case.seed)),
             "at_floor": at_floor(sizes),
+            "located": located(doc, truth_doc),
             **({"geometry": list(case.geometry), "fit_own_spec": case.fit_own_spec}
                if case.geometry and not case.path else {})}
 
@@ -303,6 +306,8 @@ def summary(rows: list[dict]) -> list[str]:
                 lambda r: r["kind"] == "outside")
     out += floor_rate("unexplained, nothing named", lambda r: r["right"],
                       lambda r: r["kind"] == "outside")
+    out += rate("'unexplained' where the cause acts (its event's window meets the cause's)",
+                lambda r: r["located"], lambda r: r.get("located") is not None)
     out += rate("'something else remains' beside a right verdict (a false alarm)",
                 lambda r: r["unexplained"],
                 lambda r: r["right"] and r["kind"] in ("effect", "effects"))
@@ -412,7 +417,8 @@ def main(argv: list[str] | None = None) -> None:
                     help="print (and --summary) the rates of rows saved by --json, fitting "
                     "nothing")
     ap.add_argument("--reports", type=Path,
-                    help="also keep each run's report.json in this folder (named by run)")
+                    help="also keep each run's report.json in this folder (named by run); "
+                    "with --rows, read 'located' off them for rows written without it")
     ap.add_argument("--synth-only", action="store_true",
                     help="only synthesise the drawn runs into the cache (no fits)")
     ap.add_argument("--geometry", nargs=2, type=float, metavar=("RADIAL", "AXIAL"),
@@ -431,12 +437,7 @@ def main(argv: list[str] | None = None) -> None:
                     "round-off decides")
     args = ap.parse_args(argv)
     if args.rows:
-        try:
-            rows = json.loads(args.rows.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as e:
-            print(f"error: --rows {args.rows}: {e}; give a file written by --json")
-            raise SystemExit(2) from None
-        return _report(rows, args, argv)
+        return _from_rows(args, argv)
     if args.runs_per_family < 1:
         ap.error("--runs-per-family: at least 1")
     geometry = tuple(args.geometry or ())
@@ -540,6 +541,38 @@ def _fitting_options(rows: list[dict], per: dict[str, int], args) -> str:
         out += f" --geometry {geometry[0]:g} {geometry[1]:g}"
         out += " --fit-own-spec" if any(r.get("fit_own_spec") for r in rows) else ""
     return out + "".join(f" --criterion {c}" for c in args.criterion)
+
+
+def _from_rows(args, argv: list[str] | None) -> None:
+    """``--rows``: the rates of rows a fitting call saved, fitting nothing (with
+    ``--reports``, :func:`_fill_located` first)."""
+    try:
+        rows = json.loads(args.rows.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as e:
+        print(f"error: --rows {args.rows}: {e}; give a file written by --json")
+        raise SystemExit(2) from None
+    if args.reports:
+        _fill_located(rows, args.reports, args.cache, args.json, args.rows)
+    return _report(rows, args, argv)
+
+
+def _fill_located(rows: list[dict], reports: Path, cache: Path, out: Path | None,
+                  source: Path) -> None:
+    """Rows written before they recorded ``located``: read it off the run's kept report
+    (``--reports``) and the cached truth; with ``--json``, write the rows so filled there
+    (never over the ``--rows`` file read)."""
+    for r in rows:
+        doc, truth = reports / f"{r['run']}.json", cache / f"{r['run']}.truth.json"
+        if "located" not in r and doc.exists() and truth.exists():
+            r["located"] = located(*(json.loads(f.read_text(encoding="utf-8"))
+                                     for f in (doc, truth)))
+    if out is not None:
+        if out.resolve() == source.resolve():
+            print(f"error: --json {out} is the --rows file; write the filled rows elsewhere")
+            raise SystemExit(2)
+        from spindle.outputs import write_json
+
+        write_json(out, rows)
 
 
 def _report(rows: list[dict], args, argv: list[str] | None) -> None:

@@ -39,6 +39,29 @@ def fit_outcome(doc: dict) -> dict:
                                 .items()}}
 
 
+def located(doc: dict, truth_doc: dict) -> bool | None:
+    """Whether the window of an "unexplained" verdict's event (report.json's something_else
+    hypothesis, where the competitor's test made the run unexplained) meets the span [s] over
+    which a cause outside the library in the run's truth acts (compare.synth.outside's
+    ``acts_s``); None where the verdict located no event or no such cause has a span (an
+    electronics drift acts over the whole run)."""
+    from compare.synth.outside import OUTSIDE
+
+    se = doc.get("something_else") or {}
+    h = se.get("hypothesis")
+    if se.get("basis") != "something else" or not h:
+        return None
+    effects = truth_doc.get("effect")
+    params = truth_doc.get("parameters") or {}
+    if isinstance(effects, str):
+        effects, params = [effects], {effects: params}
+    spans = [OUTSIDE[e].acts_s(params[e]) for e in effects or [] if e in OUTSIDE]
+    spans = [s for s in spans if s is not None]
+    if not spans:
+        return None
+    return any(h["t0_s"] < b and h["t1_s"] > a for a, b in spans)
+
+
 def within_tolerances(rmse: dict[str, float]) -> bool:
     """Whether every channel's RMS [K; µm for P1] is within its tolerance."""
     from spindle.tolerances import channel_tolerance, edge_scale

@@ -241,3 +241,39 @@ def test_the_losslaw_family_is_a_control_drawn_beside_the_others(monkeypatch):
     for r in rows:
         effects, _ = bench_families.draw("mixed", int(r["run"].rsplit("-", 1)[1]))
         assert effects == r["truth"], r["run"]
+
+
+def test_an_unexplained_verdict_is_located_where_its_cause_acts(monkeypatch):
+    """benchmarks/verdicts.py ``located``: the window of the event that made a run
+    "unexplained" meets the span over which the truth's cause outside the library acts
+    (compare.synth.outside's ``acts_s``); None where nothing was located (a verdict on the
+    held-out misfit alone) or the cause acts over the whole run. A window cause's span is
+    where its injection is not zero."""
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    from verdicts import located
+
+    from compare.synth.outside import OUTSIDE, _window
+
+    draft = {"start_h": 5.0, "duration_h": 2.0, "delta_K": 6.0}
+    a, b = OUTSIDE["enclosure_draft"].acts_s(draft)
+    t = np.arange(0.0, 16 * 3600.0, 60.0)
+    on = _window(t, 5.0, 2.0) > 0
+    assert a <= t[on][0] and t[on][-1] <= b and not on[(t < a) | (t > b)].any()
+
+    def doc(t0_h, t1_h, basis="something else"):
+        return {"something_else": {"basis": basis, "hypothesis": {
+            "t0_s": t0_h * 3600.0, "t1_s": t1_h * 3600.0}}}
+
+    truth = {"effect": "enclosure_draft", "parameters": draft}
+    assert located(doc(5.5, 7.0), truth) is True
+    assert located(doc(10.0, 12.0), truth) is False
+    assert located(doc(5.5, 7.0, "held-out misfit"), truth) is None
+    drift = {"effect": "electronics_drift", "parameters": {"amplitude_um": 1.0,
+                                                            "period_h": 5.0, "phase": 0.0}}
+    assert located(doc(5.5, 7.0), drift) is None
+    # beside a library effect (the mixed family: parameters by effect); from its start on
+    mixed = {"effect": ["fixture_expansion", "sensor_drift"],
+             "parameters": {"fixture_expansion": {}, "sensor_drift": {
+                 "channel": "T1", "start_h": 9.0, "rate_K_h": 0.5}}}
+    assert located(doc(12.0, 16.0), mixed) is True
+    assert located(doc(2.0, 8.5), mixed) is False

@@ -618,3 +618,18 @@ def test_the_probes_beside_the_law_rivals_read_as_measured():
             f"its heat on {sum(r['wrong_after'] for r in told)}") in prose
     assert f"on {len(moved)} of {len(share['rows'])} runs" in prose
     assert all(r["truth"] in ("windage_loss", "coolant_dynamics") for r in moved)
+
+
+def test_where_an_unexplained_verdict_is_located_reads_as_measured():
+    """docs/fit.md "Against the issue's figures": the share of outside runs whose located
+    event meets the cause's span is the summary's line (benchmarks/verdicts.py ``located``)."""
+    summary = (ROOT / "docs" / "figures" / "fit-families.txt").read_text("utf-8")
+    k, n, *_ = _rate(summary, "'unexplained' where the cause acts (its event's window meets "
+                     "the cause's)")
+    prose = " ".join((ROOT / "docs" / "fit.md").read_text(encoding="utf-8").split())
+    assert f"over which the cause acts (compare.synth.outside's `acts_s`) on {k} of {n};" in prose
+    import json
+
+    rows = json.loads((ROOT / "docs" / "figures" / "fit-families.json").read_text("utf-8"))
+    missed = [r["run"] for r in rows if r.get("located") is False]
+    assert missed == ["outside-19"] and "the one it misses, outside-19," in prose

@@ -16,10 +16,14 @@ which are laws of the inputs:
 - ``coolant_flow_drop``: the coolant flow falls for a few hours (a filter clogging, then
   cleaned): the water warms along the jacket as ``coolant_dynamics`` has it, but only then,
   so no law of the inputs holds for the whole run.
+
+Each says where in the run it acts (``acts_s``), which benchmarks/verdicts.py ``located``
+compares with the window an "unexplained" verdict gives.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -43,8 +47,21 @@ def _draw_window(rng) -> dict:
     return {"start_h": float(rng.uniform(3.0, 10.0)), "duration_h": float(rng.uniform(1.5, 4.0))}
 
 
+class _Windowed(Effect):
+    """A cause that acts during a window of hours (:func:`_draw_window`)."""
+
+    def acts_s(self, truth) -> tuple[float, float] | None:
+        """Where in the run it acts [s]: its window, the closing ramp included."""
+        a = truth["start_h"] * 3600.0
+        return a, a + truth["duration_h"] * 3600.0 + RAMP_S
+
+
 class ElectronicsDrift(Effect):
     name = "electronics_drift"
+
+    def acts_s(self, truth) -> tuple[float, float] | None:
+        """Where in the run it acts [s]: over the whole run, no window (None)."""
+        return None
 
     def draw(self, rng):
         return {"amplitude_um": float(rng.uniform(1.0, 2.0)),
@@ -60,6 +77,10 @@ class ElectronicsDrift(Effect):
 
 class SensorDrift(Effect):
     name = "sensor_drift"
+
+    def acts_s(self, truth) -> tuple[float, float] | None:
+        """Where in the run it acts [s]: from its start on."""
+        return truth["start_h"] * 3600.0, math.inf
 
     def draw(self, rng):
         return {"channel": str(rng.choice(["T1", "T2", "T_stator"])),
@@ -77,6 +98,10 @@ class CoolantSensorOffset(Effect):
     name = "coolant_sensor_offset"
     needs_coolant = True  # without a coolant film the logged coolant drives nothing
 
+    def acts_s(self, truth) -> tuple[float, float] | None:
+        """Where in the run it acts [s]: from its start on."""
+        return truth["start_h"] * 3600.0, math.inf
+
     def draw(self, rng):
         return {"start_h": float(rng.uniform(3.0, 11.0)),
                 "offset_K": float(rng.choice([-1, 1]) * rng.uniform(1.0, 2.5))}
@@ -88,6 +113,11 @@ class CoolantSensorOffset(Effect):
 
 class BearingRunIn(Effect):
     name = "bearing_run_in"
+
+    def acts_s(self, truth) -> tuple[float, float] | None:
+        """Where in the run it acts [s]: from the start to three decay times (the excess is
+        then under 5 % of its first value)."""
+        return 0.0, 3.0 * truth["tau_h"] * 3600.0
 
     def draw(self, rng):
         return {"excess": float(rng.uniform(0.5, 1.2)), "tau_h": float(rng.uniform(1.0, 3.0))}
@@ -116,7 +146,7 @@ class BearingRunIn(Effect):
         return case.with_sources(out), {"power_W": drag}
 
 
-class EnclosureDraft(Effect):
+class EnclosureDraft(_Windowed):
     name = "enclosure_draft"
 
     def draw(self, rng):
@@ -134,7 +164,7 @@ class EnclosureDraft(Effect):
         return replace(case, T_ambient_K=air), {}
 
 
-class CoolantFlowDrop(Effect):
+class CoolantFlowDrop(_Windowed):
     name = "coolant_flow_drop"
     needs_coolant = True
 
