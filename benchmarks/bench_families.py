@@ -40,7 +40,8 @@ share of runs with the right verdict, and the issue's rates with 95 % Wilson int
 true effect named first, nothing named on clean runs, ``unexplained`` and nothing named on
 runs outside the library, a false second effect, a wrong effect named on any run, and the
 validation RMS within the tolerances where the verdict names an effect or says the base is
-adequate; then the fit's time.
+adequate, and where an "unexplained" verdict locates an event, whether its window meets the
+span its cause acts over (verdicts.located); then the fit's time.
 """
 
 from __future__ import annotations
