@@ -637,3 +637,30 @@ def test_where_an_unexplained_verdict_is_located_reads_as_measured():
     k, n, *_ = _rate(mixed, "'unexplained' where the cause acts (its event's window meets "
                      "the cause's)")
     assert f"the window meets the cause's span on {k} of {n}." in prose
+
+
+def test_the_held_out_refit_reads_as_measured():
+    """docs/fit.md "On held-out runs": the verdict that moved, the validation RMS and the
+    located events, against docs/figures/fit-held-out-refit.txt and the held-out summary (the
+    causes of the runs that end "base adequate" are read where the synthetic runs are cached,
+    benchmarks/.families-cache, which a fresh checkout lacks)."""
+    import json
+
+    refit = (ROOT / "docs" / "figures" / "fit-held-out-refit.txt").read_text("utf-8")
+    moved = re.findall(r"^  (\S+) +\[.*\] -> \[.*\]  right", refit, re.M)
+    rms = re.search(r"moved on (\d+) of 100 runs by more than 0.001 .* at most ([\d.]+) ",
+                    refit).groups()
+    summary = (ROOT / "docs" / "figures" / "fit-families-held-out.txt").read_text("utf-8")
+    k, n, *_ = _rate(summary, "'unexplained' where the cause acts (its event's window meets "
+                     "the cause's)")
+    prose = " ".join((ROOT / "docs" / "fit.md").read_text(encoding="utf-8").split())
+    assert moved == ["two-1023"] and "one verdict moved" in prose and "two-1023, a windage" in prose
+    assert f"moved on {rms[0]} runs, by at most {float(rms[1]):.2f}" in prose
+    assert f"made \"unexplained\", the event's window meets the span its cause acts over on {k};" \
+        in prose and f"Of the {n} outside runs" in prose
+    rows = json.loads((ROOT / "docs" / "figures" / "fit-families-held-out.json").read_text())
+    adequate = [r for r in rows if r["family"] == "outside" and r["verdict"] == "base adequate"]
+    drifts = {json.loads((ROOT / "benchmarks" / ".families-cache" / f"{r['run']}.truth.json")
+                         .read_text())["effect"] for r in adequate
+              if (ROOT / "benchmarks" / ".families-cache" / f"{r['run']}.truth.json").exists()}
+    assert len(adequate) == 3 and drifts <= {"electronics_drift"}
