@@ -260,11 +260,14 @@ def readme_fit_rates(summary: str) -> str:
     tk, tn, tp, _, _ = _rate(summary, "true effect named first (runs with an effect)")
     ck, cn, _, _, _ = _rate(summary, "nothing named on clean runs")
     ok, on, op, _, _ = _rate(summary, "unexplained, nothing named (runs outside the library)")
+    lk, ln, _, _, _ = _rate(summary, "'unexplained' where the cause acts (its event's window "
+                            "meets the cause's)")
     assert int(wn) == total
     return (f"On {total} runs drawn from families and the peer's, it named a wrong cause on "
             f"{wk} ({wp} %), the true effect first on {tk} of {tn} ({tp} %), nothing on "
             f"{ck} of {cn} clean runs, and \"unexplained\" on {ok} of {on} runs outside its "
-            f"library ({op} %).")
+            f"library ({op} %). Where it located the cause as an event, the window it gave met "
+            f"the span the cause acts over on {lk} of {ln}.")
 
 
 def readme_mixed_rates(summary: str) -> str:
