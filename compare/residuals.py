@@ -382,9 +382,11 @@ class CrossPeak:
     ccf: float  # dimensionless, signed
     band: float  # pointwise half-width at the diagnosis' alpha
     #: the largest |ccf| at lags >= 0 alone (the residual at or after the signal, as a
-    #: response to it can be): its lag [s] and value
+    #: response to it can be): its lag [s] and value, and whether that lag is the largest
+    #: tried (then the peak lies beyond the range, not at a lag it found)
     lag_after_s: float = 0.0
     ccf_after: float = 0.0
+    after_at_edge: bool = False
 
     @property
     def beyond_band(self) -> bool:
@@ -393,7 +395,8 @@ class CrossPeak:
     def to_dict(self) -> dict[str, Any]:
         return jsonable({"name": self.name, "kind": self.kind, "lag": self.lag, "lag_s": self.lag_s,
                        "ccf": self.ccf, "band": self.band, "beyond_band": self.beyond_band,
-                       "lag_after_s": self.lag_after_s, "ccf_after": self.ccf_after})
+                       "lag_after_s": self.lag_after_s, "ccf_after": self.ccf_after,
+                       "after_at_edge": self.after_at_edge})
 
 
 @dataclass(frozen=True)
@@ -411,8 +414,8 @@ class ChannelDiagnostics:
 
     def best(self, kind: str, after: bool = False) -> CrossPeak | None:
         """The input (``kind="input"``) or signature with the largest |ccf| (``after``: at
-        lags >= 0 alone), None if none."""
-        peaks = [c for c in self.cross if c.kind == kind]
+        lags >= 0 alone, short of the largest lag tried), None if none."""
+        peaks = [c for c in self.cross if c.kind == kind and not (after and c.after_at_edge)]
         return max(peaks, key=lambda c: abs(c.ccf_after if after else c.ccf)) if peaks else None
 
     def to_dict(self) -> dict[str, Any]:
@@ -507,7 +510,7 @@ def diagnose(residuals: Mapping[str, Any], dt_s: float,
                 lag, val = peak_lag(ls, cc)
                 lag_after, val_after = peak_lag(ls[ls >= 0], cc[ls >= 0])
                 cross.append(CrossPeak(sname, kind, lag, lag * dt_s, val, band,
-                                       lag_after * dt_s, val_after))
+                                       lag_after * dt_s, val_after, lag_after == ls.max()))
         except ValueError as e:
             raise ValueError(f"channel {name}: {e}") from e
         channels[name] = ChannelDiagnostics(name, int(s["n"]), float(s["rmse"]), float(s["max"]),

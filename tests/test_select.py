@@ -333,7 +333,8 @@ def test_a_residual_that_leads_an_input_is_not_said_to_follow_it():
     it. The verdict had said "follows the speed most closely (127 min before it)" on a
     coolant-flow drop (outside-2). Here T2's residual is the speed's step two hours early: the
     diagnostics' peak over both signs stays at -120 min for the residual table, and the
-    verdict's sentence names no input at a negative lag."""
+    verdict's sentence names no input at a negative lag. Nor one whose correlation peaks at
+    the largest lag tried ("240 min after it" on outside-2 then): no lag was found there."""
     from types import SimpleNamespace
 
     from compare.fit.calibrate import TOLERANCE
@@ -357,6 +358,14 @@ def test_a_residual_that_leads_an_input_is_not_said_to_follow_it():
     place = residual_place(rep, 2 * 3600.0, 3 * 3600.0)
     assert place["lag_s"] is None or place["lag_s"] >= 0.0
     assert "before it" not in place_text(place)
+    # a step of the residual 3.5 h after the room's: its correlation grows up to the largest
+    # lag tried (a quarter of the 8 h, 2 h), where no peak was found, so the room is not named
+    room = np.where(g >= 3600.0, 1.0, 0.0)
+    late = {"T2": np.where(g >= 4.5 * 3600.0, 1.0, 0.0) + 0.01 * rng.standard_normal(len(g))}
+    rep.diagnostics_after = diagnose(late, 60.0, {"T_env": room}, alpha=0.01)
+    peak = rep.diagnostics_after.channels["T2"].cross[0]
+    assert peak.after_at_edge and peak.lag_after_s == 7200.0 and peak.ccf_after > peak.band
+    assert residual_place(rep, 2 * 3600.0, 3 * 3600.0)["input"] is None
 
 
 def test_something_else_is_not_looked_for_where_the_inputs_are_not_known():

@@ -226,8 +226,9 @@ def residual_place(rep, t0_s: float | None = None, t1_s: float | None = None) ->
     """Where the final model's residual lives: the channel whose RMS in tolerances is largest
     over [t0, t1) [s] (default: the validation window), that RMS, and the input its residual
     follows most closely over the whole run (the largest cross-correlation of the residual
-    diagnostics at lags >= 0, with its lag [s]: a residual that leads an input is no response
-    to it). None where no channel has samples there."""
+    diagnostics at lags >= 0 short of the largest tried, with its lag [s]: a residual that
+    leads an input is no response to it, and a peak at the range's end is no lag found). None
+    where no channel has samples there."""
     m, final = rep.measured, rep.selection.final
     g = m.grid_s
     if t0_s is None:
