@@ -946,3 +946,17 @@ def test_the_criteria_table_shows_a_figure_report_json_could_not_hold_as_not_ava
            "peak_tolerances": None, "criteria": {}, "route": None}
     html = _criteria_html({"candidates": [row]})
     assert html.count("n/a") == 3, html
+
+
+def test_a_heat_beyond_what_a_part_holds_is_read_as_where():
+    """compare.fit.competitor.Hypothesis.text: the scan's amplitudes are not bounded, and a
+    coolant-flow drop reads as "a heat of +5398 W into the cooling_sleeve" (outside-2); beyond
+    Q_MAX_W (a heat no part holds) the sentence says to read the window as where the misfit
+    is, not as a heat. Within it, as before."""
+    from compare.fit.competitor import Q_MAX_W, Hypothesis
+
+    big = Hypothesis("heat", "cooling_sleeve", 19800.0, 25200.0, 5398.0, 30.0, 8.8, 100)
+    small = Hypothesis("heat", "housing", 0.0, 12600.0, 25.0, 9.0, 0.8, 100)
+    assert big.text() == (f"a heat of +5398 W into the cooling_sleeve, 5.5-7.0 h (beyond the "
+                          f"{Q_MAX_W:.0f} W a part could take: read it as where, not as a heat)")
+    assert small.text() == "a heat of +25 W into the housing, 0.0-3.5 h"

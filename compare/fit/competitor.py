@@ -134,7 +134,11 @@ class Hypothesis:
     def text(self) -> str:
         span = f"{self.t0_s / 3600:.1f}-{self.t1_s / 3600:.1f} h"
         if self.kind == "heat":
-            return f"a heat of {self.amplitude:+.0f} W into the {self.where}, {span}"
+            # beyond Q_MAX_W no part holds such a heat: the window says where the misfit is
+            # (a part that something cools less, a reading), not how much heat
+            beyond = (f" (beyond the {Q_MAX_W:.0f} W a part could take: read it as where, not as "
+                      "a heat)" if abs(self.amplitude) > Q_MAX_W else "")
+            return f"a heat of {self.amplitude:+.0f} W into the {self.where}, {span}{beyond}"
         return f"{self.where} off by {self.amplitude:+.2f} tolerances, {span}"
 
 
