@@ -508,7 +508,8 @@ def diagnose(residuals: Mapping[str, Any], dt_s: float,
                     continue  # a constant input (a run at standstill) follows no residual
                 ls, cc, band = cross_correlation(a, x, max_lag, alpha, detrend)
                 lag, val = peak_lag(ls, cc)
-                lag_after, val_after = peak_lag(ls[ls >= 0], cc[ls >= 0])
+                pos = ls >= 0
+                lag_after, val_after = peak_lag(ls[pos], cc[pos])
                 cross.append(CrossPeak(sname, kind, lag, lag * dt_s, val, band,
                                        lag_after * dt_s, val_after, lag_after == ls.max()))
         except ValueError as e:

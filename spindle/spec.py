@@ -175,6 +175,10 @@ class Spec:
     def parts_with_role(self, role: str) -> list[Part]:
         return [p for p in self.parts if p.role == role]
 
+    def sources_with_role(self, *roles: str) -> list[HeatSource]:
+        """The heat sources on parts of any of ``roles``, in the spec's order."""
+        return [h for h in self.heat_sources if h.part and self.part(h.part).role in roles]
+
     def mass_kg(self, part: str, section: str | None = None) -> float:
         return float(sum(self.materials[s.material].rho_kg_m3 * s.volume_m3
                          for s in self.part(part).sections

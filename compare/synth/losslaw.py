@@ -28,11 +28,6 @@ from spindle.loads import TimeSeries
 RISE_AT_RPM = RANDOM_MAX_SPEED_RPM
 
 
-def _motor_source(spec, role: str) -> str:
-    return next(h.name for h in spec.heat_sources
-                if h.part and spec.part(h.part).role == role)
-
-
 class RotorLossRise(Effect):
     name = "rotor_loss_rise"
     synth_sources = ("rotor", "stator")  # it moves loss from the one to the other
@@ -50,7 +45,7 @@ class RotorLossRise(Effect):
         from spindle.drive import drive_for
 
         drive = drive_for(spec)
-        rotor, stator = _motor_source(spec, "rotor"), _motor_source(spec, "stator")
+        rotor, stator = (spec.sources_with_role(r)[0].name for r in ("rotor", "stator"))
         src_r, src_s = case.sources[rotor], case.sources[stator]
         t = np.unique(np.concatenate([np.asarray(src_r.time_s, dtype=float),
                                       np.asarray(src_s.time_s, dtype=float),

@@ -123,8 +123,7 @@ class BearingRunIn(Effect):
         return {"excess": float(rng.uniform(0.5, 1.2)), "tau_h": float(rng.uniform(1.0, 3.0))}
 
     def synth_case(self, case, spec, truth):
-        bearings = [h.name for h in spec.heat_sources
-                    if h.part and spec.part(h.part).role in ("front_bearing", "rear_bearing")]
+        bearings = [h.name for h in spec.sources_with_role("front_bearing", "rear_bearing")]
         a, tau = truth["excess"], truth["tau_h"] * 3600.0
         out = {}
         extra = []

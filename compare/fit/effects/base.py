@@ -88,8 +88,8 @@ class Effect:
         carry it; with ``synth``, also the heat sources its injection changes."""
         if self.needs_coolant and not spec.liquid_cooled:
             return 'a coolant film (a [[surfaces]] entry with T_ref = "coolant")'
-        roles = {spec.part(h.part).role for h in spec.heat_sources if h.part}
-        lacking = [r for r in (self.synth_sources if synth else ()) if r not in roles]
+        lacking = [r for r in (self.synth_sources if synth else ())
+                   if not spec.sources_with_role(r)]
         if lacking:
             return " and ".join(f'a heat source on a part with role = "{r}"' for r in lacking)
         return ""

@@ -119,8 +119,7 @@ def param_of(spec, source: str) -> str:
 def bearing_sources(spec) -> list:
     """The spec's bearing heat sources, in the order the feedback stacks their ring
     differences."""
-    return [h for h in spec.heat_sources
-            if h.part and spec.part(h.part).role in ("front_bearing", "rear_bearing")]
+    return spec.sources_with_role("front_bearing", "rear_bearing")
 
 
 def _k_of(spec, source, truth) -> float:

@@ -56,7 +56,7 @@ class WindageLoss(Effect):
         return {"c_w_W_krpm3": float(rng.uniform(0.6, 1.5))}
 
     def synth_case(self, case, spec, truth):
-        rotor = [h.name for h in spec.heat_sources if h.part and spec.part(h.part).role == "rotor"]
+        rotor = [h.name for h in spec.sources_with_role("rotor")]
         src = case.sources[rotor[0]]
         t = np.asarray(src.time_s)
         c = truth["c_w_W_krpm3"]
