@@ -277,3 +277,35 @@ def test_an_unexplained_verdict_is_located_where_its_cause_acts(monkeypatch):
                  "channel": "T1", "start_h": 9.0, "rate_K_h": 0.5}}}
     assert located(doc(12.0, 16.0), mixed) is True
     assert located(doc(2.0, 8.5), mixed) is False
+
+
+def test_the_rule_census_reads_which_rule_decided(monkeypatch, tmp_path):
+    """benchmarks/rule_census.py on hand-made reports: a candidate stopped only by its material
+    change, one qualified only by the plausible base, one a law of the speed stopped, and a run
+    unexplained by its held-out misfit; a candidate that failed significance is no rule's."""
+    import json
+
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import rule_census
+
+    base = {"significant": True, "material": True, "signature": None, "predicts": True,
+            "beats_something_else": True, "distinct": True, "changes_prediction": True,
+            "restores_plausible_base": False, "null_at_optimum": None,
+            "final_model_adequate": None}
+
+    def cand(**over):
+        return {"candidate": "x", "criteria": {**base, **over}}
+
+    reports = {
+        "a": {"candidates": [cand(changes_prediction=False)]},
+        "b": {"candidates": [cand(changes_prediction=False, restores_plausible_base=True)]},
+        "c": {"candidates": [{**cand(beats_something_else=False), "law": {"label": "L"}}]},
+        "d": {"candidates": [cand(significant=False, changes_prediction=False)],
+              "something_else": {"basis": "held-out misfit"}},
+    }
+    for name, doc in reports.items():
+        (tmp_path / f"{name}.json").write_text(json.dumps(doc), encoding="utf-8")
+    n, runs = rule_census.census([tmp_path])
+    assert n == 4
+    assert runs == {"open_loop_material_change": ["a"], "plausible_base_route": ["b"],
+                    "law_rivals": ["c"], "held_out_misfit_unexplained": ["d"]}
