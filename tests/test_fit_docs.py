@@ -555,6 +555,53 @@ def test_the_other_spindles_table_is_its_files():
     assert_block("docs/fit.md", "geometry", geometry_table())
 
 
+#: docs/fit.md's spindles of other designs, drawn and fitted with their own specs
+#: (bench_families --spec tests/data/own-specs/NAME.toml): (file stem, the spindle)
+DESIGN_SETS = (
+    ("fit-spec-gs24", "gs24, 15 kW / 24 000 rpm grinder"),
+    ("fit-spec-bs25", "bs25, 60 kW / 2500 rpm boring spindle"),
+    ("fit-spec-ms12", "ms12, 11 kW / 12 000 rpm, air-cooled"),
+)
+
+
+def designs_table() -> str:
+    """docs/fit.md's table of the runs drawn from spindles of other designs, from their
+    summary files: the runs fitted per family and the rates of GEOMETRY_RATES ("-" where a
+    summary has no such runs)."""
+    lines = ["| spindle | runs fitted | " + " | ".join(GEOMETRY_RATES) + " |",
+             "|---|---|" + "---|" * len(GEOMETRY_RATES)]
+    for stem, spindle in DESIGN_SETS:
+        text = (ROOT / "docs" / "figures" / f"{stem}.txt").read_text(encoding="utf-8")
+        runs = re.search(r"^runs: (.*)$", text, re.M).group(1)
+        cells = []
+        for label in GEOMETRY_RATES:
+            has = re.search(rf"^  {re.escape(label)}\s+\d+ of", text, re.M)
+            cells.append("{} of {}".format(*_rate(text, label)[:2]) if has else "-")
+        lines.append(f"| {spindle} | {runs} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def readme_designs_rates() -> str:
+    """The README's sentence on runs from spindles of other designs, from their summaries
+    (DESIGN_SETS)."""
+    rates = [_rate((ROOT / "docs" / "figures" / f"{stem}.txt").read_text(encoding="utf-8"),
+                   "a wrong effect named (any run)") for stem, _ in DESIGN_SETS]
+    runs, wrong = sum(int(r[1]) for r in rates), sum(int(r[0]) for r in rates)
+    return (f"On {runs} runs drawn from {len(rates)} spindles of other designs, each fitted "
+            f"with its own spec, it named a wrong cause on {wrong}:")
+
+
+def test_the_readme_quotes_the_other_designs_rates():
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    assert readme_designs_rates() in readme, readme_designs_rates()
+
+
+def test_the_other_designs_table_is_its_files():
+    from tests.docs_blocks import assert_block
+
+    assert_block("docs/fit.md", "designs", designs_table())
+
+
 def test_the_event_probes_prose_is_its_figures_file():
     """docs/fit.md's sentence on the probe of judging the library beside the competitor's
     event (docs/fit-history.md "2026-12-02 (25)") from its figures file."""
