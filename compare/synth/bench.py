@@ -93,7 +93,7 @@ def _anderson(G, x0: np.ndarray, tol: float, max_iter: int = 25, memory: int = 5
     if best[0] < (tol if accept is None else accept):
         return best[1], best[2], best[0]
     raise RuntimeError(f"the injected feedback did not converge: max |G(x) - x| = "
-                       f"{err:.3g} after {max_iter} FEM runs")
+                       f"{best[0]:.3g} at best in {max_iter} FEM runs")
 
 
 def _fixed_point(ref, case: LoadCase, feedbacks: list, dt_s: float, T0: float,
