@@ -56,6 +56,14 @@ class _Windowed(Effect):
         return a, a + truth["duration_h"] * 3600.0 + RAMP_S
 
 
+class _FromStart(Effect):
+    """A cause that acts from a drawn start (``start_h``) to the run's end."""
+
+    def acts_s(self, truth) -> tuple[float, float] | None:
+        """Where in the run it acts [s]: from its start on."""
+        return truth["start_h"] * 3600.0, math.inf
+
+
 class ElectronicsDrift(Effect):
     name = "electronics_drift"
 
@@ -75,12 +83,8 @@ class ElectronicsDrift(Effect):
         return {}
 
 
-class SensorDrift(Effect):
+class SensorDrift(_FromStart):
     name = "sensor_drift"
-
-    def acts_s(self, truth) -> tuple[float, float] | None:
-        """Where in the run it acts [s]: from its start on."""
-        return truth["start_h"] * 3600.0, math.inf
 
     def draw(self, rng):
         return {"channel": str(rng.choice(["T1", "T2", "T_stator"])),
@@ -94,13 +98,9 @@ class SensorDrift(Effect):
         return {}
 
 
-class CoolantSensorOffset(Effect):
+class CoolantSensorOffset(_FromStart):
     name = "coolant_sensor_offset"
     needs_coolant = True  # without a coolant film the logged coolant drives nothing
-
-    def acts_s(self, truth) -> tuple[float, float] | None:
-        """Where in the run it acts [s]: from its start on."""
-        return truth["start_h"] * 3600.0, math.inf
 
     def draw(self, rng):
         return {"start_h": float(rng.uniform(3.0, 11.0)),
