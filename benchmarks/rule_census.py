@@ -33,7 +33,7 @@ import json
 from collections.abc import Iterable
 from pathlib import Path
 
-OPEN_LOOP = ("predicts", "beats_something_else", "distinct")
+from compare.fit.select import OPEN_LOOP
 
 
 def decisions(report: dict) -> set[str]:
