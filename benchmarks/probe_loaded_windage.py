@@ -30,16 +30,14 @@ ROOT = Path(__file__).resolve().parents[1]
 def plateaus(run, criteria) -> np.ndarray:
     """(n [krpm], M [N m], mean P_el - M omega [W], mean T_stator [K]) per plateau."""
     from compare.fit.signatures import segments
+    from spindle.bench_inputs import held, valid_samples
+    from spindle.units import ZERO_C_K
 
     t = np.asarray(run.time_s, dtype=float)
-
-    def held(name: str) -> np.ndarray:  # each sample's last logged value
-        x = np.asarray(run.columns.get(name, np.zeros_like(t)), dtype=float)
-        ok = np.isfinite(x)
-        idx = np.maximum.accumulate(np.where(ok, np.arange(len(x)), 0))
-        return np.where(np.arange(len(x)) >= np.argmax(ok), x[idx], np.nan)
-
-    n, P, M, T = (held(c) for c in ("speed_rpm", "power_kW", "load_torque_Nm", "T_stator"))
+    # each row's last logged value of each column (a log by exception leaves cells empty)
+    n, P, M, T_C = (held(*valid_samples(run, c), t)
+                    for c in ("speed_rpm", "power_kW", "load_torque_Nm", "T_stator_C"))
+    T = T_C + ZERO_C_K
     rows = []
     for s in segments(run, criteria):
         if s.speed_rpm < criteria.moving_rpm or s.duration_s < criteria.level_min_s:
