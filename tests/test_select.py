@@ -247,27 +247,39 @@ def test_a_law_of_the_speed_is_a_drag_the_drive_supplies():
 def test_the_verdict_says_which_law_stopped_which_effects():
     """report.verdict_lines: candidates that fitted (significant, material) and failed
     beats_something_else against a law of the speed get one sentence naming the law's fit
-    and them; a candidate that was not significant, or that beat it, is not listed."""
+    and them; a candidate that was not significant, or that beat it, is not listed, nor one
+    its signature decided (named by it or vetoed: the law stops the open loop only) or one
+    the run names after all (the peer's dev2-14 read "so none is named for it:
+    bearing_preload" beside "Named: bearing_preload ... its signature")."""
     from compare.fit.competitor import LAWS
     from compare.fit.report import verdict_lines
 
     law = {"label": LAWS["rotor"], "values": {"q_law_W": 52.4, "k_law": 3.62}}
 
-    def cand(name, beats=False, significant=True):
+    def cand(name, beats=False, significant=True, signature=None):
         return {"candidate": name, "round": 1, "law": law,
                 "criteria": {**ALL_PASS, "beats_something_else": beats,
-                             "significant": significant}}
+                             "significant": significant, "signature": signature}}
 
-    doc = {"verdict": {"kind": "unexplained", "unexplained": True, "where": "somewhere"},
-           "effects": [], "error_before": {"validation": {}}, "error_after": {"validation": {}},
-           "candidates": [cand("windage_loss"), cand("bearing_preload"),
-                          cand("mount_conduction", significant=False),
-                          cand("fixture_expansion", beats=True), cand("windage_loss")]}
-    said = [x for x in verdict_lines(doc) if x.startswith("A law the library lacks")]
-    assert said == ["A law the library lacks, a heat into the rotor of 52 W (n / 3000 "
-                    "rpm)^3.6, explains the run better than these 2 effects of the library, by "
-                    "more than one degree of freedom's margin, so none is named for it: "
-                    "windage_loss, bearing_preload."]
+    def said(candidates, effects=()):
+        doc = {"verdict": {"kind": "unexplained", "unexplained": True, "where": "somewhere"},
+               "effects": [{"label": e} for e in effects], "error_before": {"validation": {}},
+               "error_after": {"validation": {}}, "candidates": candidates}
+        return [x for x in verdict_lines(doc) if x.startswith("A law the library lacks")]
+
+    assert said([cand("windage_loss"), cand("bearing_preload"),
+                 cand("mount_conduction", significant=False),
+                 cand("fixture_expansion", beats=True), cand("windage_loss"),
+                 cand("centrifugal_shortening", signature=False),
+                 cand("sensor_lag(T1)", signature=True)]) == [
+        "A law the library lacks, a heat into the rotor of 52 W (n / 3000 rpm)^3.6, explains "
+        "the run better than these 2 effects of the library, by more than one degree of "
+        "freedom's margin, so none is named: windage_loss, bearing_preload."]
+    one = said([cand("windage_loss"), cand("bearing_preload")], effects=["bearing_preload"])
+    assert one == ["A law the library lacks, a heat into the rotor of 52 W (n / 3000 rpm)^3.6, "
+                   "explains the run better than this effect of the library, by more than one "
+                   "degree of freedom's margin, so it is not named: windage_loss."]
+    assert said([cand("bearing_preload")], effects=["bearing_preload"]) == []
 
 
 def test_a_held_out_misfit_with_nothing_named_is_unexplained_and_says_where():

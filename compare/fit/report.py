@@ -195,14 +195,17 @@ def verdict_lines(doc: dict) -> list[str]:
 def _law_lines(doc: dict) -> list[str]:
     """Where a law of the speed the library lacks (compare.fit.competitor.SpeedHeat) stopped
     an effect that fitted, significant and material, a sentence naming the law's fit (as
-    first fitted) and the effects it stopped."""
+    first fitted) and the effects it stopped. An effect its signature decided (named by it,
+    or vetoed) or that the run names after all was not stopped by the law."""
+    named = {e["label"] for e in doc["effects"]}
     stopped: dict[str, list[str]] = {}
     fitted: dict[str, dict] = {}
     for c in doc.get("candidates", []):
-        law, crit = c.get("law"), c["criteria"]
+        law, crit, lab = c.get("law"), c["criteria"], c["candidate"]
         if (law and crit.get("beats_something_else") is False and crit["significant"]
-                and crit["material"] and c["candidate"] not in stopped.get(law["label"], [])):
-            stopped.setdefault(law["label"], []).append(c["candidate"])
+                and crit["material"] and crit.get("signature") is None and lab not in named
+                and lab not in stopped.get(law["label"], [])):
+            stopped.setdefault(law["label"], []).append(lab)
             fitted.setdefault(law["label"], law["values"])
     role = {lab: r for r, lab in LAWS.items()}
     out = []
@@ -213,7 +216,7 @@ def _law_lines(doc: dict) -> list[str]:
                    f"rpm)^{v['k_law']:.1f}, explains the run better than "
                    f"{'this effect' if len(effects) == 1 else f'these {len(effects)} effects'}"
                    " of the library, by more than one degree of freedom's margin, so "
-                   f"{'it is' if len(effects) == 1 else 'none is'} named for it: "
+                   f"{'it is not' if len(effects) == 1 else 'none is'} named: "
                    f"{', '.join(effects)}.")
     return out
 
