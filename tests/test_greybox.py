@@ -309,7 +309,7 @@ def test_a_stretched_network_has_the_same_links(spec_path, nodes):
     its masses and links: bs25's did not, since its rotor starts where a shaft slice ends
     and the two z, each in its own floating point, left a sliver of 1e-17 m between them
     once stretched by 1.2, a link of shaft[2] and rotor[0] that do not touch
-    (lumped.build.Builder.cuts drops pieces shorter than the geometry's tolerance). Every
+    (lumped.build._Builder.cuts drops pieces shorter than the geometry's tolerance). Every
     spec we ship or draw from is asked, at the probe stretch and its inverse."""
     from compare.fit.greybox import STRETCH_PROBE
     from lumped.build import build_network
