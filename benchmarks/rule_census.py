@@ -42,7 +42,9 @@ def decisions(report: dict) -> set[str]:
     for j in report.get("candidates", []):
         c = j["criteria"]
         passed = bool(c["significant"] and c["material"])
-        open_loop = passed and not c["signature"] and all(c.get(k) for k in OPEN_LOOP)
+        # a signature that applies decides alone (named by it, or vetoed): the open loop's
+        # rules and the laws decide only where none applies (compare.fit.select.Judgement.route)
+        open_loop = passed and c["signature"] is None and all(c.get(k) for k in OPEN_LOOP)
         if open_loop and c.get("changes_prediction") is False:
             out.add("plausible_base_route" if c.get("restores_plausible_base")
                     else "open_loop_material_change")
@@ -50,7 +52,8 @@ def decisions(report: dict) -> set[str]:
             out.add("null_from_candidate")
         if c.get("final_model_adequate") is False:
             out.add("open_loop_adequate_model")
-        others = passed and c["signature"] is not False and c.get("predicts") and c.get("distinct")
+        others = (passed and c["signature"] is None and c.get("predicts")
+                  and c.get("distinct"))
         if others and not c["beats_something_else"] and j.get("law"):
             out.add("law_rivals")
         if (passed and c["signature"] is False and all(c.get(k) for k in OPEN_LOOP)

@@ -282,7 +282,9 @@ def test_an_unexplained_verdict_is_located_where_its_cause_acts(monkeypatch):
 def test_the_rule_census_reads_which_rule_decided(monkeypatch, tmp_path):
     """benchmarks/rule_census.py on hand-made reports: a candidate stopped only by its material
     change, one qualified only by the plausible base, one a law of the speed stopped, and a run
-    unexplained by its held-out misfit; a candidate that failed significance is no rule's."""
+    unexplained by its held-out misfit; a candidate that failed significance is no rule's, nor
+    one its signature decided (vetoed, or named by it): switching an open-loop rule or the laws
+    off would not change its verdict."""
     import json
 
     monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
@@ -302,10 +304,13 @@ def test_the_rule_census_reads_which_rule_decided(monkeypatch, tmp_path):
         "c": {"candidates": [{**cand(beats_something_else=False), "law": {"label": "L"}}]},
         "d": {"candidates": [cand(significant=False, changes_prediction=False)],
               "something_else": {"basis": "held-out misfit"}},
+        "e": {"candidates": [cand(signature=False, changes_prediction=False),
+                             {**cand(signature=True, beats_something_else=False),
+                              "law": {"label": "L"}}]},
     }
     for name, doc in reports.items():
         (tmp_path / f"{name}.json").write_text(json.dumps(doc), encoding="utf-8")
     n, runs = rule_census.census([tmp_path])
-    assert n == 4
+    assert n == 5
     assert runs == {"open_loop_material_change": ["a"], "plausible_base_route": ["b"],
                     "law_rivals": ["c"], "held_out_misfit_unexplained": ["d"]}
