@@ -118,6 +118,17 @@ def drive_file_path(spec_file: str | Path, preset: str) -> Path | None:
     return path if path.is_file() else None
 
 
+def spec_files(spec: Spec) -> list[str]:
+    """The files a spec is read from: its TOML and the drive file its ``[power_balance]
+    preset`` names (a command's inputs, which no output may replace or move)."""
+    files = [str(spec.path)]
+    if spec.power_preset is not None:
+        drive = drive_file_path(spec.path, spec.power_preset)
+        if drive is not None:
+            files.append(str(drive))
+    return files
+
+
 def resolve_spec_path(name_or_path: str | Path) -> Path:
     """A path to a TOML file, or the name of a shipped spec."""
     if not isinstance(name_or_path, str | Path):

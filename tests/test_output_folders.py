@@ -367,3 +367,50 @@ def test_a_cycle_file_given_is_an_input_even_with_force(tmp_path, capsys, comman
     assert main([*command, str(cycle), "--out", str(tmp_path), "--force", "--quiet"]) == 2
     assert "holds the input" in capsys.readouterr().err
     assert cycle.is_file() and not list(tmp_path.parent.glob(f"{tmp_path.name}.kept-*"))
+
+
+@pytest.mark.parametrize("command", [["fit", "--spec", "{spec}", str(ROOT / "tests" / "data" /
+                                      "peer-runs" / "bench-runs" / "dev-01.csv")],
+                                     ["study", "{spec}", "--steady-only"], ["mesh", "{spec}"]])
+def test_the_drive_file_a_spec_names_is_an_input_even_with_force(tmp_path, capsys, command):
+    """A spec naming its drive by a file beside it ([power_balance] preset = "../drive/d.toml"):
+    the drive file was not counted as an input, so --force moved it out of the --out folder
+    that held it, and fit then refused its own finished report for the missing drive. The
+    drive file is an input like the spec (spindle.spec_reader.spec_files): exit 2, the drive
+    where it was, nothing moved aside."""
+    from compare.cli import main
+    from spindle.spec_reader import shipped_drives, shipped_specs
+
+    (tmp_path / "spec").mkdir()
+    drive = tmp_path / "drive" / "d.toml"
+    drive.parent.mkdir()
+    drive.write_bytes(shipped_drives()["spl2782"].read_bytes())
+    text = shipped_specs()["spl2782"].read_text(encoding="utf-8")
+    assert 'preset = "spl2782"' in text
+    spec = tmp_path / "spec" / "my.toml"
+    spec.write_text(text.replace('preset = "spl2782"', 'preset = "../drive/d.toml"'),
+                    encoding="utf-8")
+    before = drive.read_bytes()
+    args = [str(spec) if a == "{spec}" else a for a in command]
+    code = main([*args, "--out", str(drive.parent), "--force", "--quiet"])
+    assert code == 2 and "holds the input" in capsys.readouterr().err
+    assert drive.read_bytes() == before
+    assert not list(tmp_path.glob("drive.kept-*"))
+
+
+def test_fit_writes_no_report_when_its_summary_refuses(tmp_path, capsys, monkeypatch):
+    """fit composes what it prints (which reads the spec's drive again) before its report is
+    put in place: a refusal there (a drive file removed during the run) exits 2 with nothing
+    written, where it had exited 2 beside a finished report."""
+    import compare.fit.report as report
+    from compare.cli import main
+
+    def refuse(rep):
+        raise InputError("my.toml", "power_balance.preset", "gone", "put it back")
+
+    monkeypatch.setattr(report, "summary_text", refuse)
+    out = tmp_path / "fit"
+    run = ROOT / "tests" / "data" / "peer-runs" / "bench-runs" / "dev-01.csv"
+    assert main(["fit", str(run), "--out", str(out), "--no-pictures", "--quiet"]) == 2
+    assert "power_balance.preset" in capsys.readouterr().err
+    assert not out.exists() and os.listdir(tmp_path) == []

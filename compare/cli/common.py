@@ -165,3 +165,11 @@ def pass_fail(ok: bool, borderline: bool = False) -> str:
         colour = "33" if borderline else "32" if ok else "31"
         return f"\033[{colour};1m{word}\033[0m"
     return word
+
+
+def spec_files(spec) -> list[str]:
+    """The files ``spec`` was read from (spindle.spec_reader.spec_files): a command's inputs,
+    which no output may replace or move."""
+    from spindle.spec_reader import spec_files as files
+
+    return files(spec)

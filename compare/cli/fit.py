@@ -14,6 +14,7 @@ from compare.cli.common import (
     add_quiet,
     number,
     out_folder,
+    spec_files,
     with_progress,
 )
 from compare.executor import default_workers
@@ -63,7 +64,7 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
     base_extra = _base_extra(args.base_extra)
     spec = load_spec(args.spec)
     criteria = Criteria().with_file(args.criteria) if args.criteria else None
-    inputs = [spec.path, args.run, *([args.criteria] if args.criteria else [])]
+    inputs = [*spec_files(spec), args.run, *([args.criteria] if args.criteria else [])]
     default = f"results/{safe_name(spec.name)}/fit-{safe_name(Path(args.run).stem)}"
     out = out_folder(args.out, default, inputs, force=args.force)
     rep = run_fit(args.run, spec, args.fit_fraction, args.alpha, args.nodes,
@@ -75,8 +76,11 @@ def _cmd_fit(args: argparse.Namespace, progress: Progress) -> int:
                   cv_blocks=args.cv_blocks, criteria=criteria, workers=args.workers)
     with output_dir(out, inputs=inputs, force=args.force) as tmp, progress.pictures():
         save_report(rep, tmp, pictures=not args.no_pictures)
+        # composed before the outputs are committed: it reads the spec's drive again, and a
+        # refusal then must leave no report behind
+        text = summary_text(rep)
     progress.done()
-    print(summary_text(rep))
+    print(text)
     print(f"wrote {out}/report.json, {out}/report.html")
     return 0
 

@@ -13,6 +13,7 @@ from compare.cli.common import (
     add_quiet,
     add_spec,
     out_folder,
+    spec_files,
     with_progress,
 )
 
@@ -29,7 +30,7 @@ def _cmd_mesh(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", [spec.path], force=args.force)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", spec_files(spec), force=args.force)
     check_level(spec, args.level)  # before levels 0 .. N - 1 are made
     rows = []
     print(f"{'level':>5} {'elements':>9} {'nodes':>8} {'dofs_P1':>8} {'dofs_P2':>8} {'h_max_mm':>9}")
@@ -40,7 +41,7 @@ def _cmd_mesh(args: argparse.Namespace, progress: Progress) -> int:
         rows.append({**c2, "dofs_P1": c1["dofs_P1"], "h_max_m": sm.h_max_m})
         print(f"{level:5d} {c2['elements']:9d} {c2['nodes']:8d} {c1['dofs_P1']:8d} "
               f"{c2['dofs_P2']:8d} {sm.h_max_m * 1e3:9.3f}")
-    with output_dir(out, inputs=[spec.path], force=args.force) as tmp, progress.pictures():
+    with output_dir(out, inputs=spec_files(spec), force=args.force) as tmp, progress.pictures():
         save_mesh_vtu(sm, tmp / f"mesh_level{args.level}.vtu")
         (tmp / "mesh.json").write_text(json.dumps(
             {"spec": spec.name, "parts": sm.part_names, "levels": rows,

@@ -16,6 +16,7 @@ from compare.cli.common import (
     add_spec,
     input_files,
     load_spec_with_sensors,
+    spec_files,
     with_progress,
 )
 
@@ -29,7 +30,7 @@ def _cmd_baseline(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.outputs import check_output_file, write_output_file
 
     spec = load_spec_with_sensors(args.spec)  # validates before the long run
-    out = check_output_file(args.out, input_files(spec.path), args.force)
+    out = check_output_file(args.out, input_files(*spec_files(spec)), args.force)
     settings = {"levels": sorted(set(args.levels)), "nodes": sorted(set(args.nodes)),
                 "dt_s": args.dt, "transient": not args.steady_only}
     tolerances = {"temperature_K": args.tol_temp, "growth_um": args.tol_growth}

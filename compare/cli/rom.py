@@ -19,6 +19,7 @@ from compare.cli.common import (
     number,
     out_folder,
     pass_fail,
+    spec_files,
     with_progress,
 )
 from compare.progress import Progress
@@ -60,7 +61,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.outputs import output_dir, safe_name
 
     spec = load_spec_with_sensors(args.spec)
-    inputs = [spec.path, *input_files(args.cycle, *args.held_out)]
+    inputs = [*spec_files(spec), *input_files(args.cycle, *args.held_out)]
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/rom", inputs, force=args.force)
     _check_cycles([args.cycle, *args.held_out])
     study = rom_study(spec, args.level, args.cycle, args.held_out, args.dt, args.tol_temp,

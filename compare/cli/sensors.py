@@ -15,6 +15,7 @@ from compare.cli.common import (
     load_spec_with_sensors,
     number,
     out_folder,
+    spec_files,
     with_progress,
 )
 from compare.verify.accuracy import (
@@ -39,7 +40,7 @@ def run(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.outputs import output_dir, safe_name
 
     spec = load_spec_with_sensors(args.spec)
-    inputs = [spec.path, *input_files(*(args.cases or []), args.rank_case)]
+    inputs = [*spec_files(spec), *input_files(*(args.cases or []), args.rank_case)]
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/sensors", inputs, force=args.force)
     say = progress.say
     cases = load_cases(spec, args.cases) if args.cases else None

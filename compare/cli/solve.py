@@ -21,6 +21,7 @@ from compare.cli.common import (
     load_spec_with_sensors,
     number,
     out_folder,
+    spec_files,
     with_progress,
 )
 from spindle.errors import InputError
@@ -59,7 +60,7 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
                          "speed")
     progress.stage("reading the spec")
     spec = load_spec_with_sensors(args.spec)
-    inputs = [spec.path, *input_files(args.case, args.cycle)]
+    inputs = [*spec_files(spec), *input_files(args.case, args.cycle)]
     out = out_folder(args.out, f"results/{safe_name(spec.name)}/solve", inputs, force=args.force)
     t0 = time.perf_counter()
     if args.model == "lumped":
@@ -81,7 +82,7 @@ def _cmd_solve(args: argparse.Namespace, progress: Progress) -> int:
                   f"elements, {ref.thermal.basis.N} DOFs")
     t_asm = time.perf_counter() - t0
     case = spec.default_load_case()
-    inputs = [spec.path]
+    inputs = spec_files(spec)
     if args.case:
         case = load_case_input(spec, args.case, case, inputs)
     if args.speed is not None:

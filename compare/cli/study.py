@@ -18,6 +18,7 @@ from compare.cli.common import (
     load_spec_with_sensors,
     out_folder,
     pass_fail,
+    spec_files,
     with_progress,
 )
 from spindle.errors import InputError
@@ -35,7 +36,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.plots import levels_text
 
     spec = load_spec_with_sensors(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/study", [spec.path], force=args.force)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/study", spec_files(spec), force=args.force)
     if args.workers < 1:
         raise InputError("command line", "--workers", f"{args.workers} is below 1",
                          "give --workers 1 (serial) or more")
@@ -43,7 +44,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     result = run_study(spec, levels, nodes, transient=not args.steady_only, dt_s=args.dt,
                        threshold=args.threshold / 100.0, progress=progress.say, workers=args.workers,
                        scheduler=args.scheduler, rom=args.rom)
-    with output_dir(out, inputs=[spec.path], force=args.force) as tmp, progress.pictures():
+    with output_dir(out, inputs=spec_files(spec), force=args.force) as tmp, progress.pictures():
         result.save(tmp, pictures=not args.no_pictures)
     progress.done()
     conv = result.convergence

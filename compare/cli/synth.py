@@ -6,7 +6,14 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from compare.cli.common import MESH_LEVEL, add_quiet, input_files, number, with_progress
+from compare.cli.common import (
+    MESH_LEVEL,
+    add_quiet,
+    input_files,
+    number,
+    spec_files,
+    with_progress,
+)
 from spindle.errors import InputError
 
 if TYPE_CHECKING:
@@ -34,7 +41,7 @@ def _cmd_synth(args: argparse.Namespace, progress: Progress) -> int:
     out = Path(args.out)
     if out.suffix.lower() != ".csv":
         raise InputError(str(out), "--out", "is not a .csv file name", "give e.g. run.csv")
-    inputs = input_files(args.cycle, spec.path)
+    inputs = input_files(args.cycle, *spec_files(spec))
     for path in (out, out.with_suffix(".truth.json")):
         check_output_file(path, inputs, args.force)
     progress.stage(f"FEM level {args.level} run of '{args.cycle}' with "
