@@ -6,7 +6,7 @@ not verdicts on named runs (issue 32 §7).
                                         [--peers tests/data/peer-runs/bench-runs ...]
                                         [--reports DIR] [--summary FILE] [--synth-only]
                                         [--geometry RADIAL AXIAL [--fit-own-spec]]
-                                        [--ambient-shift-K 1e-5]
+                                        [--ambient-shift-K 1e-5] [--every-s 60]
 
 Families (each run drawn from its seed: the spindle's mismatch to the spec, the cycle, the
 effect and its size, the noise and sampling; ``synth --mismatch``):
@@ -22,6 +22,11 @@ effect and its size, the noise and sampling; ``synth --mismatch``):
   uniformly: the rotor's share of the motor losses rising with speed), which the base's one
   loss split cannot follow: a control (nothing should be named) whose base is off;
 - ``peers``: the peer's runs in the folders of ``--peers`` (a fixed set, each fitted once).
+
+``--every-s SECONDS`` fits each drawn run as a logger that scans once every SECONDS records
+it (:func:`sampled_every`: the run's first row at or after each multiple), in place of the
+run's own logging (1 s, or by exception for half of them): how the verdicts hold where a
+bench logs once a minute. The peer's runs are fitted as they are.
 
 ``--geometry RADIAL AXIAL`` draws the runs from another spindle: the spec's radii times
 RADIAL and its lengths times AXIAL (spindle.stretch), before the drawn mismatch, and fits them
@@ -113,6 +118,7 @@ class FamilyRun:
     geometry: tuple = ()  # (radial, axial) factors of the spindle the drawn runs come from
     fit_own_spec: bool = False  # fit with that spindle's own spec, not the shipped one
     ambient_shift_K: float = 0.0  # fit a copy whose ambient reads this much higher
+    every_s: float = 0.0  # fit a copy sampled once every this many seconds (0: as logged)
 
     @property
     def label(self) -> str:
@@ -181,7 +187,9 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
         if not (run.exists() and sidecar.exists()):
             synth(data_spec, cycle, effects if len(effects) > 1 else effects[0], case.seed, run,
                   mismatch=True)
-        if logs_on_change(case.family, case.seed):
+        if case.every_s:
+            run = sampled_every(run, case.every_s, Path(case.cache) / f"every-{case.every_s:g}s")
+        elif logs_on_change(case.family, case.seed):
             from compare.synth.bench import log_on_change
 
             thinned = run.with_name(f"{run.stem}-onchange.csv")
@@ -221,7 +229,9 @@ def one(case: FamilyRun, synth_only: bool = False) -> dict:
             "rms_within_tolerance": rms_ok, "validation_rmse": out["validation_rmse"],
             "missed_by": missed_by(doc, truth),
             "fit_s": rep.runtime_s, "synth_s": t_synth, "sizes": sizes,
-            "on_change": bool(not case.path and logs_on_change(case.family, case.seed)),
+            "on_change": bool(not case.path and not case.every_s
+                              and logs_on_change(case.family, case.seed)),
+            **({"every_s": case.every_s} if case.every_s and not case.path else {}),
             "at_floor": at_floor(sizes),
             "located": located(doc, truth_doc),
             **({"geometry": list(case.geometry), "fit_own_spec": case.fit_own_spec}
@@ -246,6 +256,27 @@ def shifted_ambient(run: Path, shift_K: float, folder: Path) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     copy = folder / f"{run.stem}-env{shift_K:+g}K{run.suffix}"
     # two benchmarks may share the cache: a fit never reads a half-written copy
+    atomic_write(copy, lambda tmp: tmp.write_text("\n".join(out) + "\n", encoding="utf-8"))
+    return copy
+
+
+def sampled_every(run: Path, every_s: float, folder: Path) -> Path:
+    """A copy of the bench file ``run`` (in ``folder``) as a logger that scans once every
+    ``every_s`` [s] records it: the first row at or after each multiple of ``every_s``, its
+    cells as they are (``--every-s``)."""
+    lines = run.read_text(encoding="utf-8").splitlines()
+    head = next(i for i, t in enumerate(lines) if t.startswith("time_s"))
+    out = [t for t in lines[:head] if not t.startswith("# rows")] + [lines[head]]
+    due = -math.inf
+    for t in lines[head + 1:]:
+        time_s = float(t.split(",", 1)[0])
+        if time_s >= due:
+            out.append(t)
+            due = (math.floor(time_s / every_s) + 1) * every_s
+    from spindle.outputs import atomic_write
+
+    folder.mkdir(parents=True, exist_ok=True)
+    copy = folder / run.name
     atomic_write(copy, lambda tmp: tmp.write_text("\n".join(out) + "\n", encoding="utf-8"))
     return copy
 
@@ -436,11 +467,17 @@ def main(argv: list[str] | None = None) -> None:
                     "e.g. 1e-5, a thousandth of the loggers' 0.01 K: compare the rows with "
                     "an unshifted benchmark's (compare_reports.py) for the verdicts that "
                     "round-off decides")
+    ap.add_argument("--every-s", type=float, default=0.0, metavar="SECONDS",
+                    help="fit each drawn run as a logger scanning once every SECONDS records it "
+                    "(the first row at or after each multiple), e.g. 60; the peer's runs as "
+                    "they are")
     args = ap.parse_args(argv)
     if args.rows:
         return _from_rows(args, argv)
     if args.runs_per_family < 1:
         ap.error("--runs-per-family: at least 1")
+    if args.every_s < 0 or not math.isfinite(args.every_s):
+        ap.error("--every-s: a cadence in seconds above 0 (or 0: the runs as logged)")
     geometry = tuple(args.geometry or ())
     if geometry:
         if not all(0.5 <= g <= 2.0 for g in geometry):
@@ -460,7 +497,7 @@ def main(argv: list[str] | None = None) -> None:
         reports = str(args.reports)
     cases = [FamilyRun(f, s, str(args.cache), spec=args.spec, reports=reports,
                        criteria=criteria, geometry=geometry, fit_own_spec=args.fit_own_spec,
-                       ambient_shift_K=args.ambient_shift_K)
+                       ambient_shift_K=args.ambient_shift_K, every_s=args.every_s)
              for f in args.families
              if f in FAMILIES
              for s in range(args.first_seed, args.first_seed + args.runs_per_family)]
@@ -541,6 +578,9 @@ def _fitting_options(rows: list[dict], per: dict[str, int], args) -> str:
     if geometry:
         out += f" --geometry {geometry[0]:g} {geometry[1]:g}"
         out += " --fit-own-spec" if any(r.get("fit_own_spec") for r in rows) else ""
+    every = next((r["every_s"] for r in rows if r.get("every_s")), None)
+    if every:
+        out += f" --every-s {every:g}"
     return out + "".join(f" --criterion {c}" for c in args.criterion)
 
 

@@ -182,6 +182,31 @@ def test_the_ambient_shifted_copy_moves_the_ambient_alone(monkeypatch, tmp_path)
         np.testing.assert_allclose(b.columns[name][logged], want[logged], rtol=0, atol=1e-12)
 
 
+def test_the_copy_sampled_every_minute_is_the_first_row_of_each_minute(monkeypatch, tmp_path):
+    """bench_families --every-s 60: of the peer's 10 s file (which has gaps), the copy read
+    back holds, for each minute, the original's first row at or after it (one row only where a
+    gap spans minutes), every column as read from the original to the bit; the original is not
+    touched."""
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import bench_families
+
+    from spindle.bench import read_bench
+
+    run = ROOT / "tests" / "data" / "peer-runs" / "bench-runs" / "dev-01.csv"
+    before = run.read_bytes()
+    copy = bench_families.sampled_every(run, 60.0, tmp_path / "every")
+    assert run.read_bytes() == before and copy.parent == tmp_path / "every"
+    a, b = read_bench(run), read_bench(copy)
+    minutes = np.arange(0.0, a.time_s[-1] + 1.0, 60.0)
+    keep = np.unique(np.searchsorted(a.time_s, minutes, side="left"))
+    keep = keep[keep < len(a.time_s)]
+    assert len(keep) < len(a.time_s) / 5  # a sixth of a 10 s log, fewer over its gaps
+    np.testing.assert_array_equal(b.time_s, a.time_s[keep])
+    assert set(a.columns) == set(b.columns)
+    for name, col in a.columns.items():
+        np.testing.assert_array_equal(b.columns[name], col[keep])
+
+
 def test_the_mixed_family_is_judged_by_its_library_effect_and_what_remains(monkeypatch):
     """bench_families' ``mixed`` runs carry one library effect and one cause outside the
     library (compare.synth.outside): right is that effect named alone *and* something else

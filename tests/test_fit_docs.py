@@ -715,3 +715,66 @@ def test_the_held_out_refit_reads_as_measured():
                          .read_text())["effect"] for r in adequate
               if (ROOT / "benchmarks" / ".families-cache" / f"{r['run']}.truth.json").exists()}
     assert len(adequate) == 3 and drifts <= {"electronics_drift"}
+
+
+#: the rates docs/fit.md's table of the once-a-minute logger compares
+CADENCE_RATES = ("true effect named first (runs with an effect)",
+                 "'unexplained' on clean runs (a false alarm)",
+                 "unexplained, nothing named (runs outside the library)",
+                 "a wrong effect named (any run)",
+                 "validation RMS within the tolerances (named or adequate)",
+                 "the verdict right as a whole")
+
+
+def cadence_table() -> str:
+    """docs/fit.md's table of the drawn runs fitted as logged and as a logger scanning once a
+    minute records them (bench_families --every-s 60): the rates of CADENCE_RATES of the
+    committed main rows of the same runs (docs/figures/fit-families.json) and of the
+    once-a-minute rows (fit-families-every-60s.json), each by bench_families' own summary."""
+    import json
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        from bench_families import summary
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    fig = ROOT / "docs" / "figures"
+    minute = json.loads((fig / "fit-families-every-60s.json").read_text(encoding="utf-8"))
+    logged = {r["run"].removesuffix("-onchange"): r
+              for r in json.loads((fig / "fit-families.json").read_text(encoding="utf-8"))}
+    texts = ["\n".join(summary([logged[r["run"]] for r in minute])), "\n".join(summary(minute))]
+    lines = ["| rate (the same 100 drawn runs) | as logged | once a minute |", "|---|---|---|"]
+    for label in CADENCE_RATES:
+        cells = ["{} of {}, {} % [{}, {}]".format(*_rate(t, label)) for t in texts]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def test_the_once_a_minute_table_is_its_files():
+    from tests.docs_blocks import assert_block
+
+    assert_block("docs/fit.md", "every-60s", cadence_table())
+
+
+def readme_cadence_rates() -> str:
+    """The README's sentence on a bench logging once a minute, from cadence_table's files."""
+    import json
+
+    fig = ROOT / "docs" / "figures"
+    minute = json.loads((fig / "fit-families-every-60s.json").read_text(encoding="utf-8"))
+    logged = {r["run"].removesuffix("-onchange"): r
+              for r in json.loads((fig / "fit-families.json").read_text(encoding="utf-8"))}
+    same = [logged[r["run"]] for r in minute]
+    clean = [r for r in minute if r["family"] == "clean"]
+    return (f"Fitted as a bench logging once a minute records them, {len(minute)} of these "
+            f"runs got {sum(r['right'] for r in minute)} right verdicts (as logged, "
+            f"{sum(r['right'] for r in same)}), a wrong cause on "
+            f"{sum(r['wrong'] for r in minute)} and \"unexplained\" on "
+            f"{sum(r['unexplained'] for r in clean)} of {len(clean)} clean runs: on a loaded "
+            "run the drive's losses change faster than such a log resolves")
+
+
+def test_the_readme_quotes_the_once_a_minute_rates():
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    assert readme_cadence_rates() in readme, readme_cadence_rates()
