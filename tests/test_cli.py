@@ -565,3 +565,22 @@ def test_an_empty_run_path_or_a_missing_criteria_file_says_so(tmp_path, capsys, 
     assert main([*argv, "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert words in err and err.count("\n") == 1 and not out.exists()
+
+
+def test_fit_refuses_more_nodes_than_the_grey_box_takes(tmp_path, capsys):
+    """fit's --nodes stops at compare.fit.greybox.MAX_NODES (161: 4.5 GB and 4 min on a 16 h
+    run; 500 would need tens of GB): the command line refuses 162 before any work, and the
+    Python API (spindle_verify.fit) refuses it as an InputError, not a MemoryError."""
+    import spindle_verify
+    from compare.cli.fit import FIT_NODES_MAX
+    from compare.fit.greybox import MAX_NODES
+    from spindle.errors import InputError
+
+    assert FIT_NODES_MAX == MAX_NODES
+    run = str(Path(__file__).parent / "data" / "peer-runs" / "bench-runs" / "dev-01.csv")
+    out = tmp_path / "x"
+    assert main(["fit", run, "--nodes", str(MAX_NODES + 1), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--nodes" in err and "Traceback" not in err and not out.exists()
+    with pytest.raises(InputError, match="--nodes"):
+        spindle_verify.fit(run, nodes=MAX_NODES + 1)

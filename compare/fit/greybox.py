@@ -35,6 +35,12 @@ _GROUPS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact")
 _K_PARAMS = (*_GROUPS, "heat_capacity", "axial_scale", "G_seat_W_K")
 
 
+#: the most nodes a grey box takes: it keeps each parameter's trajectory of every node, and 161
+#: took 237 s and 4.5 GB on a 16 h run (2026-12-02, memory about n^1.8), so 500 would need
+#: tens of GB (the lumped solver alone takes lumped.build.MAX_NODES)
+MAX_NODES = 161
+
+
 def _geometric(x: np.ndarray, floor: float, rel: float) -> np.ndarray:
     """``x`` (at least ``floor`` taken) rounded to the nearest point of the geometric grid of
     relative step ``rel``."""

@@ -27,7 +27,7 @@ from compare.fit.criteria import Criteria
 from compare.fit.effects import LIBRARY
 from compare.fit.effects import candidates as candidate_labels
 from compare.fit.gaps import unknown_input_spans
-from compare.fit.greybox import GreyBox, stretch_exponents
+from compare.fit.greybox import MAX_NODES, GreyBox, stretch_exponents
 from compare.fit.growth_check import check_growth, library_terms
 from compare.fit.params import BASE_PARAMS, DEFAULT_BASE_EXTRA, EXTRA_BASE_PARAMS, default_theta
 from compare.fit.select import Selection, select
@@ -95,6 +95,10 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
     asked = base_extra is not None
     base_extra = tuple(DEFAULT_BASE_EXTRA if base_extra is None else base_extra)
     _check_base_extra(base_extra)
+    if not 2 <= nodes <= MAX_NODES:
+        raise InputError("command line", "--nodes", f"{nodes} is outside 2..{MAX_NODES}",
+                         "fit with the 11 nodes of the default, or at most "
+                         f"{MAX_NODES} (time and memory grow fast with them)")
     if not 0.2 <= fit_fraction <= 0.9:
         raise InputError("command line", "--fit-fraction", f"{fit_fraction} is outside 0.2..0.9",
                          "fit on 20 % to 90 % of the run, e.g. 0.6")
