@@ -726,6 +726,32 @@ CADENCE_RATES = ("true effect named first (runs with an effect)",
                  "the verdict right as a whole")
 
 
+def cadence_held_out_text() -> str:
+    """docs/fit.md's sentence on the held-out runs fitted once a minute
+    (fit-families-every-60s-held-out.json) against their committed rows
+    (fit-families-held-out.json)."""
+    import json
+
+    fig = ROOT / "docs" / "figures"
+    minute = json.loads((fig / "fit-families-every-60s-held-out.json").read_text(encoding="utf-8"))
+    logged = {r["run"].removesuffix("-onchange"): r for r in json.loads(
+        (fig / "fit-families-held-out.json").read_text(encoding="utf-8"))}
+    same = [logged[r["run"]] for r in minute]
+
+    def count(rows, hit, of=lambda r: True):
+        pool = [r for r in rows if of(r)]
+        return f"{sum(bool(hit(r)) for r in pool)} of {len(pool)}"
+
+    clean = lambda r: r["family"] == "clean"  # noqa: E731
+    effect = lambda r: r["family"] == "effect"  # noqa: E731
+    return (f"On {len(minute)} held-out runs (clean and effect, seeds 1001-1025) once a minute: "
+            f"\"unexplained\" on {count(minute, lambda r: r['unexplained'], clean)} clean runs "
+            f"(as logged {count(same, lambda r: r['unexplained'], clean)}), the true effect first "
+            f"on {count(minute, lambda r: r['first'], effect)} (as logged "
+            f"{count(same, lambda r: r['first'], effect)}), a wrong name on "
+            f"{count(minute, lambda r: r['wrong'])} (as logged {count(same, lambda r: r['wrong'])}).")
+
+
 def cadence_table() -> str:
     """docs/fit.md's table of the drawn runs fitted as logged and as a logger scanning once a
     minute records them (bench_families --every-s 60): the rates of CADENCE_RATES of the
@@ -755,6 +781,7 @@ def test_the_once_a_minute_table_is_its_files():
     from tests.docs_blocks import assert_block
 
     assert_block("docs/fit.md", "every-60s", cadence_table())
+    assert_block("docs/fit.md", "every-60s-held-out", cadence_held_out_text())
 
 
 def readme_cadence_rates() -> str:
