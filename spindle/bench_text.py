@@ -9,6 +9,9 @@ from spindle.errors import InputError
 
 #: byte-order marks of UTF-16, which some spreadsheet programs save "Unicode text" in
 _UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
+#: the first bytes of the archives a bench export is sent in (their formats' magic numbers)
+_ARCHIVES = {b"\x1f\x8b": "gzip", b"PK\x03\x04": "zip", b"7z\xbc\xaf\x27\x1c": "7z",
+             b"BZh": "bzip2", b"\xfd7zXZ\x00": "xz"}
 
 
 def split_unit(column: str) -> tuple[str, str]:
@@ -37,6 +40,10 @@ def hint_for(column: str, header: list[str]) -> str:
 def decoded(raw: bytes, name: str) -> str:
     """``raw`` as UTF-8 text (a byte-order mark, as spreadsheet exports write, dropped);
     InputError naming the file ``name``, the line and the byte where it is not."""
+    kind = next((k for magic, k in _ARCHIVES.items() if raw.startswith(magic)), None)
+    if kind:
+        raise InputError(name, "file", f"is a {kind} archive, not text (its first bytes are "
+                         f"{kind}'s)", "unpack it and give the CSV inside")
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -17,6 +17,30 @@ def test_a_utf16_file_is_named_as_such(codec):
     assert "is UTF-16 text" in str(exc.value) and "Latin-1" not in str(exc.value)
 
 
+@pytest.mark.parametrize("kind", ["gzip", "zip", "bzip2", "xz"])
+def test_a_compressed_export_is_named_as_an_archive(kind, tmp_path):
+    """A bench export sent compressed (fuzzing round 6: a gzip or zip file read as a CSV was
+    hinted as Latin-1): the archive is made by Python's own modules, and the message names its
+    kind and says to unpack it."""
+    import bz2
+    import gzip
+    import lzma
+    import zipfile
+
+    text = b"time_s,speed_rpm\n" + b"".join(b"%d,%d\n" % (i, 3000) for i in range(200))
+    if kind == "zip":
+        path = tmp_path / "run.zip"
+        with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+            z.writestr("run.csv", text)
+        raw = path.read_bytes()
+    else:
+        raw = {"gzip": gzip.compress, "bzip2": bz2.compress, "xz": lzma.compress}[kind](text)
+    with pytest.raises(InputError) as exc:
+        decoded(raw, "run.csv")
+    assert f"is a {kind} archive" in str(exc.value) and "unpack" in str(exc.value)
+    assert "Latin-1" not in str(exc.value)
+
+
 def test_latin1_is_still_hinted_as_latin1():
     with pytest.raises(InputError) as exc:
         decoded("# room 20 °C\ntime_s\n".encode("latin-1"), "run.csv")
