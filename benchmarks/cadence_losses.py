@@ -34,7 +34,8 @@ def losses_W(path: Path) -> tuple[np.ndarray, np.ndarray]:
     return run.time_s[ok], q[ok]
 
 
-def window_means(t: np.ndarray, y: np.ndarray, at: np.ndarray) -> np.ndarray:
+def window_means(y: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """The means of ``y`` over each WINDOW_S window of its times ``at`` [s]."""
     k = np.floor(at / WINDOW_S).astype(int)
     return np.array([y[k == j].mean() for j in np.unique(k)])
 
@@ -45,6 +46,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--every-s", type=float, default=60.0)
     ap.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".families-cache")
     args = ap.parse_args(argv)
+    from spindle.bench_inputs import held
+
     held_err, lin_err = [], []
     print(f"{'run':10} {'held: mean':>11} {'max':>6} {'linear: mean':>13} {'max':>6}  [W]")
     for name in args.runs:
@@ -54,10 +57,10 @@ def main(argv: list[str] | None = None) -> None:
             continue
         t, q = losses_W(full)
         ts, qs = losses_W(sampled_every(full, args.every_s, args.cache / f"every-{args.every_s:g}s"))
-        truth = window_means(t, q, t)
-        held = window_means(t, qs[np.clip(np.searchsorted(ts, t, side="right") - 1, 0, None)], t)
-        lin = window_means(t, np.interp(t, ts, qs), t)
-        h, li = np.abs(held - truth), np.abs(lin - truth)
+        truth = window_means(q, t)
+        hold = window_means(held(ts, qs, t), t)
+        lin = window_means(np.interp(t, ts, qs), t)
+        h, li = np.abs(hold - truth), np.abs(lin - truth)
         held_err.append(h.mean())
         lin_err.append(li.mean())
         print(f"{name:10} {h.mean():11.1f} {h.max():6.0f} {li.mean():13.1f} {li.max():6.0f}")

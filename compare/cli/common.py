@@ -167,7 +167,7 @@ def pass_fail(ok: bool, borderline: bool = False) -> str:
     return word
 
 
-def spec_files(spec) -> list[str]:
+def spec_files(spec: Spec) -> list[str]:
     """The files ``spec`` was read from (spindle.spec_reader.spec_files): a command's inputs,
     which no output may replace or move."""
     from spindle.spec_reader import spec_files as files

@@ -52,13 +52,13 @@ def _cmd_crosscheck(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.outputs import output_dir, safe_name
 
     spec = load_spec_with_sensors(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/crosscheck", spec_files(spec),
+    inputs = spec_files(spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/crosscheck", inputs,
                      force=args.force)
-    inputs: list[str] = []
     case = (None if args.case is None
             else load_case_input(spec, args.case, spec.default_load_case(), inputs))
     progress.stage(f"solving level {args.level} with scikit-fem and with CalculiX")
-    with output_dir(out, inputs=[*spec_files(spec), *inputs], force=args.force) as tmp:
+    with output_dir(out, inputs=inputs, force=args.force) as tmp:
         result = crosscheck(spec, args.level, case,
                             keep_dir=(tmp / "ccx") if args.keep_deck else None)
         files = result.save(tmp)

@@ -35,7 +35,8 @@ def _cmd_measures(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/measures", spec_files(spec), force=args.force)
+    inputs = spec_files(spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/measures", inputs, force=args.force)
     for n in args.lumped_nodes:
         if n not in PRESETS and not (n.isdigit() and int(n) >= 2):
             raise InputError("command line", "--nodes", f"'{n}' is not a lumped model",
@@ -52,7 +53,7 @@ def _cmd_measures(args: argparse.Namespace, progress: Progress) -> int:
                          f"'{spec.name}'", "give --measures FILE (format: docs/measures.md)")
     mfile = read_measures(mpath, spec, args.points)
     case = spec.default_load_case()
-    inputs = [*spec_files(spec), str(mpath)]
+    inputs.append(str(mpath))
     if args.case:
         case = load_case_input(spec, args.case, case, inputs)
     elif spec.power_preset:  # the spindle's rated point (the SPL2782.1's: nominal)

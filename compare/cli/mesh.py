@@ -30,7 +30,8 @@ def _cmd_mesh(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.spec_reader import load_spec
 
     spec = load_spec(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", spec_files(spec), force=args.force)
+    inputs = spec_files(spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/mesh", inputs, force=args.force)
     check_level(spec, args.level)  # before levels 0 .. N - 1 are made
     rows = []
     print(f"{'level':>5} {'elements':>9} {'nodes':>8} {'dofs_P1':>8} {'dofs_P2':>8} {'h_max_mm':>9}")
@@ -41,7 +42,7 @@ def _cmd_mesh(args: argparse.Namespace, progress: Progress) -> int:
         rows.append({**c2, "dofs_P1": c1["dofs_P1"], "h_max_m": sm.h_max_m})
         print(f"{level:5d} {c2['elements']:9d} {c2['nodes']:8d} {c1['dofs_P1']:8d} "
               f"{c2['dofs_P2']:8d} {sm.h_max_m * 1e3:9.3f}")
-    with output_dir(out, inputs=spec_files(spec), force=args.force) as tmp, progress.pictures():
+    with output_dir(out, inputs=inputs, force=args.force) as tmp, progress.pictures():
         save_mesh_vtu(sm, tmp / f"mesh_level{args.level}.vtu")
         (tmp / "mesh.json").write_text(json.dumps(
             {"spec": spec.name, "parts": sm.part_names, "levels": rows,

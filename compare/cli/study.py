@@ -36,7 +36,8 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     from spindle.plots import levels_text
 
     spec = load_spec_with_sensors(args.spec)
-    out = out_folder(args.out, f"results/{safe_name(spec.name)}/study", spec_files(spec), force=args.force)
+    inputs = spec_files(spec)
+    out = out_folder(args.out, f"results/{safe_name(spec.name)}/study", inputs, force=args.force)
     if args.workers < 1:
         raise InputError("command line", "--workers", f"{args.workers} is below 1",
                          "give --workers 1 (serial) or more")
@@ -44,7 +45,7 @@ def _cmd_study(args: argparse.Namespace, progress: Progress) -> int:
     result = run_study(spec, levels, nodes, transient=not args.steady_only, dt_s=args.dt,
                        threshold=args.threshold / 100.0, progress=progress.say, workers=args.workers,
                        scheduler=args.scheduler, rom=args.rom)
-    with output_dir(out, inputs=spec_files(spec), force=args.force) as tmp, progress.pictures():
+    with output_dir(out, inputs=inputs, force=args.force) as tmp, progress.pictures():
         result.save(tmp, pictures=not args.no_pictures)
     progress.done()
     conv = result.convergence
