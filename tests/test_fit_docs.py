@@ -726,17 +726,24 @@ CADENCE_RATES = ("true effect named first (runs with an effect)",
                  "the verdict right as a whole")
 
 
+def _cadence_rows(minute_file: str, logged_file: str) -> tuple[list[dict], list[dict]]:
+    """The once-a-minute rows of docs/figures/``minute_file`` and the committed rows of the
+    same runs as logged (``logged_file``; a run logged on change is labelled ``-onchange``)."""
+    import json
+
+    fig = ROOT / "docs" / "figures"
+    minute = json.loads((fig / minute_file).read_text(encoding="utf-8"))
+    logged = {r["run"].removesuffix("-onchange"): r
+              for r in json.loads((fig / logged_file).read_text(encoding="utf-8"))}
+    return minute, [logged[r["run"]] for r in minute]
+
+
 def cadence_held_out_text() -> str:
     """docs/fit.md's sentence on the held-out runs fitted once a minute
     (fit-families-every-60s-held-out.json) against their committed rows
     (fit-families-held-out.json)."""
-    import json
-
-    fig = ROOT / "docs" / "figures"
-    minute = json.loads((fig / "fit-families-every-60s-held-out.json").read_text(encoding="utf-8"))
-    logged = {r["run"].removesuffix("-onchange"): r for r in json.loads(
-        (fig / "fit-families-held-out.json").read_text(encoding="utf-8"))}
-    same = [logged[r["run"]] for r in minute]
+    minute, same = _cadence_rows("fit-families-every-60s-held-out.json",
+                                 "fit-families-held-out.json")
 
     def count(rows, hit, of=lambda r: True):
         pool = [r for r in rows if of(r)]
@@ -757,7 +764,6 @@ def cadence_table() -> str:
     minute records them (bench_families --every-s 60): the rates of CADENCE_RATES of the
     committed main rows of the same runs (docs/figures/fit-families.json) and of the
     once-a-minute rows (fit-families-every-60s.json), each by bench_families' own summary."""
-    import json
     import sys
 
     sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -765,11 +771,8 @@ def cadence_table() -> str:
         from bench_families import summary
     finally:
         sys.path.remove(str(ROOT / "benchmarks"))
-    fig = ROOT / "docs" / "figures"
-    minute = json.loads((fig / "fit-families-every-60s.json").read_text(encoding="utf-8"))
-    logged = {r["run"].removesuffix("-onchange"): r
-              for r in json.loads((fig / "fit-families.json").read_text(encoding="utf-8"))}
-    texts = ["\n".join(summary([logged[r["run"]] for r in minute])), "\n".join(summary(minute))]
+    minute, same = _cadence_rows("fit-families-every-60s.json", "fit-families.json")
+    texts = ["\n".join(summary(same)), "\n".join(summary(minute))]
     lines = ["| rate (the same 100 drawn runs) | as logged | once a minute |", "|---|---|---|"]
     for label in CADENCE_RATES:
         cells = ["{} of {}, {} % [{}, {}]".format(*_rate(t, label)) for t in texts]
@@ -786,13 +789,7 @@ def test_the_once_a_minute_table_is_its_files():
 
 def readme_cadence_rates() -> str:
     """The README's sentence on a bench logging once a minute, from cadence_table's files."""
-    import json
-
-    fig = ROOT / "docs" / "figures"
-    minute = json.loads((fig / "fit-families-every-60s.json").read_text(encoding="utf-8"))
-    logged = {r["run"].removesuffix("-onchange"): r
-              for r in json.loads((fig / "fit-families.json").read_text(encoding="utf-8"))}
-    same = [logged[r["run"]] for r in minute]
+    minute, same = _cadence_rows("fit-families-every-60s.json", "fit-families.json")
     clean = [r for r in minute if r["family"] == "clean"]
     return (f"Fitted as a bench logging once a minute records them, {len(minute)} of these "
             f"runs got {sum(r['right'] for r in minute)} right verdicts (as logged, "
