@@ -2,7 +2,7 @@
 first samples (compare.fit.start) against the uniform start, on drawn runs.
 
     python benchmarks/bench_start.py [--runs 40] [--workers 2] [--json OUT.json]
-                                     [--summary FILE] [--rows ROWS.json]
+                                     [--summary FILE] [--rows ROWS.json [--before OLD.json]]
 
 Each run is a family run of bench_families.py (one its cache holds as a regular log, with
 its truth) with its first hours cut off: a logger started on a spindle that was already
@@ -123,18 +123,29 @@ def _said(row: dict) -> str:
             + (" (right)" if row["right"] else ""))
 
 
-def summary(rows: list[dict]) -> list[str]:
-    out = [f"runs: {len({r['run'] for r in rows})} cut runs, each fitted with both starts"]
-    for arm in ARMS:
-        sub = [r for r in rows if r["arm"] == arm]
+def summary(rows: list[dict], before: list[dict] | None = None) -> list[str]:
+    """The rates per arm and the verdicts the start changed (uniform -> read); with
+    ``before`` (rows of an earlier commit), the 'read' arm of each and the verdicts the
+    commit changed (before -> now), on the cut runs both hold."""
+    if before is not None:
+        now = {r["run"]: r for r in rows if r["arm"] == "read"}
+        then = {r["run"]: r for r in before if r["arm"] == "read" and r["run"] in now}
+        arms = {"before": list(then.values()), "now": [now[k] for k in then]}
+        frm, to = "before", "now"
+    else:
+        arms = {arm: [r for r in rows if r["arm"] == arm] for arm in ARMS}
+        frm, to = "uniform", "read"
+    out = [f"runs: {len({r['run'] for r in rows if before is None or r['run'] in then})} cut "
+           "runs, " + ("each fitted with the start read, before and now" if before is not None
+                       else "each fitted with both starts")]
+    for arm, sub in arms.items():
         moved = sum((r["prehistory_s"] or 0) > 0 for r in sub)
-        out += [f"start {arm!r}" + (f" (moved on {moved} runs):" if arm == "read" else ":"),
+        out += [f"start {arm!r}" + (f" (moved on {moved} runs):" if arm != "uniform" else ":"),
                 *rates(sub)]
-    by = {(r["run"], r["arm"]): r for r in rows}
-    changed = [(run, by[run, "uniform"], r) for (run, arm), r in by.items()
-               if arm == "read" and (run, "uniform") in by
-               and _said(by[run, "uniform"]) != _said(r)]
-    out.append(f"verdicts changed ({len(changed)}): run, truth: uniform -> read")
+    by = {r["run"]: r for r in arms[frm]}
+    changed = [(r["run"], by[r["run"]], r) for r in arms[to]
+               if r["run"] in by and _said(by[r["run"]]) != _said(r)]
+    out.append(f"verdicts changed ({len(changed)}): run, truth: {frm} -> {to}")
     out += [f"  {run}, {r['truth']}: {_said(u)} -> {_said(r)}" for run, u, r in changed]
     return out
 
@@ -145,6 +156,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", type=Path, help="write the rows to this JSON file")
     ap.add_argument("--rows", type=Path, help="summarise these rows (no fitting)")
+    ap.add_argument("--before", type=Path,
+                    help="with --rows: rows of an earlier commit, whose 'read' arm the summary "
+                    "sets against the rows' (the rates of each, the verdicts changed)")
     ap.add_argument("--summary", type=Path, help="also write the summary to this file")
     ap.add_argument("--arms", nargs="+", choices=list(ARMS), default=list(ARMS),
                     help="fit these starts only (default: both)")
@@ -167,7 +181,10 @@ def main(argv: list[str] | None = None) -> None:
             line=lambda r: f"  {r['run']}, {r['arm']}: {r['truth']} -> {r['verdict']} "
                            f"{','.join(r['named'])}", group=lambda r: r["arm"],
             json_path=args.json)
-    text = "\n".join(summary(rows))
+    if args.before and not args.rows:
+        ap.error("--before needs --rows")
+    before = json.loads(args.before.read_text(encoding="utf-8")) if args.before else None
+    text = "\n".join(summary(rows, before))
     print(text)
     if args.summary:
         from spindle.outputs import atomic_write

@@ -641,6 +641,9 @@ class Inputs:
     #: the first interval's inputs held for this long [s] before grid[0], from T_start_K:
     #: where the run starts (compare.fit.start; 0: at T_start_K, uniform)
     prehistory_s: float = 0.0
+    #: the heat [W] of the named sources during that prehistory, where it is not the first
+    #: interval's (a spindle that ran elsewhere before the log; compare.fit.start)
+    prehistory_heat_W: dict[str, float] | None = None
 
 
 def interval_inputs(run: BenchRun, grid_s: float = 60.0, hold_steps: float = HOLD_STEPS,

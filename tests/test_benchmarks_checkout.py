@@ -339,3 +339,29 @@ def test_the_rule_census_reads_which_rule_decided(monkeypatch, tmp_path):
     assert n == 5
     assert runs == {"open_loop_material_change": ["a"], "plausible_base_route": ["b"],
                     "law_rivals": ["c"], "held_out_misfit_unexplained": ["d"]}
+
+
+def test_bench_start_sets_its_rows_against_an_earlier_commits(monkeypatch, tmp_path):
+    """bench_start --rows NOW --before THEN: the 'read' arm of each (the uniform arm and runs
+    only one file holds left out), their rates, and the runs whose verdict changed."""
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))
+    import bench_start
+
+    def row(run, named, right, arm="read", verdict="named"):
+        return {"run": run, "arm": arm, "truth": None, "named": named, "verdict": verdict,
+                "kind": "control", "right": right, "first": None, "wrong": bool(named),
+                "rms_within_tolerance": True, "prehistory_s": 3600.0}
+
+    then = [row("clean-1-cut2.00h", ["fixture_expansion"], False),
+            row("clean-2-cut3.00h", [], True, verdict="base adequate"),
+            row("clean-2-cut3.00h", ["fixture_expansion"], False, arm="uniform"),
+            row("clean-9-cut1.00h", [], True, verdict="base adequate")]
+    now = [row("clean-1-cut2.00h", [], True, verdict="base adequate"),
+           row("clean-2-cut3.00h", [], True, verdict="base adequate")]
+    text = "\n".join(bench_start.summary(now, then))
+    assert text.startswith("runs: 2 cut runs")
+    assert "wrong effect named (any run)                                 1 of   2" in text
+    assert "wrong effect named (any run)                                 0 of   2" in text
+    assert text.endswith("verdicts changed (1): run, truth: before -> now\n"
+                         "  clean-1-cut2.00h, None: named fixture_expansion -> base adequate "
+                         "(right)")

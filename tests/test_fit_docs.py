@@ -56,6 +56,7 @@ def test_the_criteria_rows_are_the_table_the_fit_runs_with():
                                          ("held-out", "fit-families-held-out.txt"),
                                          ("perturb", "perturb-peers.txt"),
                                          ("start", "fit-start.txt"),
+                                         ("start-elsewhere", "fit-start-elsewhere.txt"),
                                          ("mixed", "fit-families-mixed.txt"),
                                          ("losslaw", "fit-families-losslaw.txt"),
                                          ("trade-law-rivals", "fit-trade-law-rivals.txt")])
@@ -802,3 +803,44 @@ def readme_cadence_rates() -> str:
 def test_the_readme_quotes_the_once_a_minute_rates():
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     assert readme_cadence_rates() in readme, readme_cadence_rates()
+
+
+def start_elsewhere_text() -> str:
+    """docs/fit.md's sentence on the prehistory that ran elsewhere, per family, from its two
+    row files (fit-start-elsewhere-before.json at the commit before, fit-start-elsewhere.json):
+    right verdicts per family before -> now, and the wrong names now by effect."""
+    import json
+    from collections import Counter
+
+    def load(name: str) -> dict:
+        rows = json.loads((ROOT / "docs" / "figures" / name).read_text(encoding="utf-8"))
+        return {r["run"]: r for r in rows if r["arm"] == "read"}
+
+    now, then = load("fit-start-elsewhere.json"), load("fit-start-elsewhere-before.json")
+    runs = [k for k in now if k in then]
+    fams = list(dict.fromkeys(now[k]["family"] for k in runs))
+    per = ", ".join(f"{f} {sum(then[k]['right'] for k in runs if then[k]['family'] == f)} -> "
+                    f"{sum(now[k]['right'] for k in runs if now[k]['family'] == f)} of "
+                    f"{sum(now[k]['family'] == f for k in runs)}" for f in fams)
+
+    def wrong(rows: dict) -> str:
+        count = Counter()
+        for k in runs:
+            truth = rows[k]["truth"] if isinstance(rows[k]["truth"], list) else [rows[k]["truth"]]
+            count.update(n.split("(")[0] for n in rows[k]["named"] if n.split("(")[0] not in truth)
+        return ", ".join(f"{n} {c}" for n, c in count.most_common())
+
+    from scipy.stats import binomtest
+
+    lost = sum(bool(then[k]["wrong"]) and not now[k]["wrong"] for k in runs)
+    gained = sum(bool(now[k]["wrong"]) and not then[k]["wrong"] for k in runs)
+    p = binomtest(min(lost, gained), lost + gained).pvalue
+    return (f"Right verdicts per family, before -> now: {per}. The wrong names before: "
+            f"{wrong(then)}; now: {wrong(now)}. A wrong name gone on {lost} runs, new on "
+            f"{gained} (McNemar's exact test, p = {p:.2f}).")
+
+
+def test_the_start_elsewhere_sentence_is_its_files():
+    from tests.docs_blocks import assert_block
+
+    assert_block("docs/fit.md", "start-elsewhere-trade", start_elsewhere_text())

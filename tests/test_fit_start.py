@@ -121,15 +121,108 @@ def test_the_fem_starts_from_the_same_prehistory():
 
 def test_a_start_no_prehistory_reaches_is_said():
     """A log begun at rest on a spindle 5 K above a room the coolant matches (stopped after
-    a run: cooling): at rest the first operating point holds every mass at the room, so no
-    prehistory reaches the samples; the start stays uniform and the warning says the first
-    hours' misfit is partly the start's."""
+    a run: cooling), and at rest throughout: the first operating point holds every mass at
+    the room and the run makes no heat, so no prehistory of its heat reaches the samples;
+    the start stays uniform and the warning says the first hours' misfit is partly the
+    start's."""
     inputs = _inputs(speed_rpm=0.0, T_cool_K=293.15)
     gb = GreyBox(SPEC, drive_for(SPEC), replace(inputs, power_kW=np.zeros(120)))
     start = run_start(gb, default_theta(gb.parameters()),
                       {"T1": 298.15, "T2": 298.15, "T_stator": 298.15}, Criteria())
-    assert not start.reached and start.prehistory_s == 0.0
-    assert "no time at the run's first operating point reaches" in start.text()
+    assert not start.reached and start.prehistory_s == 0.0 and start.heat_W is None
+    assert "no prehistory of the run's heat reaches" in start.text()
+
+
+def _ran_elsewhere(tau_s: float, n_hot: int = 10) -> tuple[Inputs, Inputs]:
+    """A log begun at 6000 rpm under 2 N m on a spindle that ran at 6000 rpm under 30 N m
+    for ``tau_s`` before it; the log reaches that point later, for ``n_hot`` intervals. The
+    log's inputs, and the same with that point held for ``tau_s`` in front (60 s steps).
+    (One speed: the prehistory's films are the first interval's, compare.fit.start.)"""
+    n = 120
+    speed, torque = np.full(n, 6000.0), np.full(n, 2.0)
+    torque[60:60 + n_hot] = 30.0
+    power = (torque * speed * np.pi / 30.0 + 900.0 + 2.0 * torque ** 2) / 1e3
+    log = Inputs(np.arange(0.0, 60.0 * n + 1.0, 60.0), speed, power, torque,
+                 np.full(n, 293.15), np.full(n, 291.15))
+    k = int(tau_s / 60.0)
+
+    def before(x: np.ndarray) -> np.ndarray:
+        return np.r_[np.full(k, x[60]), x]
+
+    longer = Inputs(np.r_[np.arange(-tau_s, 0.0, 60.0), log.grid_s],
+                    *(before(getattr(log, f)) for f in ("speed_rpm", "power_kW",
+                                                        "load_torque_Nm", "T_env_K",
+                                                        "T_coolant_K")))
+    return log, longer
+
+
+def test_a_spindle_that_ran_elsewhere_starts_from_a_prehistory_of_its_heat():
+    """A log begun lightly loaded on a spindle that ran at its hottest point for 6 h before:
+    no time at the light load reaches the first samples (the stator far warmer), so the
+    start reads the prehistory's heat too, as a fraction of the run's largest in the
+    motor and in the bearings. The first samples are the grey box's own readings after that
+    point held for 6 h, by the ordinary step recursion (an independent path to the modal
+    step the start reads them with): the start meets them within 0.05 tolerances (the
+    least-squares fit's, far below the 1 tolerance of Criteria.start_within_tolerances) and
+    the prehistory's heat is the hot point's to 2 % (an exactly determined inversion of three
+    readings for three unknowns)."""
+    from compare.fit.greybox import MOTOR_SOURCES
+
+    tau = 6 * 3600.0
+    log, longer = _ran_elsewhere(tau)
+    drive = drive_for(SPEC)
+    k = int(tau / 60.0)
+    whole = GreyBox(SPEC, drive, longer).simulate({})
+    first = {c: float(whole[c][k]) for c in ("T1", "T2", "T_stator")}
+    gb = GreyBox(SPEC, drive, log)
+    theta = default_theta(gb.parameters())
+    readings = gb.start_readings(theta)
+    for held in np.geomspace(60.0, Criteria().prehistory_max_s, 30):  # the light load held: short
+        assert max(abs(v - readings(held)[c]) for c, v in first.items()) > 1.5
+    start = run_start(gb, theta, first, Criteria())
+    assert start.reached and start.heat_W is not None
+    assert max(abs(v) for v in start.misfit.values()) < 0.05
+    hot = gb.sources(theta["f0"], theta["rotor_share"])
+    for motor in (True, False):
+        want = sum(float(v[60]) for n, v in hot.items() if (n in MOTOR_SOURCES) == motor)
+        assert start._group_W(motor) == pytest.approx(want, rel=0.02)
+    assert "prehistory that ran elsewhere" in start.text()
+
+
+def test_the_prehistory_heat_starts_grey_box_and_fem_alike():
+    """A prehistory of another heat (Inputs.prehistory_heat_W) starts the grey box and the
+    FEM as the run that begins with that heat held for the prehistory does, each by its own
+    steps: the grey box's modal step against its step recursion (1e-9 K), the FEM's against
+    the same backward Euler steps in front (1e-8 K, its factorisation's rounding)."""
+    from compare.fit.discrepancy import fem_readings
+    from reference import ReferenceModel
+
+    tau = 2 * 3600.0
+    log, longer = _ran_elsewhere(tau)
+    drive = drive_for(SPEC)
+    k = int(tau / 60.0)
+    gb = GreyBox(SPEC, drive, log)
+    theta = default_theta(gb.parameters())
+    hot = gb.sources(theta["f0"], theta["rotor_share"], theta.get("friction_exponent", 0.0))
+    heat_W = {n: float(v[60]) for n, v in hot.items()}
+    moved = replace(log, prehistory_s=tau, prehistory_heat_W=heat_W)
+    held = GreyBox(SPEC, drive, moved).simulate({})
+    whole = GreyBox(SPEC, drive, longer).simulate({})
+    for c in ("T1", "T2", "T_stator"):
+        np.testing.assert_allclose(held[c], whole[c][k:], rtol=0, atol=1e-9)
+    ref = ReferenceModel(SPEC, 0)
+    short = replace(moved, grid_s=moved.grid_s[:21], **{
+        f: getattr(moved, f)[:20] for f in ("speed_rpm", "power_kW", "load_torque_Nm",
+                                            "T_env_K", "T_coolant_K")})
+    front = replace(longer, grid_s=longer.grid_s[:k + 21], **{
+        f: getattr(longer, f)[:k + 20] for f in ("speed_rpm", "power_kW", "load_torque_Nm",
+                                                 "T_env_K", "T_coolant_K")})
+    fem = fem_readings(ref, SPEC, short, {n: v[:20] for n, v in hot.items()}, ["T1", "T_stator"])
+    fem_whole = fem_readings(ref, SPEC, front, {n: np.r_[np.full(k, v[60]), v[:20]]
+                                                for n, v in hot.items()}, ["T1", "T_stator"])
+    for c in ("T1", "T_stator"):
+        np.testing.assert_allclose(fem[c], fem_whole[c][k:], rtol=0, atol=1e-8)
+        assert fem[c][0] - 293.15 > 2.0
 
 
 def test_a_run_of_another_spindle_is_warned_of():
@@ -198,3 +291,35 @@ def test_a_control_logged_on_a_running_spindle_fits_as_its_unedited_run(tmp_path
     doc = run_fit(cut, SPEC).to_dict()
     assert doc["start"]["prehistory_s"] > 0
     assert doc["verdict"]["kind"] == "base adequate", doc["verdict"]
+
+
+def test_a_prehistory_elsewhere_has_its_heat_calibrated_up_to_the_runs_largest():
+    """A prehistory that ran elsewhere (Inputs.prehistory_heat_W) gives the grey box two
+    parameters, its heat in the motor and in the bearings as multiples of the read heat
+    (compare.fit.params.PREHISTORY_HEAT, calibrated with the base as prehistory_h is): a
+    multiple set in theta is that heat simulated, and each is bounded by the run's largest
+    heat in its group over the read one. A group read at no heat has no parameter."""
+    from compare.fit.greybox import MOTOR_SOURCES
+    from compare.fit.params import PREHISTORY_HEAT
+
+    log, _ = _ran_elsewhere(3 * 3600.0)
+    drive = drive_for(SPEC)
+    gb = GreyBox(SPEC, drive, log)
+    theta = default_theta(gb.parameters())
+    src = gb.sources(theta["f0"], theta["rotor_share"], theta.get("friction_exponent", 0.0))
+    read = {n: 0.5 * float(v[60]) for n, v in src.items()}  # half the hot point's
+    moved = GreyBox(SPEC, drive, replace(log, prehistory_s=3 * 3600.0, prehistory_heat_W=read))
+    params = moved.parameters()
+    motor, bearings = (PREHISTORY_HEAT[g].name for g in ("motor", "bearings"))
+    for name, group in ((motor, True), (bearings, False)):
+        peak = max(sum(float(v[i]) for n, v in src.items() if (n in MOTOR_SOURCES) == group)
+                   for i in range(len(log.grid_s) - 1))
+        want = peak / sum(v for n, v in read.items() if (n in MOTOR_SOURCES) == group)
+        assert params[name].hi == pytest.approx(want, rel=1e-12) and params[name].default == 1.0
+    doubled = {n: (2.0 if n in MOTOR_SOURCES else 1.0) * v for n, v in read.items()}
+    same = GreyBox(SPEC, drive, replace(log, prehistory_s=3 * 3600.0, prehistory_heat_W=doubled))
+    np.testing.assert_array_equal(moved.simulate({motor: 2.0})["T_stator"],
+                                  same.simulate({})["T_stator"])
+    no_motor = {n: (0.0 if n in MOTOR_SOURCES else v) for n, v in read.items()}
+    cold = GreyBox(SPEC, drive, replace(log, prehistory_s=3600.0, prehistory_heat_W=no_motor))
+    assert motor not in cold.parameters() and bearings in cold.parameters()

@@ -35,7 +35,7 @@ import numpy as np
 
 from compare.fit.effects import LIBRARY, effect_of
 from compare.fit.greybox import GreyBox
-from compare.fit.params import BASE_PARAMS, EXTRA_BASE_PARAMS, PREHISTORY, Param
+from compare.fit.params import BASE_PARAMS, EXTRA_BASE_PARAMS, PREHISTORY, PREHISTORY_HEAT, Param
 from compare.forked import ForkedColumns
 from compare.residuals import effective_samples
 from spindle.tolerances import channel_tolerance, edge_scale, edge_unit
@@ -354,6 +354,7 @@ def at_bound(fit: Fit, effect_label: str, rel: float) -> list[str]:
 
 def parameters_table(fit: Fit) -> list[dict]:
     params = {**BASE_PARAMS, **EXTRA_BASE_PARAMS, PREHISTORY.name: PREHISTORY,
+              **{p.name: p for p in PREHISTORY_HEAT.values()},
               **{p.name: p for e in LIBRARY.values() for p in e.params}}
     return [{"name": k, "unit": params[k].unit, "value": fit.theta[k], "ci95": list(fit.ci95[k]),
              "identifiable": fit.identifiable[k], "meaning": params[k].doc,

@@ -90,12 +90,15 @@ PREHISTORY_STEPS = 400
 
 def _after_prehistory(ref, spec: Spec, inputs: Inputs, sources_W: dict[str, np.ndarray],
                       T0: float, dt_s: float) -> np.ndarray:
-    """The FEM's field [K] after the first interval's inputs held for
-    ``inputs.prehistory_s`` from the uniform ``T0`` (compare.fit.start)."""
+    """The FEM's field [K] after the first interval's inputs (its heat as
+    ``inputs.prehistory_heat_W`` names) held for ``inputs.prehistory_s`` from the uniform
+    ``T0`` (compare.fit.start)."""
     tau = float(inputs.prehistory_s)
     first = Inputs(np.array([0.0, tau]), inputs.speed_rpm[:1], inputs.power_kW[:1],
                    inputs.load_torque_Nm[:1], inputs.T_env_K[:1], inputs.T_coolant_K[:1])
-    case = load_case_from_inputs(spec, first, {k: v[:1] for k, v in sources_W.items()})
+    held = inputs.prehistory_heat_W or {}  # a prehistory elsewhere (compare.fit.start)
+    case = load_case_from_inputs(spec, first, {k: np.array([held.get(k, v[0])])
+                                               for k, v in sources_W.items()})
     return ref.transient(case, max(dt_s, tau / PREHISTORY_STEPS), T0=T0).fields_K[-1]
 
 

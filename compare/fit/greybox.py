@@ -17,7 +17,7 @@ import numpy as np
 
 from compare.fit.effects import effect_of, parse_label
 from compare.fit.effects.base import CHANNELS
-from compare.fit.params import EXTRA_BASE_PARAMS, PREHISTORY, Param, base_params
+from compare.fit.params import EXTRA_BASE_PARAMS, PREHISTORY, PREHISTORY_HEAT, Param, base_params
 from lumped.blocks import Convection, FixedTemperature, conductance_at, varies_with_speed
 from lumped.build import build_network
 from lumped.simulation import LumpedModel
@@ -29,6 +29,8 @@ from spindle.streaming import modal_recursion
 from spindle.stretch import stretch_axially
 
 ROTATING = ("shaft", "tool", "rotor")
+#: the sources the motor's losses heat (:meth:`GreyBox.sources`); the others are friction's
+MOTOR_SOURCES = ("stator", "rotor")
 #: the parameters that scale a group of the network's edges (films, contacts)
 _GROUPS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact")
 #: the base parameters that change the conductance matrix K (an effect declares its own)
@@ -135,8 +137,37 @@ class GreyBox:
         if self.inputs.prehistory_s > 0:  # a moved start (compare.fit.start)
             out[PREHISTORY.name] = dc_replace(PREHISTORY, default=min(max(
                 self.inputs.prehistory_s / 3600.0, PREHISTORY.lo), PREHISTORY.hi))
+        for group, most in self._prehistory_caps().items():
+            out[PREHISTORY_HEAT[group].name] = dc_replace(PREHISTORY_HEAT[group], hi=most)
         out.update({p.name: p for e, _ in self._effects() for p in e.params})
         return out
+
+    def _prehistory_caps(self) -> dict[str, float]:
+        """For a prehistory that ran elsewhere (Inputs.prehistory_heat_W), the largest
+        multiple of its heat in the motor and in the bearings that the run's own largest heat
+        there allows (at the spec's values), by group; a group without heat has none."""
+        heat = self.inputs.prehistory_heat_W
+        if not heat:
+            return {}
+        spec = base_params(self.drive)
+        src = self.sources(spec["f0"].default, spec["rotor_share"].default)
+        caps = {}
+        for group, motor in (("motor", True), ("bearings", False)):
+            read = sum(v for k, v in heat.items() if (k in MOTOR_SOURCES) == motor)
+            peak = np.max(sum(v for k, v in src.items() if (k in MOTOR_SOURCES) == motor))
+            if read > 0:
+                caps[group] = max(float(peak) / read, 1.0 + 1e-6)
+        return caps
+
+    def prehistory_heat(self, theta: dict[str, float]) -> dict[str, float] | None:
+        """The prehistory's heat [W] by source at ``theta`` (the read heat times its group's
+        multiple; None: the first interval's)."""
+        heat = self.inputs.prehistory_heat_W
+        if not heat:
+            return None
+        return {k: v * theta.get(PREHISTORY_HEAT["motor" if k in MOTOR_SOURCES
+                                                 else "bearings"].name, 1.0)
+                for k, v in heat.items()}
 
     def full_theta(self, theta: dict[str, float]) -> dict[str, float]:
         """``theta`` with every parameter it does not name at its default."""
@@ -326,14 +357,21 @@ class GreyBox:
                                + [inp.T_env_K if f == "ambient" else inp.T_coolant_K
                                   for f in sys.fixed_sources])
 
-    def _start(self, sys, u0: np.ndarray, speed_rpm: float, prehistory_s: float
-               ) -> np.ndarray:
+    def _start(self, sys, u0: np.ndarray, speed_rpm: float, prehistory_s: float,
+               heat_W: dict[str, float] | None = None) -> np.ndarray:
         """The state at grid[0] [K]: uniform at the inputs' start temperature, then the first
-        interval's inputs ``u0`` (at ``speed_rpm``) held for ``prehistory_s`` [s], exact."""
+        interval's inputs ``u0`` (at ``speed_rpm``) held for ``prehistory_s`` [s], exact;
+        the sources ``heat_W`` names [W] (default the inputs' prehistory_heat_W) at those
+        values instead of the first interval's."""
         inp = self.inputs
         x = np.full(sys.n_states, inp.T_start_K if inp.T_start_K is not None else inp.T_env_K[0])
         if prehistory_s <= 0:
             return x
+        heat_W = inp.prehistory_heat_W if heat_W is None else heat_W
+        if heat_W:
+            u0 = u0.copy()
+            for i, name in enumerate(sys.source_names):
+                u0[i] = heat_W.get(name, u0[i])
         modal = None if sys.temperature_dependent else sys.modes(prehistory_s, speed_rpm)
         if modal is not None:
             a, Bm, to_modal, from_modal = modal
@@ -343,7 +381,7 @@ class GreyBox:
 
     def start_readings(self, theta: dict[str, float]):
         """The temperature sensors' readings at grid[0] [K] as a function of the prehistory
-        [s] (:meth:`_start`), for the parameters ``theta``."""
+        [s] and its heat [W] by source (:meth:`_start`), for the parameters ``theta``."""
         th = self.full_theta(theta)
         model = self._model(th)
         sys = model.system
@@ -352,8 +390,9 @@ class GreyBox:
         rows = {n: model.S[model.sensor_names.index(n)] for n in model.sensor_names
                 if n in CHANNELS and n != "P1"}
 
-        def readings(prehistory_s: float) -> dict[str, float]:
-            x = self._start(sys, u0, speed, prehistory_s)
+        def readings(prehistory_s: float, heat_W: dict[str, float] | None = None
+                     ) -> dict[str, float]:
+            x = self._start(sys, u0, speed, prehistory_s, heat_W)
             return {n: float(r @ x) for n, r in rows.items()}
 
         return readings
@@ -373,7 +412,8 @@ class GreyBox:
         m = len(sys.source_names)
         n_K = self.conductance_speeds()
         # a moved start's prehistory is a parameter (parameters()); else there is none
-        x = self._start(sys, U[0], float(n_K[0]), 3600.0 * th.get(PREHISTORY.name, 0.0))
+        x = self._start(sys, U[0], float(n_K[0]), 3600.0 * th.get(PREHISTORY.name, 0.0),
+                        self.prehistory_heat(th))
         names = [n for n in model.sensor_names if n in CHANNELS]
         rows = [model.S[model.sensor_names.index(n)] for n in names]
         has_p1 = "P1" in model.chain.rows

@@ -109,6 +109,15 @@ PREHISTORY = Param("prehistory_h", "h", 1.0, 1.0 / 60.0, 48.0, "the run's first 
                    source="the first samples' estimate (compare.fit.start) as its start, no "
                    "prior: the run's first hours decide")
 
+#: a prehistory that ran elsewhere (compare.fit.start): its heat in the motor and in the
+#: bearings as multiples of the first samples' estimate, calibrated with the base as its
+#: length is; the upper bound (GreyBox.parameters) is the run's own largest heat
+PREHISTORY_HEAT = {group: Param(
+    f"prehistory_{group}_x", "x", 1.0, 0.0, 1.0, f"the heat in the {group} during a "
+    "prehistory that ran elsewhere, a multiple of the first samples' estimate",
+    log=False, source="the first samples' estimate (compare.fit.start) as its start, no "
+    "prior: the run's first hours decide") for group in ("motor", "bearings")}
+
 #: the extras calibrated by default (``fit`` without ``--base-extra``). heat_capacity is not:
 #: it takes up part of a bearing preload and, on a peer's runs, lowered the validation error
 #: without better verdicts. The three that are each give the base a freedom that, missing,

@@ -143,7 +143,7 @@ def calibrate_base(path: str | Path, spec: Spec, fit_fraction: float = 0.6, node
                             "axially, so its lengths do not scale as one parameter")
     begins = run_start(plain, default_theta(plain.parameters()),
                        first_samples(run, channels, raw.grid_s), criteria)
-    raw = replace(raw, prehistory_s=begins.prehistory_s)
+    raw = replace(raw, prehistory_s=begins.prehistory_s, prehistory_heat_W=begins.heat_W)
     spec_model = GreyBox(spec, drive, raw, nodes, base_extra=base_extra,
                          speed_bin_rel=criteria.speed_bin_rel,
                          p1_reference_s=_late_p1_reference(run, channels, raw.grid_s))

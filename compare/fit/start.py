@@ -7,9 +7,13 @@ that start. Where one of them misses it by more than ``Criteria.start_within_tol
 the model starts instead from the run's first operating point (speed, power, room and
 coolant of its first interval) held for a time tau before the log, from the room's
 temperature. tau = 0 is the uniform start; a long tau is that point's steady state (a soak at
-rest, or a spindle that ran there). tau is first the one value that best reproduces the first
+rest, or a spindle that ran there). Where no tau reaches the first samples, the spindle ran
+elsewhere before the log (a log begun lightly loaded after heavy work): the prehistory's heat
+is read as well, a fraction of the run's own largest heat in the motor and, apart, in the
+bearings (:func:`_elsewhere`). tau is first the one value that best reproduces the first
 samples of the temperature channels with the spec's model; the FEM anchor starts from it, and
-the grey box calibrates it with the base parameters from there (compare.fit.params.PREHISTORY):
+the grey box calibrates it (and a prehistory elsewhere's heat, PREHISTORY_HEAT) with the base
+parameters from there (compare.fit.params.PREHISTORY):
 the first hours' relaxation says more of the unsensed slow masses than three first samples
 (docs/fit.md, step 1; docs/fit-history.md, "2026-11-29 (17)").
 """
@@ -19,11 +23,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar
+from scipy.optimize import least_squares, minimize_scalar
 
 from compare.fit.calibrate import TOLERANCE
 from compare.fit.criteria import Criteria
-from compare.fit.greybox import GreyBox
+from compare.fit.greybox import MOTOR_SOURCES, GreyBox
 from spindle.bench import BenchRun
 
 #: the tried prehistories per decade between the grid's step and Criteria.prehistory_max_s,
@@ -43,6 +47,8 @@ class Start:
     prehistory_s: float
     #: Criteria.start_within_tolerances of the fit
     within: float = 1.0
+    #: the prehistory's heat [W] by source, where it is not the first interval's
+    heat_W: dict[str, float] | None = None
 
     def text(self) -> str:
         """The warning for a start off the uniform one ("" where the first samples agree)."""
@@ -52,16 +58,29 @@ class Start:
         text = (f"the run does not start at the room's temperature: {worst}'s first sample is "
                 f"{self.uniform_misfit[worst] * TOLERANCE[worst]:+.1f} K from a uniform start")
         if self.prehistory_s > 0:
-            text += (", so the model starts from the run's first operating point held for "
-                     "a prehistory before the log: read from the first samples as "
-                     f"{self.prehistory_s / 3600:.2f} h, which leaves "
-                     + ", ".join(f"{c} {v * TOLERANCE[c]:+.2f} K"
-                                 for c, v in self.misfit.items())
-                     + " there, and calibrated with the base from it (prehistory_h)")
+            if self.heat_W:
+                text += (", so the model starts from a prehistory that ran elsewhere (no time "
+                         "at the run's first operating point reaches the first samples): "
+                         f"{self._group_W(True):.0f} W in the motor and "
+                         f"{self._group_W(False):.0f} W in the bearings for "
+                         f"{self.prehistory_s / 3600:.2f} h, read from the first samples")
+            else:
+                text += (", so the model starts from the run's first operating point held "
+                         "for a prehistory before the log: read from the first samples as "
+                         f"{self.prehistory_s / 3600:.2f} h")
+            text += (", which leaves " + ", ".join(f"{c} {v * TOLERANCE[c]:+.2f} K"
+                                           for c, v in self.misfit.items())
+                     + " there, and calibrated with the base from it ("
+                     + ("prehistory_h and its heat's multiples, prehistory_motor_x and "
+                        "prehistory_bearings_x" if self.heat_W else "prehistory_h") + ")")
         if not self.reached:
-            text += ("; no time at the run's first operating point reaches the logged start, "
-                     "so part of the first hours' misfit is the start's")
+            text += ("; no prehistory of the run's heat reaches the logged start, so part of "
+                     "the first hours' misfit is the start's")
         return text + " (compare.fit.start)"
+
+    def _group_W(self, motor: bool) -> float:
+        """The prehistory's heat [W] in the motor's sources, or in the others."""
+        return sum(v for k, v in (self.heat_W or {}).items() if (k in MOTOR_SOURCES) == motor)
 
     @property
     def moved(self) -> bool:
@@ -74,7 +93,8 @@ class Start:
         return all(abs(v) <= self.within for v in self.misfit.values())
 
     def to_dict(self) -> dict:
-        return {"prehistory_s": self.prehistory_s, "reached": self.reached,
+        return {"prehistory_s": self.prehistory_s, "prehistory_heat_W": self.heat_W,
+                "reached": self.reached,
                 "first_K": self.first_K, "uniform_misfit_tolerances": self.uniform_misfit,
                 "misfit_tolerances": self.misfit}
 
@@ -124,4 +144,43 @@ def run_start(gb: GreyBox, theta: dict[str, float], first_K: dict[str, float],
                               method="bounded", options={"xatol": 1e-3})
         if res.fun < costs[i]:
             best = float(np.exp(res.x))
-    return Start(first_K, uniform, misfit(best), best, criteria.start_within_tolerances)
+    begins = Start(first_K, uniform, misfit(best), best, criteria.start_within_tolerances)
+    if begins.reached:
+        return begins
+    return _elsewhere(gb, theta, first_K, begins, readings, step, criteria) or begins
+
+
+def _elsewhere(gb: GreyBox, theta: dict[str, float], first_K: dict[str, float], held: Start,
+               readings, step_s: float, criteria: Criteria) -> Start | None:
+    """Where no time at the first operating point reaches the first samples, the spindle ran
+    elsewhere before the log: its prehistory's heat is read as well, a fraction in [0, 1] of
+    the run's own largest heat in the motor and, apart, in the bearings (the two heat T_stator
+    and the rings in other proportions; a spindle runs before its log as within it, so no
+    more). None where that does not start nearer the first samples than ``held``."""
+    src = gb.sources(theta["f0"], theta["rotor_share"], theta.get("friction_exponent", 0.0))
+    groups = [[k for k in src if (k in MOTOR_SOURCES) == motor] for motor in (True, False)]
+    groups = [g for g in groups if g]
+    peaks, f0 = [], []
+    for names in groups:
+        total = sum(src[k] for k in names)
+        i = int(np.argmax(total))
+        peaks.append({k: float(src[k][i]) for k in names})
+        f0.append(float(np.clip(total[0] / total[i], 0.0, 1.0)) if total[i] > 0 else 0.0)
+
+    def heat(f) -> dict[str, float]:
+        return {k: float(fg) * v for fg, peak in zip(f, peaks, strict=True)
+                for k, v in peak.items()}
+
+    def misfit(z) -> dict[str, float]:
+        y = readings(float(np.exp(z[0])), heat(z[1:]))
+        return {c: (v - y[c]) / TOLERANCE[c] for c, v in first_K.items() if c in y}
+
+    lo = np.r_[np.log(step_s), np.zeros(len(peaks))]
+    hi = np.r_[np.log(criteria.prehistory_max_s), np.ones(len(peaks))]
+    z0 = np.clip(np.r_[np.log(max(held.prehistory_s, step_s)), f0], lo, hi)
+    sol = least_squares(lambda z: list(misfit(z).values()), z0, bounds=(lo, hi))
+    end = misfit(sol.x)
+    if sum(v * v for v in end.values()) >= sum(v * v for v in held.misfit.values()):
+        return None
+    return Start(first_K, held.uniform_misfit, end, float(np.exp(sol.x[0])), held.within,
+                 heat(sol.x[1:]))
