@@ -51,22 +51,23 @@ Q_MAX_W = 2000.0
 D_MAX_TOL = 10.0
 
 
+def _heat_role(net, role: str, source: str) -> None:
+    """A heat source ``source`` spread over the masses of the first part of ``role``."""
+    part = next(p for p in net.parts.values() if p.part.role == role)
+    spread_heat(net, part.masses, source, f"source:{source}")
+
+
 class WindowHeat(Effect):
     """An unexplained heat into the first part of ``role`` during [t0, t1) [s]."""
-
-    channels = ("T1", "T2", "T_stator", "P1")
 
     def __init__(self, role: str, t0_s: float, t1_s: float):
         self.role, self.t0_s, self.t1_s = role, float(t0_s), float(t1_s)
         self.name = f"{NAME}[heat into the {role}, {t0_s / 3600:.1f}-{t1_s / 3600:.1f} h]"
-        self.explanation = (f"a heat of q into the {role} from {t0_s / 3600:.1f} h to "
-                            f"{t1_s / 3600:.1f} h that no effect of the library explains")
         self.params = (Param("q_else_W", "W", 0.0, -Q_MAX_W, Q_MAX_W,
                              "unexplained heat into the part during the window", log=False),)
 
     def extend_network(self, net, spec, power_measured):
-        part = next(p for p in net.parts.values() if p.part.role == self.role)
-        spread_heat(net, part.masses, NAME, f"source:{NAME}")
+        _heat_role(net, self.role, NAME)
 
     def heat(self, sources_W, theta, inputs):
         # the heat flows on the grid's intervals whose middle lies in [t0, t1)
@@ -83,21 +84,16 @@ class SpeedHeat(Effect):
     spec lacks). Windage is one such law, with k = 3 into the rotor; only its signature, the
     drag in the logged power, tells it from the others."""
 
-    channels = ("T1", "T2", "T_stator", "P1")
-
     def __init__(self, role: str):
         self.role = role
         self.name = f"{NAME}[a heat into the {role} rising with speed]"
-        self.explanation = (f"a heat into the {role} that rises with speed as a power of it, "
-                            "which no effect of the library explains")
         self.params = (Param("q_law_W", "W", 0.0, 0.0, LAW_MAX_W, f"the heat into the {role} "
                              f"at {FRICTION_REF_RPM:g} rpm", log=False),
                        Param("k_law", "-", 2.0, 0.0, 4.0, "its exponent of the speed",
                              log=False))
 
     def extend_network(self, net, spec, power_measured):
-        part = next(p for p in net.parts.values() if p.part.role == self.role)
-        spread_heat(net, part.masses, f"law:{self.role}", f"source:law:{self.role}")
+        _heat_role(net, self.role, f"law:{self.role}")
 
     def heat(self, sources_W, theta, inputs):
         n = np.maximum(np.asarray(inputs.speed_rpm, dtype=float), 0.0)

@@ -88,8 +88,9 @@ class BearingPreload(Effect):
             pts.append((z, 0.5 * float(sec.r_in(z) + sec.r_out(z))))
         P = thermal.probe_matrix(np.array(pts).T).toarray()
         functionals = {f"{p}.{sec.name}": row for (p, sec), row in zip(rings, P, strict=True)}
-        bearings = bearing_sources(spec)
-        ks = [_k_of(spec, h, truth) for h in bearings]
+        bearings = spec.sources_with_role("front_bearing", "rear_bearing")
+        # a truth written before the rear coefficient existed holds one for both
+        ks = [truth.get(param_of(spec, h.name), truth[FRONT]) for h in bearings]
 
         def differences(readings, case, t):
             return np.concatenate([readings[f"{h.part}.inner_ring"]
@@ -114,20 +115,6 @@ def param_of(spec, source: str) -> str:
     """The preload parameter of a bearing heat source: the front set's or the rear's."""
     src = next(h for h in spec.heat_sources if h.name == source)
     return REAR if spec.part(src.part).role == "rear_bearing" else FRONT
-
-
-def bearing_sources(spec) -> list:
-    """The spec's bearing heat sources, in the order the feedback stacks their ring
-    differences."""
-    return spec.sources_with_role("front_bearing", "rear_bearing")
-
-
-def _k_of(spec, source, truth) -> float:
-    """The injected coefficient [1/K] of a bearing heat source (a truth written before the
-    rear coefficient existed holds one for both)."""
-    if spec.part(source.part).role == "rear_bearing":
-        return truth.get(REAR, truth[FRONT])
-    return truth[FRONT]
 
 
 def _drag_flows(net) -> list[tuple]:
