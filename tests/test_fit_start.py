@@ -166,7 +166,7 @@ def test_a_spindle_that_ran_elsewhere_starts_from_a_prehistory_of_its_heat():
     least-squares fit's, far below the 1 tolerance of Criteria.start_within_tolerances) and
     the prehistory's heat is the hot point's to 2 % (an exactly determined inversion of three
     readings for three unknowns)."""
-    from compare.fit.greybox import MOTOR_SOURCES
+    from spindle.drive_file import MOTOR_SOURCES
 
     tau = 6 * 3600.0
     log, longer = _ran_elsewhere(tau)
@@ -185,7 +185,7 @@ def test_a_spindle_that_ran_elsewhere_starts_from_a_prehistory_of_its_heat():
     hot = gb.sources(theta["f0"], theta["rotor_share"])
     for motor in (True, False):
         want = sum(float(v[60]) for n, v in hot.items() if (n in MOTOR_SOURCES) == motor)
-        assert start._group_W(motor) == pytest.approx(want, rel=0.02)
+        assert start.group_W("motor" if motor else "bearings") == pytest.approx(want, rel=0.02)
     assert "prehistory that ran elsewhere" in start.text()
 
 
@@ -299,8 +299,8 @@ def test_a_prehistory_elsewhere_has_its_heat_calibrated_up_to_the_runs_largest()
     (compare.fit.params.PREHISTORY_HEAT, calibrated with the base as prehistory_h is): a
     multiple set in theta is that heat simulated, and each is bounded by the run's largest
     heat in its group over the read one. A group read at no heat has no parameter."""
-    from compare.fit.greybox import MOTOR_SOURCES
     from compare.fit.params import PREHISTORY_HEAT
+    from spindle.drive_file import MOTOR_SOURCES
 
     log, _ = _ran_elsewhere(3 * 3600.0)
     drive = drive_for(SPEC)

@@ -23,14 +23,13 @@ from lumped.build import build_network
 from lumped.simulation import LumpedModel
 from spindle.bench_inputs import Inputs, interval_heat_W
 from spindle.drive import Drive
+from spindle.drive_file import MOTOR_SOURCES
 from spindle.errors import InputError
 from spindle.spec import ContactLink, Spec
 from spindle.streaming import modal_recursion
 from spindle.stretch import stretch_axially
 
 ROTATING = ("shaft", "tool", "rotor")
-#: the sources the motor's losses heat (:meth:`GreyBox.sources`); the others are friction's
-MOTOR_SOURCES = ("stator", "rotor")
 #: the parameters that scale a group of the network's edges (films, contacts)
 _GROUPS = ("h_coolant", "h_air", "h_rotating", "contact", "stator_contact")
 #: the base parameters that change the conductance matrix K (an effect declares its own)
@@ -48,6 +47,19 @@ def _geometric(x: np.ndarray, floor: float, rel: float) -> np.ndarray:
     relative step ``rel``."""
     step = np.log1p(rel)
     return np.exp(np.round(np.log(np.maximum(x, floor)) / step) * step)
+
+
+def source_group(name: str) -> str:
+    """"motor" for a source the motor's losses heat (MOTOR_SOURCES), else "bearings"."""
+    return "motor" if name in MOTOR_SOURCES else "bearings"
+
+
+def heat_groups(heat_W: dict[str, float]) -> dict[str, float]:
+    """The heat [W] of ``heat_W`` summed by :func:`source_group`."""
+    out: dict[str, float] = {}
+    for k, v in heat_W.items():
+        out[source_group(k)] = out.get(source_group(k), 0.0) + v
+    return out
 
 
 @dataclass
@@ -149,15 +161,28 @@ class GreyBox:
         heat = self.inputs.prehistory_heat_W
         if not heat:
             return {}
-        spec = base_params(self.drive)
-        src = self.sources(spec["f0"].default, spec["rotor_share"].default)
-        caps = {}
-        for group, motor in (("motor", True), ("bearings", False)):
-            read = sum(v for k, v in heat.items() if (k in MOTOR_SOURCES) == motor)
-            peak = np.max(sum(v for k, v in src.items() if (k in MOTOR_SOURCES) == motor))
-            if read > 0:
-                caps[group] = max(float(peak) / read, 1.0 + 1e-6)
-        return caps
+        # parameters() asks it on every simulation; under "src", as all that the inputs decide
+        key = ("src", "prehistory_caps")
+        if key not in self._cache:
+            spec = base_params(self.drive)
+            hottest = self.hottest({k: spec[k].default for k in ("f0", "rotor_share")})
+            read = heat_groups(heat)
+            self._cache[key] = {g: max(sum(peak.values()) / read[g], 1.0 + 1e-6)
+                                for g, peak in hottest.items() if read.get(g, 0.0) > 0}
+        return self._cache[key]
+
+    def hottest(self, theta: dict[str, float]) -> dict[str, dict[str, float]]:
+        """Per group of sources (:func:`heat_groups`' "motor", "bearings"), each source's
+        heat [W] in the interval where the group's total is largest, at ``theta``'s f0,
+        rotor_share and friction_exponent (0 where it names none)."""
+        src = self.sources(theta["f0"], theta["rotor_share"], theta.get("friction_exponent", 0.0))
+        out = {}
+        for group in ("motor", "bearings"):
+            names = [k for k in src if source_group(k) == group]
+            if names:
+                i = int(np.argmax(sum(src[k] for k in names)))
+                out[group] = {k: float(src[k][i]) for k in names}
+        return out
 
     def prehistory_heat(self, theta: dict[str, float]) -> dict[str, float] | None:
         """The prehistory's heat [W] by source at ``theta`` (the read heat times its group's
@@ -165,8 +190,7 @@ class GreyBox:
         heat = self.inputs.prehistory_heat_W
         if not heat:
             return None
-        return {k: v * theta.get(PREHISTORY_HEAT["motor" if k in MOTOR_SOURCES
-                                                 else "bearings"].name, 1.0)
+        return {k: v * theta.get(PREHISTORY_HEAT[source_group(k)].name, 1.0)
                 for k, v in heat.items()}
 
     def full_theta(self, theta: dict[str, float]) -> dict[str, float]:

@@ -27,7 +27,7 @@ from scipy.optimize import least_squares, minimize_scalar
 
 from compare.fit.calibrate import TOLERANCE
 from compare.fit.criteria import Criteria
-from compare.fit.greybox import MOTOR_SOURCES, GreyBox
+from compare.fit.greybox import GreyBox, heat_groups
 from spindle.bench import BenchRun
 
 #: the tried prehistories per decade between the grid's step and Criteria.prehistory_max_s,
@@ -61,8 +61,8 @@ class Start:
             if self.heat_W:
                 text += (", so the model starts from a prehistory that ran elsewhere (no time "
                          "at the run's first operating point reaches the first samples): "
-                         f"{self._group_W(True):.0f} W in the motor and "
-                         f"{self._group_W(False):.0f} W in the bearings for "
+                         f"{self.group_W('motor'):.0f} W in the motor and "
+                         f"{self.group_W('bearings'):.0f} W in the bearings for "
                          f"{self.prehistory_s / 3600:.2f} h, read from the first samples")
             else:
                 text += (", so the model starts from the run's first operating point held "
@@ -78,9 +78,10 @@ class Start:
                      "the first hours' misfit is the start's")
         return text + " (compare.fit.start)"
 
-    def _group_W(self, motor: bool) -> float:
-        """The prehistory's heat [W] in the motor's sources, or in the others."""
-        return sum(v for k, v in (self.heat_W or {}).items() if (k in MOTOR_SOURCES) == motor)
+    def group_W(self, group: str) -> float:
+        """The prehistory's heat [W] in the motor's sources or the bearings'
+        (compare.fit.greybox.heat_groups)."""
+        return heat_groups(self.heat_W or {}).get(group, 0.0)
 
     @property
     def moved(self) -> bool:
@@ -119,8 +120,8 @@ def run_start(gb: GreyBox, theta: dict[str, float], first_K: dict[str, float],
     ``theta`` (the spec's values: module docstring)."""
     readings = gb.start_readings(theta)
 
-    def misfit(tau: float) -> dict[str, float]:
-        y = readings(tau)
+    def misfit(tau: float, heat_W: dict[str, float] | None = None) -> dict[str, float]:
+        y = readings(tau, heat_W)
         return {c: (v - y[c]) / TOLERANCE[c] for c, v in first_K.items() if c in y}
 
     def cost(tau: float) -> float:
@@ -147,40 +148,38 @@ def run_start(gb: GreyBox, theta: dict[str, float], first_K: dict[str, float],
     begins = Start(first_K, uniform, misfit(best), best, criteria.start_within_tolerances)
     if begins.reached:
         return begins
-    return _elsewhere(gb, theta, first_K, begins, readings, step, criteria) or begins
+    return _elsewhere(gb, theta, begins, misfit, step, criteria) or begins
 
 
-def _elsewhere(gb: GreyBox, theta: dict[str, float], first_K: dict[str, float], held: Start,
-               readings, step_s: float, criteria: Criteria) -> Start | None:
+def _elsewhere(gb: GreyBox, theta: dict[str, float], held: Start, misfit, step_s: float,
+               criteria: Criteria) -> Start | None:
     """Where no time at the first operating point reaches the first samples, the spindle ran
     elsewhere before the log: its prehistory's heat is read as well, a fraction in [0, 1] of
     the run's own largest heat in the motor and, apart, in the bearings (the two heat T_stator
     and the rings in other proportions; a spindle runs before its log as within it, so no
-    more). None where that does not start nearer the first samples than ``held``."""
-    src = gb.sources(theta["f0"], theta["rotor_share"], theta.get("friction_exponent", 0.0))
-    groups = [[k for k in src if (k in MOTOR_SOURCES) == motor] for motor in (True, False)]
-    groups = [g for g in groups if g]
-    peaks, f0 = [], []
-    for names in groups:
-        total = sum(src[k] for k in names)
-        i = int(np.argmax(total))
-        peaks.append({k: float(src[k][i]) for k in names})
-        f0.append(float(np.clip(total[0] / total[i], 0.0, 1.0)) if total[i] > 0 else 0.0)
+    more). None where that does not start nearer the first samples than ``held``; ``misfit``
+    (tau [s], heat [W] by source): the first samples' misfit [tolerances] from that start."""
+    hottest = gb.hottest(theta)
+    first = heat_groups({k: float(v[0]) for k, v in gb.sources(
+        theta["f0"], theta["rotor_share"], theta.get("friction_exponent", 0.0)).items()})
+    peaks = list(hottest.values())
+    top = [sum(peak.values()) for peak in peaks]
+    f0 = [float(np.clip(first[g] / t, 0.0, 1.0)) if t > 0 else 0.0
+          for g, t in zip(hottest, top, strict=True)]
 
     def heat(f) -> dict[str, float]:
         return {k: float(fg) * v for fg, peak in zip(f, peaks, strict=True)
                 for k, v in peak.items()}
 
-    def misfit(z) -> dict[str, float]:
-        y = readings(float(np.exp(z[0])), heat(z[1:]))
-        return {c: (v - y[c]) / TOLERANCE[c] for c, v in first_K.items() if c in y}
+    def at(z) -> dict[str, float]:
+        return misfit(float(np.exp(z[0])), heat(z[1:]))
 
     lo = np.r_[np.log(step_s), np.zeros(len(peaks))]
     hi = np.r_[np.log(criteria.prehistory_max_s), np.ones(len(peaks))]
     z0 = np.clip(np.r_[np.log(max(held.prehistory_s, step_s)), f0], lo, hi)
-    sol = least_squares(lambda z: list(misfit(z).values()), z0, bounds=(lo, hi))
-    end = misfit(sol.x)
+    sol = least_squares(lambda z: list(at(z).values()), z0, bounds=(lo, hi))
+    end = at(sol.x)
     if sum(v * v for v in end.values()) >= sum(v * v for v in held.misfit.values()):
         return None
-    return Start(first_K, held.uniform_misfit, end, float(np.exp(sol.x[0])), held.within,
+    return Start(held.first_K, held.uniform_misfit, end, float(np.exp(sol.x[0])), held.within,
                  heat(sol.x[1:]))
