@@ -336,14 +336,20 @@ class ThermalSystem:
 
     def _full(self, speed_rpm: float, q: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
         """K over all free nodes and B (free x inputs) at a speed, for source powers q."""
-        st = self._stamps()
-        K, B = st.K0.copy(), st.B0.copy()
-        if st.varying:
-            g = np.array([conductance_at(G, speed_rpm) for G in st.varying])
-            K += (st.Kv @ g).reshape(K.shape)
-            B += (st.Bv @ g).reshape(B.shape)
-        if q is None or not self.temperature_dependent:
-            return K, B
+        feedback = q is not None and self.temperature_dependent
+        if feedback and ("full", speed_rpm) in self._cache:
+            # the speed's part is the same for every q: a fit asks many q at a speed
+            K, B = (a.copy() for a in self._cache[("full", speed_rpm)])
+        else:
+            st = self._stamps()
+            K, B = st.K0.copy(), st.B0.copy()
+            if st.varying:
+                g = np.array([conductance_at(G, speed_rpm) for G in st.varying])
+                K += (st.Kv @ g).reshape(K.shape)
+                B += (st.Bv @ g).reshape(B.shape)
+            if not feedback:
+                return K, B
+            self._cache[("full", speed_rpm)] = (K.copy(), B.copy())
         pos = self._pos
         col = self._source_col
         for n, f in self.flows:  # the temperature-dependent flows' terms in K

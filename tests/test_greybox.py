@@ -96,6 +96,66 @@ def test_a_simulation_does_not_depend_on_the_parameter_sets_simulated_before(set
         np.testing.assert_array_equal(again[c], fresh[c])
 
 
+@pytest.mark.parametrize("bin_rel", [0.0, 0.05])
+def test_a_feedback_simulation_is_the_recursion_step_by_step(setup, bin_rel):
+    """With a bearing preload the bearings' heat enters the matrices, so the grey box steps
+    through the run with an exact zero-order-hold step per interval. It makes one step per
+    distinct binned heat of a segment and bins the run's heat once (binning and keying each
+    interval took half of a preload run's fit). The states must be, bit for bit, those of
+    the recursion x+ = Phi(q_i) x + Gamma(q_i) u_i with each interval's own step: the same
+    steps and the same products in the same order. The states are read through unit
+    read-out rows, which copy them exactly."""
+    from dataclasses import replace
+
+    spec, _, inp = setup
+    # a logged speed that wanders within 3 % of its level, as a bench's does: the conductances
+    # see one binned speed (one segment), the bearings' heat the exact one, so the heat, and
+    # with it the step, changes from interval to interval inside a segment
+    wobble = 1.0 + 0.03 * np.sin(np.arange(len(inp.speed_rpm)) * 0.7)
+    inp = replace(inp, speed_rpm=np.asarray(inp.speed_rpm, dtype=float) * wobble)
+    gb = GreyBox(spec, DRIVES["spl2782"], inp, speed_bin_rel=bin_rel).variant(
+        ("bearing_preload",))
+    theta = {"k_preload_1_K": 0.02, "k_preload_rear_1_K": 0.01, "f0": 1.2}
+    th = gb.full_theta(theta)
+    system = gb._model(th).system
+    assert system.temperature_dependent
+    n = system.n_states
+    rows = {f"x{k}": np.eye(n)[k] for k in range(n)}
+    out = gb.simulate(theta, extra_rows=rows)
+    X = np.column_stack([out[f"x{k}"] for k in range(n)])
+    U = gb._input_matrix(th, system)
+    m = len(system.source_names)
+    speeds, dts = gb.conductance_speeds(), np.diff(inp.grid_s)
+    x = X[0]
+    steps = []
+    for i in range(len(dts)):
+        Phi, Gam = system.discretize(float(dts[i]), float(speeds[i]), gb._binned(U[i, :m]))
+        x = Phi @ x + Gam @ U[i]
+        steps.append(x)
+    np.testing.assert_array_equal(X[1:], np.array(steps))
+    if bin_rel:  # segments of many intervals, whose heats differ
+        assert len(np.unique(speeds)) < len(speeds) / 4
+        assert len(np.unique(gb._binned(U[:, :m]), axis=0)) > 2 * len(np.unique(speeds))
+    assert np.ptp(X[:, 0]) > 1.0  # the run heats the spindle
+
+
+def test_the_heat_of_each_interval_is_its_operating_points(setup):
+    """The power balances are made once per distinct operating point of the run (speed,
+    torque, power) and spread over the intervals; each interval's heat must be the drive's
+    heat at its own operating point, exactly."""
+    spec, _, inp = setup
+    gb = GreyBox(spec, DRIVES["spl2782"], inp)
+    points, which = gb._operating_points()
+    assert len(points) < len(which) / 5  # a cycle repeats its operating points
+    heat = gb.sources(1.3, 0.4, 0.2)
+    drive = DRIVES["spl2782"].with_f0(1.3).with_rotor_share(0.4).with_friction_exponent(0.2)
+    for i in range(0, len(which), 7):
+        ref = drive.heat_W(round(float(inp.speed_rpm[i]), 3),
+                           round(float(inp.load_torque_Nm[i]), 2), None)
+        for src, value in ref.items():
+            assert heat[src][i] == pytest.approx(value, rel=1e-12, abs=1e-12), (i, src)
+
+
 def test_grey_boxes_on_other_inputs_may_share_a_cache_without_its_input_keys(setup):
     """The gap placement (compare.fit.run._place_gap_switches) tries a speed switch at each
     grid edge inside a logging gap, each a grey box on other inputs sharing one cache (the

@@ -173,8 +173,9 @@ def test_the_stamped_matrices_are_the_entrywise_ones(nodes, tc):
     """K and B at a speed come from stamps summed once per system (a fit asks for them at
     every speed of every parameter set); they must be the matrices eq. 8 writes entry by
     entry, on spl2782's networks with speed-dependent films and bearings, and with the
-    temperature-dependent bearing friction. Tolerance: the two sum the same terms in another
-    order, 1e-13 of the largest entry is a few hundred roundings of 1e-16."""
+    temperature-dependent bearing friction, at two heats per speed. Tolerance: the two sum the
+    same terms in another order, 1e-13 of the largest entry is a few hundred roundings of
+    1e-16."""
     from lumped.build import build_network
     from spindle.spec_reader import load_spec
 
@@ -183,7 +184,8 @@ def test_the_stamped_matrices_are_the_entrywise_ones(nodes, tc):
     assert len(sys_._stamps().varying) > 0 and sys_.temperature_dependent == (tc != 0)
     q = np.linspace(10.0, 100.0, len(sys_.source_names))
     for speed in (0.0, 1234.5, 4300.0, 9000.0):
-        for power in (None, q):
+        # a second heat at the same speed reuses the speed's part of the first (_full)
+        for power in (None, q, 1.7 * q):
             K, B = sys_._full(speed, power)
             K_ref, B_ref = _loop_matrices(sys_, speed, power if tc else None)
             np.testing.assert_allclose(K, K_ref, rtol=0, atol=1e-13 * np.abs(K_ref).max())

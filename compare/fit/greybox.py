@@ -214,7 +214,7 @@ class GreyBox:
             rotor = rotor_share * whole["stator"]
             out = {**whole, "rotor": rotor, "stator": whole["stator"] - rotor}
             srcs = [k2 for k2 in self._cache if isinstance(k2, tuple) and k2[:1] == ("src",)
-                    and k2[1] != "balances"]
+                    and not isinstance(k2[1], str)]  # not the balances, points, caps
             for k2 in srcs[:-7]:  # keep the last few: a Jacobian visits f0 and the split
                 del self._cache[k2]
             self._cache[key] = out
@@ -227,25 +227,33 @@ class GreyBox:
         if key not in self._cache:
             d = self.drive.with_f0(f0).with_rotor_share(0.0).with_friction_exponent(
                 friction_exponent)
-            inp = self.inputs
-            memo: dict[tuple, dict[str, float]] = {}
-            rows = []
-            for n, M, P in zip(inp.speed_rpm, inp.load_torque_Nm, inp.power_kW, strict=True):
-                # measured power to 10 W: below the losses' own uncertainty, and it keeps
-                # the number of distinct operating points (power-balance calls) small
-                k = (round(float(n), 3), round(float(M), 2),
-                     None if np.isnan(P) else round(float(P), 2))
-                # P unknown (nan): the motor model gives the losses; measured P: standstill
-                # and P < P_mech handled as the bench does
-                if k not in memo:
-                    memo[k] = (d.heat_W(k[0], k[1], None) if k[2] is None
-                               else interval_heat_W(d, k[0], k[1], k[2])[0])
-                rows.append(memo[k])
+            points, which = self._operating_points()
+            # P unknown (None): the motor model gives the losses; measured P: standstill
+            # and P < P_mech handled as the bench does
+            heats = [d.heat_W(n, M, None) if P is None else interval_heat_W(d, n, M, P)[0]
+                     for n, M, P in points]
             old = [k2 for k2 in self._cache if isinstance(k2, tuple)
                    and k2[:2] == ("src", "balances")]
             for k2 in old[:-3]:  # a Jacobian visits f0 and the friction exponent
                 del self._cache[k2]
-            self._cache[key] = {s: np.array([r[s] for r in rows]) for s in rows[0]}
+            self._cache[key] = {s: np.array([h[s] for h in heats])[which] for s in heats[0]}
+        return self._cache[key]
+
+    def _operating_points(self) -> tuple[list[tuple], np.ndarray]:
+        """The run's distinct operating points (speed [rpm] to 1e-3, torque [N m] to 0.01,
+        measured power [kW] to 0.01 or None) and, per interval, its point's index: the
+        power balances are made once per point."""
+        key = ("src", "points")
+        if key not in self._cache:
+            inp = self.inputs
+            index: dict[tuple, int] = {}
+            # measured power to 10 W: below the losses' own uncertainty, and it keeps the
+            # number of distinct operating points (power-balance calls) small
+            which = [index.setdefault((round(float(n), 3), round(float(M), 2),
+                                       None if np.isnan(P) else round(float(P), 2)), len(index))
+                     for n, M, P in zip(inp.speed_rpm, inp.load_torque_Nm, inp.power_kW,
+                                        strict=True)]
+            self._cache[key] = (list(index), np.array(which, dtype=np.intp))
         return self._cache[key]
 
     # ------------------------------------------------------------------ model
@@ -453,6 +461,7 @@ class GreyBox:
         first = np.flatnonzero(np.r_[True, (dts[1:] != dts[:-1]) | (n_K[1:] != n_K[:-1])])[:n_int]
         sys.prepare_modes(dts[first], n_K[first])
         bounds = [*first.tolist(), n_int]
+        heats = heat_keys = None
         for k, j in zip(bounds[:-1], bounds[1:], strict=True):
             modal = None if sys.temperature_dependent else sys.modes(float(dts[k]), float(n_K[k]))
             if modal is not None:
@@ -461,8 +470,16 @@ class GreyBox:
                 Y[k + 1:j + 1] = Yseg
                 x = from_modal @ z
             else:  # a feedback of the heat on temperatures: its heat enters the matrices
+                if heats is None:  # binned once a simulation, the same floats as per row
+                    heats = self._binned(U[:, :m])
+                    heat_keys = list(map(tuple, heats.tolist()))
+                steps: dict[tuple, tuple] = {}  # a step per distinct heat of this segment
                 for i in range(k, j):
-                    Phi, Gam = sys.discretize(float(dts[i]), float(n_K[i]), self._binned(U[i, :m]))
+                    step = steps.get(heat_keys[i])
+                    if step is None:
+                        step = steps[heat_keys[i]] = sys.discretize(float(dts[k]),
+                                                                    float(n_K[k]), heats[i])
+                    Phi, Gam = step
                     x = Phi @ x + Gam @ U[i]
                     Y[i + 1] = readout @ x
         out: dict[str, np.ndarray] = {n: Y[:, i] for i, n in enumerate(names)}
