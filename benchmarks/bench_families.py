@@ -40,7 +40,10 @@ Each drawn run's truth gives its effects' sizes; the rates are also given on the
 every effect reaches the peer's stated floor, 1.5 K or 2 um in some channel.
 
 The synthetic runs are kept in ``--cache`` (default benchmarks/.families-cache, ignored by
-git) and fitted again on the next call: they do not depend on the fit. Prints per family the
+git) and fitted again on the next call: they do not depend on the fit. On a fresh machine the
+cache is empty, and each drawn run is first synthesised by the FEM reference at level 2 with its
+drawn spindle (``--synth-only`` does only that): 20 s to several minutes a run (effect-1 75 s,
+effect-2 22 s on a slow 2-core machine, 2026-12-02), hours for the main set's 223 runs. Prints per family the
 share of runs with the right verdict, and the issue's rates with 95 % Wilson intervals: the
 true effect named first, nothing named on clean runs, ``unexplained`` and nothing named on
 runs outside the library, a false second effect, a wrong effect named on any run, and the
